@@ -1,0 +1,14 @@
+//! Shared foundation of autoshovel: plane geometry aliases, poses and frame
+//! conventions (SPEC §1), angle wrapping, polylines and cubic B-splines.
+//!
+//! Every other crate depends on this one; it depends on nothing of ours.
+
+mod angle;
+mod bspline;
+mod geom;
+mod polyline;
+
+pub use angle::{angle_diff, deg, rad, wrap_angle};
+pub use bspline::{CubicBSpline, CurveSample};
+pub use geom::{heading_vec, perp, Pose2, Vec2};
+pub use polyline::{arc_lengths, menger_curvature, polyline_length, segment_nearest};

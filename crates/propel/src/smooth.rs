@@ -1,0 +1,89 @@
+//! Cubic B-spline smoothing of a raw potential-field polyline
+//! (electric-shovel paper §3.3), then resampling by arc length.
+//!
+//! The paper does not say how the control points are chosen. We decimate the
+//! raw polyline to about one control point per `control_spacing_m` (keeping
+//! the start, the end of the lead-in and the goal), so the spline cuts the
+//! descent's zig-zags while its clamped ends keep the start point and the
+//! arrival direction. The caller checks clearance and halves the spacing when
+//! the smoothed curve cuts a corner too close.
+
+use autoshovel_core::{CubicBSpline, CurveSample, Vec2};
+use serde::{Deserialize, Serialize};
+
+/// Smoothing parameters.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SmoothParams {
+    /// Target distance between B-spline control points [m].
+    pub control_spacing_m: f64,
+    /// Spacing of the output samples [m].
+    pub sample_spacing_m: f64,
+    /// Smallest control spacing tried when the smoothed path collides [m].
+    pub min_control_spacing_m: f64,
+}
+
+impl Default for SmoothParams {
+    fn default() -> Self {
+        Self { control_spacing_m: 1.0, sample_spacing_m: 0.1, min_control_spacing_m: 0.1 }
+    }
+}
+
+/// Picks control points from `raw` about `spacing_m` apart along its length,
+/// always keeping the first point, the point at index `keep` (end of the
+/// lead-in) and the last point.
+pub fn decimate(raw: &[Vec2], spacing_m: f64, keep: usize) -> Vec<Vec2> {
+    let mut out = Vec::new();
+    let Some(&first) = raw.first() else { return out };
+    out.push(first);
+    let mut since = 0.0;
+    for i in 1..raw.len() {
+        since += (raw[i] - raw[i - 1]).norm();
+        let last = i + 1 == raw.len();
+        if last || i == keep || since >= spacing_m {
+            // Avoid a near-duplicate final control point (it would bend the end tangent).
+            if last && since < 0.5 * spacing_m && out.len() > 1 && i != keep {
+                out.pop();
+            }
+            out.push(raw[i]);
+            since = 0.0;
+        }
+    }
+    out
+}
+
+/// Smooths `raw` into samples spaced `sample_spacing_m` apart.
+pub fn smooth(raw: &[Vec2], control_spacing_m: f64, sample_spacing_m: f64, keep: usize) -> Vec<CurveSample> {
+    let ctrl = decimate(raw, control_spacing_m, keep);
+    match CubicBSpline::clamped(ctrl) {
+        Some(spline) => spline.sample_by_arc_length(sample_spacing_m),
+        None => Vec::new(),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use approx::assert_relative_eq;
+
+    #[test]
+    fn decimation_keeps_ends_and_spacing() {
+        let raw: Vec<Vec2> = (0..=100).map(|i| Vec2::new(0.1 * i as f64, 0.0)).collect();
+        let c = decimate(&raw, 1.0, 10);
+        assert_relative_eq!(c[0], raw[0]);
+        assert_relative_eq!(*c.last().unwrap(), raw[100]);
+        assert!(c.contains(&raw[10]));
+        assert!(c.len() >= 10 && c.len() <= 12, "{}", c.len());
+    }
+
+    #[test]
+    fn zigzag_is_smoothed_towards_its_mean_line() {
+        // A descent oscillating ±5 cm about y = 0 becomes (nearly) straight.
+        let raw: Vec<Vec2> = (0..=200).map(|i| Vec2::new(0.1 * i as f64, if i % 2 == 0 { 0.05 } else { -0.05 })).collect();
+        let s = smooth(&raw, 1.0, 0.1, 0);
+        let max_dev = s.iter().map(|c| c.point.y.abs()).fold(0.0, f64::max);
+        assert!(max_dev <= 0.05 + 1e-12);
+        let max_kappa = s.iter().skip(2).map(|c| c.curvature.abs()).fold(0.0, f64::max);
+        assert!(max_kappa < 0.5, "curvature {max_kappa}");
+    }
+}

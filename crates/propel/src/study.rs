@@ -1,0 +1,1 @@
+//! Random haul-road study (todo)
