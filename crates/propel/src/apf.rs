@@ -13,8 +13,11 @@
 //!   capped field (|F| = ηρ_d beyond ρ_d), which is what "capped attraction"
 //!   describes and keeps the descent from kinking at ρ_d.
 //! - Eqs. 9–11 scale the repulsion by ρⁿ(q, q_t). We measure that distance in
-//!   units of ρ_d, (ρ(q, q_t)/ρ_d)ⁿ, so that k keeps the units of the classic
-//!   field; F_rep1 pushes from the obstacle to the machine and F_rep2, the
+//!   units of ρ_d and saturate it at 1, min(ρ(q, q_t)/ρ_d, 1)ⁿ, so that k keeps
+//!   the units of the classic field and far from the target the repulsion is
+//!   the classic one. Unbounded, ρⁿ grows with the distance to the target and
+//!   walls off every gap between an obstacle and the road edge (the random
+//!   road study failed on most maps that way). F_rep1 pushes from the obstacle to the machine and F_rep2, the
 //!   derivative of the same potential with respect to ρ(q, q_t), pulls the
 //!   machine towards the target (eq. 11: F_rep2 = n/2·k(1/ρ − 1/ρ0)²ρⁿ⁻¹).
 //!   Both vanish at the target, so a goal next to an obstacle is reachable.
@@ -110,9 +113,9 @@ impl ApfParams {
     pub fn improved() -> Self {
         Self {
             eta: 1.0,
-            rho_d_m: 5.0,
-            k_rep: 2.0,
-            rho0_m: 3.0,
+            rho_d_m: 10.0,
+            k_rep: 0.7,
+            rho0_m: 2.0,
             n: 2.0,
             mu: 0.7,
             rho_t_m: 5.0,
@@ -190,7 +193,9 @@ pub fn field_force(map: &Map, q: Vec2, target: &Target, footprint_radius_m: f64,
             att + virt
         }
     };
-    let s = rt / p.rho_d_m;
+    // (ρ(q,q_t)/ρ_d)ⁿ, saturating at 1 beyond ρ_d (see the module notes).
+    let s = (rt / p.rho_d_m).min(1.0);
+    let far = rt > p.rho_d_m;
     map.for_each_nearest(q, |nb| {
         let rho = (nb.distance - footprint_radius_m).max(p.min_clearance_m);
         if rho >= p.rho0_m {
@@ -201,7 +206,7 @@ pub fn field_force(map: &Map, q: Vec2, target: &Target, footprint_radius_m: f64,
             FieldKind::Classic => f += nb.normal * (p.k_rep * a / (rho * rho)),
             FieldKind::Improved => {
                 let rep1 = p.k_rep * a * s.powf(p.n) / (rho * rho);
-                let rep2 = 0.5 * p.n * p.k_rep * a * a * s.powf(p.n - 1.0) / p.rho_d_m;
+                let rep2 = if far { 0.0 } else { 0.5 * p.n * p.k_rep * a * a * s.powf(p.n - 1.0) / p.rho_d_m };
                 f += nb.normal * rep1 + u_goal * rep2;
             }
         }
@@ -251,7 +256,7 @@ pub fn descend(
     let mut iterations = 0;
     let mut escapes = 0;
     let mut resume_index = raw.len() - 1;
-    let mut stalls: Vec<(Vec2, f64)> = Vec::new();
+    let mut stalls: Vec<Vec2> = Vec::new();
     loop {
         let q = *raw.last().expect("raw starts non-empty");
         if (target.position - q).norm() <= p.goal_tolerance_m {
@@ -287,13 +292,29 @@ pub fn descend(
             return Descent { raw, iterations, escapes, stalled_at: Some(q) };
         }
         escapes += 1;
-        // Flip the side when stalling again near an earlier stall.
-        let again = stalls.iter().filter(|(s, _)| (s - q).norm() < 2.0).count();
-        let side_hint = if again % 2 == 0 { 1.0 } else { -1.0 };
-        let goal_dist = (target.position - q).norm();
-        stalls.push((q, goal_dist));
-        match follow_boundary(map, q, target, footprint_radius_m, kind, p, side_hint, &mut iterations, max_steps) {
+        // Stalling again where it stalled before: the field leads back into the
+        // same basin, so follow the boundary further before leaving it.
+        let repeats = stalls.iter().filter(|s| (*s - q).norm() < 2.0).count() as i32;
+        stalls.push(q);
+        let margin = 2.0 * p.step_m * 4f64.powi(repeats);
+        // Try both ways round, first at the clearance held at the stall, then
+        // closer (a narrow gap closes the level set of a wide clearance);
+        // keep the shorter way that gets past.
+        let budget_left = max_steps.saturating_sub(iterations);
+        let mut keep = (map.nearest(q).distance - footprint_radius_m).min(p.rho0_m);
+        let best = loop {
+            let found = [1.0, -1.0]
+                .into_iter()
+                .filter_map(|side| follow_boundary(map, q, target, footprint_radius_m, kind, p, side, keep, margin, budget_left))
+                .min_by_key(|seg| seg.len());
+            if found.is_some() || keep < 2.0 * MIN_FOLLOW_CLEARANCE_M {
+                break found;
+            }
+            keep = (keep * 0.5).max(MIN_FOLLOW_CLEARANCE_M);
+        };
+        match best {
             Some(seg) => {
+                iterations += seg.len();
                 raw.extend(seg);
                 resume_index = raw.len() - 1;
             }
@@ -302,9 +323,15 @@ pub fn descend(
     }
 }
 
-/// Tangent-bug escape: walk along the nearest element's boundary, keeping the
-/// clearance held at the stall, until closer to the target than the stall
-/// point and the field points onwards. `side_hint` flips the preferred side.
+/// Closest the boundary-following escape goes to an obstacle [m].
+const MIN_FOLLOW_CLEARANCE_M: f64 = 0.05;
+
+/// Tangent-bug escape: walk along the level set of the map's distance field
+/// (so round a cluster of obstacles as one), keeping the obstacles on the
+/// `side` (+1: on the left), until closer to the target than the
+/// stall point with the field pointing onwards. `None` when it cannot get
+/// past within `budget` steps. `keep` is the footprint clearance to hold and
+/// `margin` how much closer than the stall it must get before leaving [m].
 #[allow(clippy::too_many_arguments)]
 fn follow_boundary(
     map: &Map,
@@ -313,50 +340,31 @@ fn follow_boundary(
     footprint_radius_m: f64,
     kind: FieldKind,
     p: &ApfParams,
-    side_hint: f64,
-    iterations: &mut usize,
-    max_steps: usize,
+    side: f64,
+    keep: f64,
+    margin: f64,
+    budget: usize,
 ) -> Option<Vec<Vec2>> {
     let d_stall = (target.position - start).norm();
-    let nb = map.nearest(start);
-    let keep = (nb.distance - footprint_radius_m).max(0.3 * p.rho0_m).min(p.rho0_m);
-    let to_goal = target.position - start;
-    let t0 = perp(nb.normal);
-    let lean = t0.dot(&to_goal);
-    let mut side = if lean.abs() > 0.05 * to_goal.norm() {
-        lean.signum()
-    } else {
-        // Symmetric: take the side with more room a few metres on.
-        let probe = |s: f64| map.clearance(start + t0 * (s * 2.0), footprint_radius_m);
-        if probe(1.0) >= probe(-1.0) {
-            1.0
-        } else {
-            -1.0
-        }
-    };
-    side *= side_hint;
+    let keep = keep.max(MIN_FOLLOW_CLEARANCE_M);
     let mut q = start;
     let mut seg = Vec::new();
-    let budget = ((4.0 * std::f64::consts::PI * p.rho0_m + 40.0) / p.step_m) as usize;
-    for _ in 0..budget {
-        if *iterations >= max_steps {
-            return None;
-        }
+    let limit = budget.min(((4.0 * std::f64::consts::PI * p.rho0_m + 60.0) / p.step_m) as usize);
+    for _ in 0..limit {
         let nb = map.nearest(q);
         let c = nb.distance - footprint_radius_m;
-        let dir = perp(nb.normal) * side + nb.normal * (keep - c);
+        let dir = perp(nb.normal) * side + nb.normal * ((keep - c) / p.step_m).clamp(-1.0, 1.0);
         let next = q + dir.normalize() * p.step_m;
         if map.clearance(next, footprint_radius_m) <= 0.0 {
             return None;
         }
         q = next;
         seg.push(q);
-        *iterations += 1;
         let dg = (target.position - q).norm();
         if dg <= p.goal_tolerance_m {
             return Some(seg);
         }
-        if dg < d_stall - 2.0 * p.step_m {
+        if dg < d_stall - margin {
             let f = field_force(map, q, target, footprint_radius_m, kind, p);
             let nb = map.nearest(q);
             if f.dot(&(target.position - q)) > 0.0 && f.dot(&nb.normal) >= 0.0 {
