@@ -124,7 +124,7 @@ impl ApfParams {
             lead_in_m: 1.0,
             min_clearance_m: 0.01,
             stall_window: 40,
-            stall_ratio: 0.25,
+            stall_ratio: 0.1,
             escape: true,
             max_escapes: 8,
             steps_per_m_limit: 40.0,
@@ -287,6 +287,10 @@ pub fn descend(
         if !stalled {
             continue;
         }
+        // Drop the hesitation: back to where the stall window began.
+        if raw.len() > resume_index + p.stall_window {
+            raw.truncate(raw.len() - p.stall_window);
+        }
         let q = *raw.last().expect("non-empty");
         if !p.escape || escapes >= p.max_escapes || iterations >= max_steps {
             return Descent { raw, iterations, escapes, stalled_at: Some(q) };
@@ -297,16 +301,17 @@ pub fn descend(
         let repeats = stalls.iter().filter(|s| (*s - q).norm() < 2.0).count() as i32;
         stalls.push(q);
         let margin = 2.0 * p.step_m * 4f64.powi(repeats);
-        // Try both ways round, first at the clearance held at the stall, then
-        // closer (a narrow gap closes the level set of a wide clearance);
+        // Try both ways round, first at half the influence range (or the
+        // clearance held at the stall, if more), then closer (a narrow gap closes the level set of a wide clearance);
         // keep the shorter way that gets past.
         let budget_left = max_steps.saturating_sub(iterations);
-        let mut keep = (map.nearest(q).distance - footprint_radius_m).min(p.rho0_m);
+        let mut keep = (map.nearest(q).distance - footprint_radius_m).max(0.5 * p.rho0_m).min(p.rho0_m);
         let best = loop {
-            let found = [1.0, -1.0]
-                .into_iter()
-                .filter_map(|side| follow_boundary(map, q, target, footprint_radius_m, kind, p, side, keep, margin, budget_left))
-                .min_by_key(|seg| seg.len());
+            // The second side only needs to beat the first one's length.
+            let first = follow_boundary(map, q, target, footprint_radius_m, kind, p, 1.0, keep, margin, budget_left);
+            let limit = first.as_ref().map_or(budget_left, |seg| seg.len().saturating_sub(1));
+            let second = follow_boundary(map, q, target, footprint_radius_m, kind, p, -1.0, keep, margin, limit);
+            let found = second.or(first);
             if found.is_some() || keep < 2.0 * MIN_FOLLOW_CLEARANCE_M {
                 break found;
             }

@@ -6,7 +6,7 @@
 //! The machine is a disc of radius `footprint_radius_m` (at least its
 //! half-width); clearance is the distance from that disc to the nearest element.
 
-use autoshovel_core::{perp, segment_nearest, Vec2};
+use autoshovel_core::{perp, Vec2};
 
 /// The shape of one obstacle.
 #[derive(Debug, Clone, PartialEq)]
@@ -126,8 +126,10 @@ impl Shape {
                 (r - radius, normal)
             }
             Shape::Polygon { vertices } => {
+                // Squared distances in the loop, one square root at the end:
+                // this runs for every obstacle at every descent step.
                 let n = vertices.len();
-                let mut best = f64::INFINITY;
+                let mut best2 = f64::INFINITY;
                 let mut best_q = vertices[0];
                 let mut best_edge = 0;
                 let mut inside = true;
@@ -135,17 +137,21 @@ impl Shape {
                     let a = vertices[i];
                     let b = vertices[(i + 1) % n];
                     let e = b - a;
-                    if e.x * (p - a).y - e.y * (p - a).x < 0.0 {
+                    let ap = p - a;
+                    if e.x * ap.y - e.y * ap.x < 0.0 {
                         inside = false;
                     }
-                    let (q, _) = segment_nearest(p, a, b);
-                    let d = (p - q).norm();
-                    if d < best {
-                        best = d;
+                    let len2 = e.norm_squared();
+                    let t = if len2 > 0.0 { (ap.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    let q = a + e * t;
+                    let d2 = (p - q).norm_squared();
+                    if d2 < best2 {
+                        best2 = d2;
                         best_q = q;
                         best_edge = i;
                     }
                 }
+                let best = best2.sqrt();
                 let outward_edge = {
                     let e = vertices[(best_edge + 1) % n] - vertices[best_edge];
                     -perp(e).normalize()
@@ -181,16 +187,31 @@ fn bounds_of(points: &[Vec2]) -> (Vec2, Vec2) {
 }
 
 fn polyline_nearest(points: &[Vec2], p: Vec2) -> (f64, Vec2) {
-    let mut best = f64::INFINITY;
-    let mut normal = Vec2::new(1.0, 0.0);
-    for w in points.windows(2) {
-        let (q, _) = segment_nearest(p, w[0], w[1]);
-        let d = (p - q).norm();
-        if d < best {
-            best = d;
-            normal = if d > 1e-12 { (p - q) / d } else { perp(w[1] - w[0]).normalize() };
+    let mut best2 = f64::INFINITY;
+    let mut best_q = p;
+    let mut best_seg = 0;
+    for (i, w) in points.windows(2).enumerate() {
+        let (a, b) = (w[0], w[1]);
+        let e = b - a;
+        let ap = p - a;
+        let len2 = e.norm_squared();
+        let t = if len2 > 0.0 { (ap.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        let q = a + e * t;
+        let d2 = (p - q).norm_squared();
+        if d2 < best2 {
+            best2 = d2;
+            best_q = q;
+            best_seg = i;
         }
     }
+    let best = best2.sqrt();
+    let normal = if best > 1e-12 {
+        (p - best_q) / best
+    } else if points.len() >= 2 {
+        perp(points[best_seg + 1] - points[best_seg]).normalize()
+    } else {
+        Vec2::new(1.0, 0.0)
+    };
     (best, normal)
 }
 

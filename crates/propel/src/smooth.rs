@@ -29,27 +29,32 @@ impl Default for SmoothParams {
     }
 }
 
-/// Picks control points from `raw` about `spacing_m` apart along its length,
-/// always keeping the first point, the point at index `keep` (end of the
-/// lead-in) and the last point.
+/// Picks control points from `raw`: the next raw point at least `spacing_m`
+/// (straight-line) from the last control point, always keeping the first
+/// point, the point at index `keep` (end of the lead-in) and the last point.
+/// Measuring from the last kept point, not along the polyline, drops the
+/// back-and-forth of a descent that hesitated.
 pub fn decimate(raw: &[Vec2], spacing_m: f64, keep: usize) -> Vec<Vec2> {
-    let mut out = Vec::new();
+    let mut out: Vec<Vec2> = Vec::new();
     let Some(&first) = raw.first() else { return out };
     out.push(first);
-    let mut since = 0.0;
     for i in 1..raw.len() {
-        since += (raw[i] - raw[i - 1]).norm();
         let last = i + 1 == raw.len();
-        if last || i == keep || since >= spacing_m {
+        let from_kept = (raw[i] - out[out.len() - 1]).norm();
+        if last || i == keep || from_kept >= spacing_m {
             // Avoid a near-duplicate final control point (it would bend the end tangent).
-            if last && since < 0.5 * spacing_m && out.len() > 1 && i != keep {
+            if last && from_kept < 0.5 * spacing_m && out.len() > 1 && i != keep && out.len() - 1 != keep_index(&out, raw, keep) {
                 out.pop();
             }
             out.push(raw[i]);
-            since = 0.0;
         }
     }
     out
+}
+
+/// Index in `out` of the lead-in control point (raw[keep]), or usize::MAX.
+fn keep_index(out: &[Vec2], raw: &[Vec2], keep: usize) -> usize {
+    raw.get(keep).and_then(|k| out.iter().position(|p| p == k)).unwrap_or(usize::MAX)
 }
 
 /// Smooths `raw` into samples spaced `sample_spacing_m` apart.

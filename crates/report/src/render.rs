@@ -429,6 +429,27 @@ fn draw_path<'a, DB: DrawingBackend + 'a>(
         return Ok(());
     }
     let style = line_style(stroke);
+    // Thin the run to a few pixels between vertices: plotters' bitmap backend
+    // draws each segment of a wide line on its own, and hundreds of
+    // sub-pixel segments come out ragged.
+    let min_px = 3i64;
+    let mut thinned: Vec<Pt> = Vec::with_capacity(run.len());
+    let mut last_px: Option<(i32, i32)> = None;
+    for (i, p) in run.iter().enumerate() {
+        let px = chart.backend_coord(p);
+        let far = match last_px {
+            None => true,
+            Some(l) => {
+                let (dx, dy) = ((px.0 - l.0) as i64, (px.1 - l.1) as i64);
+                dx * dx + dy * dy >= min_px * min_px
+            }
+        };
+        if far || i + 1 == run.len() {
+            thinned.push(*p);
+            last_px = Some(px);
+        }
+    }
+    let run = thinned;
     if stroke.dashed {
         let (dash, gap) = dash_pattern(stroke.width.min(MAX_STROKE_PX));
         chart.draw_series(std::iter::once(DashedPathElement::new(

@@ -1,0 +1,93 @@
+//! `autoshovel demo`: every job on its embedded defaults, one report
+//! (`index.html` linking each job's plots and tabulating its summary).
+
+use std::path::Path;
+
+use anyhow::Result;
+use autoshovel_propel::study::StudyParams;
+use autoshovel_propel::{FieldKind, Scenario};
+use autoshovel_report::{write_index_html, write_summary, Section};
+use serde_json::{json, Value};
+
+use crate::output::{prepare_dir, print_json};
+
+/// Runs the demo into `out`.
+pub fn run(out: &Path, json_only: bool) -> Result<()> {
+    let out = prepare_dir(out)?;
+    let mut sections = Vec::new();
+    let mut summaries = serde_json::Map::new();
+    let runs: [(&str, FieldKind, &str); 6] = [
+        ("straight", FieldKind::Improved, "Straight travel along a haul road (Fig. 1a)."),
+        ("curve", FieldKind::Improved, "Round a parked truck and a stockpile on a bending road (Fig. 1b, Fig. 4a/b)."),
+        ("curve", FieldKind::Classic, "The classic field (eqs. 1–5) on the same road, the paper's baseline: it has no heading control and no escape."),
+        ("curve-reverse", FieldKind::Improved, "The same road travelled in reverse."),
+        ("v-shape", FieldKind::Improved, "V-shaped move: reverse to the midpoint, stop, forward to the new face, arriving square to it (Fig. 1c, Fig. 4c/d)."),
+        ("v-shape", FieldKind::Classic, "The classic field on the V-shaped move."),
+    ];
+    for (name, field, description) in runs {
+        let scenario = Scenario::builtin(name).expect("built-in scenario");
+        let key = format!("plan-path {name} {}", field.name());
+        let sub = format!("plan-path-{name}-{}", field.name());
+        let dir = prepare_dir(&out.join(&sub))?;
+        let job = crate::plan_path::job(&scenario, field, Some(&dir))?;
+        if !json_only {
+            let s = &job.summary;
+            println!(
+                "{key:40} {}",
+                if s["success"].as_bool() == Some(true) {
+                    format!(
+                        "ok: {:.2} m, heading error {:.2} deg, clearance {:.2} m, {:.2} ms",
+                        s["length_m"].as_f64().unwrap_or(f64::NAN),
+                        s["final_heading_error_deg"].as_f64().unwrap_or(f64::NAN),
+                        s["min_clearance_m"].as_f64().unwrap_or(f64::NAN),
+                        s["plan_time_ms"].as_f64().unwrap_or(f64::NAN)
+                    )
+                } else {
+                    format!("failed: {}", s["error"].as_str().unwrap_or(""))
+                }
+            );
+        }
+        sections.push(section(&key, description, &job.summary, &sub, &job.written.plots, &job.written.files));
+        summaries.insert(key, job.summary);
+    }
+    let params = StudyParams { maps: 100, ..Default::default() };
+    let sub = "study-paths";
+    let dir = prepare_dir(&out.join(sub))?;
+    let (summary, written) = crate::study::study(&params, Some(&dir), !json_only)?;
+    if !json_only {
+        println!("{}", crate::study::markdown_table(&summary));
+    }
+    sections.push(section(
+        "study-paths (100 maps)",
+        "Seeded random haul roads with 3–12 obstacles: classic APF, improved APF and the Theta* reference. The full study: autoshovel study-paths --maps 500.",
+        &summary,
+        sub,
+        &written.plots,
+        &written.files,
+    ));
+    summaries.insert("study-paths".into(), summary);
+    let all = Value::Object(summaries);
+    write_summary(&out, &json!({ "job": "demo", "jobs": all }))?;
+    let index = write_index_html(&out, "autoshovel demo", &sections)?;
+    if json_only {
+        print_json(&json!({ "job": "demo", "jobs": all }))?;
+    } else {
+        println!("report: {}", index.display());
+    }
+    Ok(())
+}
+
+fn section(title: &str, description: &str, summary: &Value, sub: &str, plots: &[String], files: &[String]) -> Section {
+    let mut s = summary.clone();
+    if let Some(o) = s.as_object_mut() {
+        o.remove("params");
+        o.remove("files");
+    }
+    Section {
+        title: title.to_string(),
+        description: description.to_string(),
+        summary: s,
+        plots: plots.iter().map(|p| format!("{sub}/{p}")).collect(),
+        files: files.iter().map(|p| format!("{sub}/{p}")).collect(),
+    }
+}

@@ -1,0 +1,88 @@
+//! `autoshovel`: the command-line program. One subcommand per job (SPEC §6);
+//! each writes `summary.json`, CSV data and SVG+PNG plots with `--out DIR`
+//! and prints the summary alone with `--json`.
+
+mod demo;
+mod output;
+mod plan_path;
+mod plots;
+mod study;
+
+use std::path::PathBuf;
+use std::process::ExitCode;
+
+use clap::{Parser, Subcommand, ValueEnum};
+
+/// Autonomy toolkit for mining excavators: perceive, plan the dig, plan the walk, drive.
+#[derive(Debug, Parser)]
+#[command(name = "autoshovel", version, about, long_about = None)]
+struct Cli {
+    #[command(subcommand)]
+    command: Command,
+}
+
+#[derive(Debug, Subcommand)]
+enum Command {
+    /// Plan the crawler's walk to the next face with a potential field (SPEC §2).
+    PlanPath(plan_path::Args),
+    /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
+    StudyPaths(study::Args),
+    /// Print a built-in scenario as TOML, to copy and edit.
+    Scenario {
+        /// Built-in scenario name.
+        name: String,
+    },
+    /// Run every job on its embedded defaults and write one report (index.html).
+    Demo {
+        /// Report folder.
+        #[arg(long, default_value = "autoshovel-demo")]
+        out: PathBuf,
+        /// Print the combined summary as JSON on stdout.
+        #[arg(long)]
+        json: bool,
+    },
+}
+
+/// Field choice on the command line.
+#[derive(Debug, Clone, Copy, ValueEnum)]
+pub enum PlannerArg {
+    /// Classic artificial potential field (eqs. 1–5), the baseline.
+    Apf,
+    /// Improved artificial potential field (eqs. 6–15).
+    ImprovedApf,
+}
+
+impl From<PlannerArg> for autoshovel_propel::FieldKind {
+    fn from(p: PlannerArg) -> Self {
+        match p {
+            PlannerArg::Apf => autoshovel_propel::FieldKind::Classic,
+            PlannerArg::ImprovedApf => autoshovel_propel::FieldKind::Improved,
+        }
+    }
+}
+
+fn main() -> ExitCode {
+    let cli = Cli::parse();
+    let result = match cli.command {
+        Command::PlanPath(args) => plan_path::run(&args),
+        Command::StudyPaths(args) => study::run(&args),
+        Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS.iter().find(|(n, _)| *n == name) {
+            Some((_, text)) => {
+                print!("{text}");
+                Ok(())
+            }
+            None => Err(anyhow::anyhow!(
+                "unknown built-in scenario '{name}' (built-ins: {})",
+                autoshovel_propel::scenario::BUILTINS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+            )),
+        },
+        Command::Demo { out, json } => demo::run(&out, json),
+    };
+    match result {
+        Ok(()) => ExitCode::SUCCESS,
+        Err(e) => {
+            eprintln!("error: {e:#}");
+            ExitCode::FAILURE
+        }
+    }
+}
