@@ -47,10 +47,20 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
                 }
             );
         }
-        sections.push(section(&key, description, &job.summary, &sub, &job.written.plots, &job.written.files));
+        sections.push(section(
+            &key,
+            description,
+            &job.summary,
+            &sub,
+            &job.written.plots,
+            &job.written.files,
+        ));
         summaries.insert(key, job.summary);
     }
-    let params = StudyParams { maps: 100, ..Default::default() };
+    let params = StudyParams {
+        maps: 100,
+        ..Default::default()
+    };
     let sub = "study-paths";
     let dir = prepare_dir(&out.join(sub))?;
     let (summary, written) = crate::study::study(&params, Some(&dir), !json_only)?;
@@ -77,7 +87,14 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     Ok(())
 }
 
-fn section(title: &str, description: &str, summary: &Value, sub: &str, plots: &[String], files: &[String]) -> Section {
+fn section(
+    title: &str,
+    description: &str,
+    summary: &Value,
+    sub: &str,
+    plots: &[String],
+    files: &[String],
+) -> Section {
     let mut s = summary.clone();
     if let Some(o) = s.as_object_mut() {
         o.remove("params");

@@ -66,14 +66,21 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),
-        Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS.iter().find(|(n, _)| *n == name) {
+        Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
+            .iter()
+            .find(|(n, _)| *n == name)
+        {
             Some((_, text)) => {
                 print!("{text}");
                 Ok(())
             }
             None => Err(anyhow::anyhow!(
                 "unknown built-in scenario '{name}' (built-ins: {})",
-                autoshovel_propel::scenario::BUILTINS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", ")
+                autoshovel_propel::scenario::BUILTINS
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", ")
             )),
         },
         Command::Demo { out, json } => demo::run(&out, json),

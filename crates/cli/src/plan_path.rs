@@ -5,8 +5,12 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
 use autoshovel_core::Vec2;
-use autoshovel_propel::{astar, plan_path, AstarParams, FieldKind, Plan, PlanOptions, PropelError, Scenario};
-use autoshovel_report::{write_csv, write_figure, write_panels, write_summary, Figure, Layer, Rgb, Stroke};
+use autoshovel_propel::{
+    astar, plan_path, AstarParams, FieldKind, Plan, PlanOptions, PropelError, Scenario,
+};
+use autoshovel_report::{
+    write_csv, write_figure, write_panels, write_summary, Figure, Layer, Rgb, Stroke,
+};
 use serde_json::{json, Value};
 
 use crate::output::{num, prepare_dir, print_json, Written};
@@ -50,26 +54,56 @@ pub fn run(args: &Args) -> Result<()> {
     } else {
         print_human(&job.summary);
         if let Some(dir) = &out {
-            println!("wrote {} (summary.json, CSV, SVG and PNG plots)", dir.display());
+            println!(
+                "wrote {} (summary.json, CSV, SVG and PNG plots)",
+                dir.display()
+            );
         }
     }
     match job.error {
-        Some(e) => Err(anyhow::Error::new(e).context(format!("{} could not plan scenario '{}'", job.summary["planner"].as_str().unwrap_or("planner"), scenario.name))),
+        Some(e) => Err(anyhow::Error::new(e).context(format!(
+            "{} could not plan scenario '{}'",
+            job.summary["planner"].as_str().unwrap_or("planner"),
+            scenario.name
+        ))),
         None => Ok(()),
     }
 }
 
 fn print_human(s: &Value) {
-    let f = |k: &str| s[k].as_f64().map(|v| format!("{v:.3}")).unwrap_or_else(|| "-".into());
+    let f = |k: &str| {
+        s[k].as_f64()
+            .map(|v| format!("{v:.3}"))
+            .unwrap_or_else(|| "-".into())
+    };
     println!(
         "{} on {}: {}",
         s["planner"].as_str().unwrap_or(""),
         s["scenario"].as_str().unwrap_or(""),
-        if s["success"].as_bool() == Some(true) { "success" } else { "FAILED" }
+        if s["success"].as_bool() == Some(true) {
+            "success"
+        } else {
+            "FAILED"
+        }
     );
-    println!("  length            {} m (reference {} m, ratio {})", f("length_m"), s["reference"]["length_m"].as_f64().map(|v| format!("{v:.3}")).unwrap_or("-".into()), s["reference"]["length_ratio"].as_f64().map(|v| format!("{v:.3}")).unwrap_or("-".into()));
+    println!(
+        "  length            {} m (reference {} m, ratio {})",
+        f("length_m"),
+        s["reference"]["length_m"]
+            .as_f64()
+            .map(|v| format!("{v:.3}"))
+            .unwrap_or("-".into()),
+        s["reference"]["length_ratio"]
+            .as_f64()
+            .map(|v| format!("{v:.3}"))
+            .unwrap_or("-".into())
+    );
     println!("  min clearance     {} m", f("min_clearance_m"));
-    println!("  heading error     {} deg at the goal, {} deg at the start", f("final_heading_error_deg"), f("start_heading_error_deg"));
+    println!(
+        "  heading error     {} deg at the goal, {} deg at the start",
+        f("final_heading_error_deg"),
+        f("start_heading_error_deg")
+    );
     println!("  max curvature     {} 1/m", f("max_curvature_per_m"));
     println!("  escapes           {}", s["escapes"]);
     println!("  plan time         {} ms", f("plan_time_ms"));
@@ -82,7 +116,13 @@ pub fn job(scenario: &Scenario, field: FieldKind, out: Option<&Path>) -> Result<
     // The reference route, leg by leg (heading-free, so a near lower bound on length).
     let mut reference: Option<(f64, Vec<Vec<Vec2>>)> = Some((0.0, Vec::new()));
     for (from, to, _) in scenario.legs() {
-        match astar(&scenario.map, from.position(), to.position(), scenario.footprint_radius_m, &AstarParams::default()) {
+        match astar(
+            &scenario.map,
+            from.position(),
+            to.position(),
+            scenario.footprint_radius_m,
+            &AstarParams::default(),
+        ) {
             Ok(r) => {
                 if let Some((len, pts)) = reference.as_mut() {
                     *len += r.length_m;
@@ -93,17 +133,38 @@ pub fn job(scenario: &Scenario, field: FieldKind, out: Option<&Path>) -> Result<
         }
     }
     let mut summary = match &result {
-        Ok(plan) => summary_ok(scenario, field, &opts, plan, reference.as_ref().map(|r| r.0)),
+        Ok(plan) => summary_ok(
+            scenario,
+            field,
+            &opts,
+            plan,
+            reference.as_ref().map(|r| r.0),
+        ),
         Err(e) => summary_err(scenario, field, &opts, e, reference.as_ref().map(|r| r.0)),
     };
     let mut written = Written::default();
     if let Some(dir) = out {
-        write_outputs(dir, scenario, field, &result, reference.as_ref().map(|r| &r.1), &mut written)?;
+        write_outputs(
+            dir,
+            scenario,
+            field,
+            &result,
+            reference.as_ref().map(|r| &r.1),
+            &mut written,
+        )?;
         written.file(dir, &dir.join("summary.json"));
-        summary["files"] = json!(written.files.iter().chain(written.plots.iter()).collect::<Vec<_>>());
+        summary["files"] = json!(written
+            .files
+            .iter()
+            .chain(written.plots.iter())
+            .collect::<Vec<_>>());
         write_summary(dir, &summary)?;
     }
-    Ok(Job { summary, written, error: result.err() })
+    Ok(Job {
+        summary,
+        written,
+        error: result.err(),
+    })
 }
 
 fn escape_strategy(plan: &Plan) -> Value {
@@ -114,7 +175,13 @@ fn escape_strategy(plan: &Plan) -> Value {
     }
 }
 
-fn summary_ok(scenario: &Scenario, field: FieldKind, opts: &PlanOptions, plan: &Plan, reference_m: Option<f64>) -> Value {
+fn summary_ok(
+    scenario: &Scenario,
+    field: FieldKind,
+    opts: &PlanOptions,
+    plan: &Plan,
+    reference_m: Option<f64>,
+) -> Value {
     let m = &plan.metrics;
     json!({
         "job": "plan-path",
@@ -153,7 +220,13 @@ fn summary_ok(scenario: &Scenario, field: FieldKind, opts: &PlanOptions, plan: &
     })
 }
 
-fn summary_err(scenario: &Scenario, field: FieldKind, opts: &PlanOptions, e: &PropelError, reference_m: Option<f64>) -> Value {
+fn summary_err(
+    scenario: &Scenario,
+    field: FieldKind,
+    opts: &PlanOptions,
+    e: &PropelError,
+    reference_m: Option<f64>,
+) -> Value {
     let at = e.position();
     json!({
         "job": "plan-path",
@@ -190,59 +263,170 @@ fn write_outputs(
     if let Some(legs) = reference {
         for (i, pts) in legs.iter().enumerate() {
             let l = Layer::line(pts.iter().map(|p| (p.x, p.y)), Stroke::dashed(Rgb::GREY, 1));
-            fig.push(if i == 0 { l.with_label("Theta* reference") } else { l });
+            fig.push(if i == 0 {
+                l.with_label("Theta* reference")
+            } else {
+                l
+            });
         }
     }
     let arrow = 3.0 * scenario.footprint_radius_m;
     match result {
         Ok(plan) => {
             for (i, leg) in plan.path.legs.iter().enumerate() {
-                let raw = Layer::line(leg.raw.iter().map(|p| (p.x, p.y)), Stroke::solid(Rgb::BLUE, 1));
-                fig.push(if i == 0 { raw.with_label("raw APF path") } else { raw });
-                let color = if leg.direction == autoshovel_propel::Direction::Reverse { Rgb::PURPLE } else { Rgb::RED };
-                let smooth = Layer::line(leg.points.iter().map(|p| (p.pose.x, p.pose.y)), Stroke::solid(color, 2));
-                fig.push(smooth.with_label(format!("smoothed, leg {} ({})", i + 1, leg.direction.name())));
+                let raw = Layer::line(
+                    leg.raw.iter().map(|p| (p.x, p.y)),
+                    Stroke::solid(Rgb::BLUE, 1),
+                );
+                fig.push(if i == 0 {
+                    raw.with_label("raw APF path")
+                } else {
+                    raw
+                });
+                let color = if leg.direction == autoshovel_propel::Direction::Reverse {
+                    Rgb::PURPLE
+                } else {
+                    Rgb::RED
+                };
+                let smooth = Layer::line(
+                    leg.points.iter().map(|p| (p.pose.x, p.pose.y)),
+                    Stroke::solid(color, 2),
+                );
+                fig.push(smooth.with_label(format!(
+                    "smoothed, leg {} ({})",
+                    i + 1,
+                    leg.direction.name()
+                )));
             }
         }
         Err(e) => {
             if let Some(p) = e.position() {
-                fig.push(Layer::points([(p.x, p.y)], Rgb::RED, 8).with_label("local minimum / failure"));
+                fig.push(
+                    Layer::points([(p.x, p.y)], Rgb::RED, 8).with_label("local minimum / failure"),
+                );
             }
         }
     }
-    fig.push(heading_arrow(scenario.start, arrow, Rgb::GREEN, "start heading"));
+    fig.push(heading_arrow(
+        scenario.start,
+        arrow,
+        Rgb::GREEN,
+        "start heading",
+    ));
     if let Some(m) = scenario.midpoint {
         fig.push(heading_arrow(m, arrow, Rgb::ORANGE, "midpoint heading"));
     }
-    fig.push(heading_arrow(scenario.goal, arrow, Rgb::BLACK, "required goal heading"));
-    written.plot(dir, write_figure(&fig, dir, "path").context("writing the path plot")?);
+    fig.push(heading_arrow(
+        scenario.goal,
+        arrow,
+        Rgb::BLACK,
+        "required goal heading",
+    ));
+    written.plot(
+        dir,
+        write_figure(&fig, dir, "path").context("writing the path plot")?,
+    );
 
     if let Ok(plan) = result {
         let csv = dir.join("path.csv");
         let rows = plan.path.legs.iter().enumerate().flat_map(|(i, leg)| {
-            leg.points.iter().map(move |p| vec![i as f64, leg.direction.sign(), p.s_m, p.pose.x, p.pose.y, p.pose.theta.to_degrees(), p.curvature_per_m])
+            leg.points.iter().map(move |p| {
+                vec![
+                    i as f64,
+                    leg.direction.sign(),
+                    p.s_m,
+                    p.pose.x,
+                    p.pose.y,
+                    p.pose.theta.to_degrees(),
+                    p.curvature_per_m,
+                ]
+            })
         });
-        write_csv(&csv, &["leg", "direction", "s_m", "x_m", "y_m", "heading_deg", "curvature_per_m"], rows)?;
+        write_csv(
+            &csv,
+            &[
+                "leg",
+                "direction",
+                "s_m",
+                "x_m",
+                "y_m",
+                "heading_deg",
+                "curvature_per_m",
+            ],
+            rows,
+        )?;
         written.file(dir, &csv);
         let raw = dir.join("raw_path.csv");
-        let rows = plan.path.legs.iter().enumerate().flat_map(|(i, leg)| leg.raw.iter().map(move |p| vec![i as f64, p.x, p.y]));
+        let rows = plan
+            .path
+            .legs
+            .iter()
+            .enumerate()
+            .flat_map(|(i, leg)| leg.raw.iter().map(move |p| vec![i as f64, p.x, p.y]));
         write_csv(&raw, &["leg", "x_m", "y_m"], rows)?;
         written.file(dir, &raw);
         // Heading and curvature along the path.
         let samples: Vec<_> = plan.path.samples().collect();
-        let heading = Figure::new("Heading along the path", "arc length s [m]", "heading [deg]")
-            .layer(Layer::line(samples.iter().map(|(_, p)| (p.s_m, p.pose.theta.to_degrees())), Stroke::solid(Rgb::BLUE, 2)).with_label("machine heading"))
-            .layer(Layer::line([(0.0, scenario.goal.theta.to_degrees()), (plan.metrics.length_m, scenario.goal.theta.to_degrees())], Stroke::dashed(Rgb::BLACK, 1)).with_label("required at goal"));
-        let curvature = Figure::new("Curvature along the path", "arc length s [m]", "curvature [1/m]")
-            .layer(Layer::line(samples.iter().map(|(_, p)| (p.s_m, p.curvature_per_m)), Stroke::solid(Rgb::RED, 2)).with_label("curvature"));
-        let clearance = Figure::new("Footprint clearance along the path", "arc length s [m]", "clearance [m]").layer(
+        let heading = Figure::new(
+            "Heading along the path",
+            "arc length s [m]",
+            "heading [deg]",
+        )
+        .layer(
             Layer::line(
-                samples.iter().map(|(_, p)| (p.s_m, scenario.map.clearance(p.pose.position(), scenario.footprint_radius_m))),
+                samples
+                    .iter()
+                    .map(|(_, p)| (p.s_m, p.pose.theta.to_degrees())),
+                Stroke::solid(Rgb::BLUE, 2),
+            )
+            .with_label("machine heading"),
+        )
+        .layer(
+            Layer::line(
+                [
+                    (0.0, scenario.goal.theta.to_degrees()),
+                    (plan.metrics.length_m, scenario.goal.theta.to_degrees()),
+                ],
+                Stroke::dashed(Rgb::BLACK, 1),
+            )
+            .with_label("required at goal"),
+        );
+        let curvature = Figure::new(
+            "Curvature along the path",
+            "arc length s [m]",
+            "curvature [1/m]",
+        )
+        .layer(
+            Layer::line(
+                samples.iter().map(|(_, p)| (p.s_m, p.curvature_per_m)),
+                Stroke::solid(Rgb::RED, 2),
+            )
+            .with_label("curvature"),
+        );
+        let clearance = Figure::new(
+            "Footprint clearance along the path",
+            "arc length s [m]",
+            "clearance [m]",
+        )
+        .layer(
+            Layer::line(
+                samples.iter().map(|(_, p)| {
+                    (
+                        p.s_m,
+                        scenario
+                            .map
+                            .clearance(p.pose.position(), scenario.footprint_radius_m),
+                    )
+                }),
                 Stroke::solid(Rgb::GREEN, 2),
             )
             .with_label("clearance"),
         );
-        written.plot(dir, write_panels(&[heading, curvature, clearance], dir, "profile").context("writing the profile plot")?);
+        written.plot(
+            dir,
+            write_panels(&[heading, curvature, clearance], dir, "profile")
+                .context("writing the profile plot")?,
+        );
     }
     Ok(())
 }

@@ -12,21 +12,46 @@ fn xy(v: Vec2) -> (f64, f64) {
 pub fn map_layers(map: &Map) -> Vec<Layer> {
     let mut layers = Vec::new();
     let (lo, hi) = (map.min, map.max);
-    layers.push(Layer::polygon([(lo.x, lo.y), (hi.x, lo.y), (hi.x, hi.y), (lo.x, hi.y)], None, Stroke::dashed(Rgb::GREY, 1)));
+    layers.push(Layer::polygon(
+        [(lo.x, lo.y), (hi.x, lo.y), (hi.x, hi.y), (lo.x, hi.y)],
+        None,
+        Stroke::dashed(Rgb::GREY, 1),
+    ));
     for (i, b) in map.boundaries.iter().enumerate() {
-        let l = Layer::line(b.points.iter().map(|p| xy(*p)), Stroke::solid(Rgb::BLACK, 2));
-        layers.push(if i == 0 { l.with_label("road boundary") } else { l });
+        let l = Layer::line(
+            b.points.iter().map(|p| xy(*p)),
+            Stroke::solid(Rgb::BLACK, 2),
+        );
+        layers.push(if i == 0 {
+            l.with_label("road boundary")
+        } else {
+            l
+        });
     }
     for (i, o) in map.obstacles.iter().enumerate() {
         let fill = Some(Rgb::BROWN);
         let (layer, at) = match &o.shape {
-            Shape::Circle { center, radius } => (Layer::circle(xy(*center), *radius, fill, Stroke::solid(Rgb::BROWN, 1)), *center),
+            Shape::Circle { center, radius } => (
+                Layer::circle(xy(*center), *radius, fill, Stroke::solid(Rgb::BROWN, 1)),
+                *center,
+            ),
             Shape::Polygon { vertices } => {
                 let c = vertices.iter().sum::<Vec2>() / vertices.len() as f64;
-                (Layer::polygon(vertices.iter().map(|p| xy(*p)), fill, Stroke::solid(Rgb::BROWN, 1)), c)
+                (
+                    Layer::polygon(
+                        vertices.iter().map(|p| xy(*p)),
+                        fill,
+                        Stroke::solid(Rgb::BROWN, 1),
+                    ),
+                    c,
+                )
             }
         };
-        layers.push(if i == 0 { layer.with_label("obstacle") } else { layer });
+        layers.push(if i == 0 {
+            layer.with_label("obstacle")
+        } else {
+            layer
+        });
         layers.push(Layer::text(xy(at), o.name.clone(), Rgb::BLACK));
     }
     layers

@@ -37,7 +37,13 @@ pub struct Args {
 
 /// Runs the study as the command line asks.
 pub fn run(args: &Args) -> Result<()> {
-    let params = StudyParams { maps: args.maps, seed: args.seed, min_obstacles: args.min_obstacles, max_obstacles: args.max_obstacles, ..Default::default() };
+    let params = StudyParams {
+        maps: args.maps,
+        seed: args.seed,
+        min_obstacles: args.min_obstacles,
+        max_obstacles: args.max_obstacles,
+        ..Default::default()
+    };
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
     let (summary, _) = study(&params, out.as_deref(), !args.json)?;
     if args.json {
@@ -52,19 +58,41 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// Runs the study; writes outputs into `out` if given.
-pub fn study(params: &StudyParams, out: Option<&std::path::Path>, progress: bool) -> Result<(Value, Written)> {
+pub fn study(
+    params: &StudyParams,
+    out: Option<&std::path::Path>,
+    progress: bool,
+) -> Result<(Value, Written)> {
     if params.maps == 0 || params.maps > 100_000 {
         bail!("--maps {} must be between 1 and 100000", params.maps);
     }
     if params.min_obstacles > params.max_obstacles || params.max_obstacles > 60 {
-        bail!("--min-obstacles {} and --max-obstacles {} must satisfy min <= max <= 60", params.min_obstacles, params.max_obstacles);
+        bail!(
+            "--min-obstacles {} and --max-obstacles {} must satisfy min <= max <= 60",
+            params.min_obstacles,
+            params.max_obstacles
+        );
     }
-    let bar = if progress { ProgressBar::new(params.maps as u64) } else { ProgressBar::hidden() };
-    bar.set_style(ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} maps, {eta} left").unwrap_or_else(|_| ProgressStyle::default_bar()));
+    let bar = if progress {
+        ProgressBar::new(params.maps as u64)
+    } else {
+        ProgressBar::hidden()
+    };
+    bar.set_style(
+        ProgressStyle::with_template("{msg} [{bar:40}] {pos}/{len} maps, {eta} left")
+            .unwrap_or_else(|_| ProgressStyle::default_bar()),
+    );
     bar.set_message("planning");
-    let rows: Vec<MapRow> = (0..params.maps).into_par_iter().progress_with(bar.clone()).map(|i| run_map(params, i)).collect();
+    let rows: Vec<MapRow> = (0..params.maps)
+        .into_par_iter()
+        .progress_with(bar.clone())
+        .map(|i| run_map(params, i))
+        .collect();
     bar.finish_and_clear();
-    let solved = rows.iter().filter(|r| r.reference_length_m.is_some()).count();
+    let solved = rows
+        .iter()
+        .filter(|r| r.reference_length_m.is_some())
+        .count();
     let classic = aggregate(&rows, "apf", |r| &r.classic);
     let improved = aggregate(&rows, "improved-apf", |r| &r.improved);
     let agg = |a: &Aggregate| {
@@ -90,11 +118,21 @@ pub fn study(params: &StudyParams, out: Option<&std::path::Path>, progress: bool
     let mut written = Written::default();
     if let Some(dir) = out {
         let csv = dir.join("maps.csv");
-        let cell = |v: f64| if v.is_finite() { format!("{v}") } else { String::new() };
+        let cell = |v: f64| {
+            if v.is_finite() {
+                format!("{v}")
+            } else {
+                String::new()
+            }
+        };
         let cells: Vec<Vec<String>> = rows
             .iter()
             .map(|r| {
-                let mut v = vec![r.index.to_string(), r.obstacles.to_string(), r.reference_length_m.map(cell).unwrap_or_default()];
+                let mut v = vec![
+                    r.index.to_string(),
+                    r.obstacles.to_string(),
+                    r.reference_length_m.map(cell).unwrap_or_default(),
+                ];
                 for o in [&r.classic, &r.improved] {
                     v.extend([
                         o.success.to_string(),
@@ -111,22 +149,47 @@ pub fn study(params: &StudyParams, out: Option<&std::path::Path>, progress: bool
             .collect();
         let mut header = vec!["map", "obstacles", "reference_length_m"];
         for p in ["apf", "improved_apf"] {
-            for f in ["success", "local_minimum", "length_m", "min_clearance_m", "final_heading_error_deg", "escapes", "error"] {
+            for f in [
+                "success",
+                "local_minimum",
+                "length_m",
+                "min_clearance_m",
+                "final_heading_error_deg",
+                "escapes",
+                "error",
+            ] {
                 header.push(Box::leak(format!("{p}_{f}").into_boxed_str()));
             }
         }
         write_csv_cells(&csv, &header, &cells)?;
         written.file(dir, &csv);
         // Success rate by obstacle count.
-        let mut fig = Figure::new("Success rate by obstacle count (maps the reference solves)", "obstacles on the map", "success within heading tolerance [%]").y_range(0.0, 100.0);
+        let mut fig = Figure::new(
+            "Success rate by obstacle count (maps the reference solves)",
+            "obstacles on the map",
+            "success within heading tolerance [%]",
+        )
+        .y_range(0.0, 100.0);
         for (name, color, pick) in [("apf", Rgb::BLUE, 0usize), ("improved-apf", Rgb::RED, 1)] {
             let pts: Vec<(f64, f64)> = (params.min_obstacles..=params.max_obstacles)
                 .filter_map(|n| {
-                    let sel: Vec<&MapRow> = rows.iter().filter(|r| r.obstacles == n && r.reference_length_m.is_some()).collect();
+                    let sel: Vec<&MapRow> = rows
+                        .iter()
+                        .filter(|r| r.obstacles == n && r.reference_length_m.is_some())
+                        .collect();
                     if sel.is_empty() {
                         return None;
                     }
-                    let ok = sel.iter().filter(|r| if pick == 0 { r.classic.success } else { r.improved.success }).count();
+                    let ok = sel
+                        .iter()
+                        .filter(|r| {
+                            if pick == 0 {
+                                r.classic.success
+                            } else {
+                                r.improved.success
+                            }
+                        })
+                        .count();
                     Some((n as f64, 100.0 * ok as f64 / sel.len() as f64))
                 })
                 .collect();
@@ -135,7 +198,11 @@ pub fn study(params: &StudyParams, out: Option<&std::path::Path>, progress: bool
         }
         written.plot(dir, write_figure(&fig, dir, "success_by_obstacles")?);
         written.file(dir, &dir.join("summary.json"));
-        summary["files"] = json!(written.files.iter().chain(written.plots.iter()).collect::<Vec<_>>());
+        summary["files"] = json!(written
+            .files
+            .iter()
+            .chain(written.plots.iter())
+            .collect::<Vec<_>>());
         write_summary(dir, &summary)?;
     }
     Ok((summary, written))
@@ -143,7 +210,11 @@ pub fn study(params: &StudyParams, out: Option<&std::path::Path>, progress: bool
 
 /// The study's table in Markdown.
 pub fn markdown_table(summary: &Value) -> String {
-    let f = |v: &Value, d: usize| v.as_f64().map(|x| format!("{x:.d$}")).unwrap_or_else(|| "-".into());
+    let f = |v: &Value, d: usize| {
+        v.as_f64()
+            .map(|x| format!("{x:.d$}"))
+            .unwrap_or_else(|| "-".into())
+    };
     let mut s = format!(
         "`{}`: the reference (Theta*) solves {} of {} maps.\n\n",
         summary["command"].as_str().unwrap_or(""),

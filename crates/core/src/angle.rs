@@ -39,7 +39,11 @@ mod tests {
         assert_relative_eq!(wrap_angle(PI), PI);
         assert_relative_eq!(wrap_angle(-PI), PI);
         assert_relative_eq!(wrap_angle(3.0 * PI), PI, epsilon = 1e-12);
-        assert_relative_eq!(angle_diff(rad(179.0), rad(-179.0)), rad(-2.0), epsilon = 1e-12);
+        assert_relative_eq!(
+            angle_diff(rad(179.0), rad(-179.0)),
+            rad(-2.0),
+            epsilon = 1e-12
+        );
     }
 
     proptest! {

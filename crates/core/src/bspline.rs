@@ -34,7 +34,11 @@ impl CubicBSpline {
             knots.push(i as f64 / (interior + 1) as f64);
         }
         knots.extend(std::iter::repeat_n(1.0, degree + 1));
-        Some(Self { degree, knots, ctrl })
+        Some(Self {
+            degree,
+            knots,
+            ctrl,
+        })
     }
 
     /// Degree of the curve.
@@ -58,7 +62,11 @@ impl CubicBSpline {
             for j in (r..=p).rev() {
                 let i = j + k - p;
                 let denom = self.knots[i + p + 1 - r] - self.knots[i];
-                let alpha = if denom > 0.0 { (u - self.knots[i]) / denom } else { 0.0 };
+                let alpha = if denom > 0.0 {
+                    (u - self.knots[i]) / denom
+                } else {
+                    0.0
+                };
                 d[j] = d[j - 1] * (1.0 - alpha) + d[j] * alpha;
             }
         }
@@ -82,7 +90,11 @@ impl CubicBSpline {
             })
             .collect();
         let knots = self.knots[1..self.knots.len() - 1].to_vec();
-        Some(Self { degree: p - 1, knots, ctrl })
+        Some(Self {
+            degree: p - 1,
+            knots,
+            ctrl,
+        })
     }
 
     /// Knot span index k with knots[k] ≤ u < knots[k+1] (last span at u = 1).
@@ -120,7 +132,11 @@ impl CubicBSpline {
             ss.push(s);
         }
         let total = s;
-        let count = if ds_m > 0.0 && total > 0.0 { (total / ds_m).ceil().max(1.0) as usize } else { 1 };
+        let count = if ds_m > 0.0 && total > 0.0 {
+            (total / ds_m).ceil().max(1.0) as usize
+        } else {
+            1
+        };
         let mut out = Vec::with_capacity(count + 1);
         let mut j = 0;
         for i in 0..=count {
@@ -148,7 +164,12 @@ impl CubicBSpline {
                 }
                 _ => (Vec2::zeros(), 0.0),
             };
-            out.push(CurveSample { point, tangent, curvature, s: target });
+            out.push(CurveSample {
+                point,
+                tangent,
+                curvature,
+                s: target,
+            });
         }
         out
     }
@@ -198,7 +219,9 @@ mod tests {
 
     #[test]
     fn collinear_control_points_give_a_straight_line_of_zero_curvature() {
-        let ctrl: Vec<Vec2> = (0..7).map(|i| Vec2::new(i as f64, 0.5 * i as f64)).collect();
+        let ctrl: Vec<Vec2> = (0..7)
+            .map(|i| Vec2::new(i as f64, 0.5 * i as f64))
+            .collect();
         let c = CubicBSpline::clamped(ctrl).unwrap();
         let samples = c.sample_by_arc_length(0.1);
         let len = (36.0f64 + 9.0).sqrt();

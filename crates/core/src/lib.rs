@@ -3,6 +3,9 @@
 //!
 //! Every other crate depends on this one; it depends on nothing of ours.
 
+// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 mod angle;
 mod bspline;
 mod geom;

@@ -54,14 +54,26 @@ mod tests {
     fn curvature_of_points_on_a_circle_is_one_over_radius() {
         let r = 7.5;
         let p = |a: f64| Vec2::new(r * a.cos(), r * a.sin());
-        assert_relative_eq!(menger_curvature(p(0.1), p(0.4), p(0.9)), 1.0 / r, epsilon = 1e-12);
+        assert_relative_eq!(
+            menger_curvature(p(0.1), p(0.4), p(0.9)),
+            1.0 / r,
+            epsilon = 1e-12
+        );
         // Clockwise → negative.
-        assert_relative_eq!(menger_curvature(p(0.9), p(0.4), p(0.1)), -1.0 / r, epsilon = 1e-12);
+        assert_relative_eq!(
+            menger_curvature(p(0.9), p(0.4), p(0.1)),
+            -1.0 / r,
+            epsilon = 1e-12
+        );
     }
 
     #[test]
     fn lengths_add_up() {
-        let pts = [Vec2::new(0.0, 0.0), Vec2::new(3.0, 4.0), Vec2::new(3.0, 10.0)];
+        let pts = [
+            Vec2::new(0.0, 0.0),
+            Vec2::new(3.0, 4.0),
+            Vec2::new(3.0, 10.0),
+        ];
         assert_relative_eq!(polyline_length(&pts), 11.0);
         assert_eq!(arc_lengths(&pts).len(), 3);
         assert_relative_eq!(arc_lengths(&pts)[1], 5.0);

@@ -11,27 +11,52 @@ fn plans(c: &mut Criterion) {
     for name in ["straight", "curve", "v-shape"] {
         let s = Scenario::builtin(name).expect("built-in");
         let opts = PlanOptions::new(FieldKind::Improved);
-        g.bench_function(format!("improved-apf/{name}"), |b| b.iter(|| plan_path(black_box(&s), &opts).expect("plans")));
+        g.bench_function(format!("improved-apf/{name}"), |b| {
+            b.iter(|| plan_path(black_box(&s), &opts).expect("plans"))
+        });
     }
     let s = Scenario::builtin("v-shape").expect("built-in");
     let opts = PlanOptions::new(FieldKind::Classic);
-    g.bench_function("apf/v-shape", |b| b.iter(|| plan_path(black_box(&s), &opts).expect("plans")));
+    g.bench_function("apf/v-shape", |b| {
+        b.iter(|| plan_path(black_box(&s), &opts).expect("plans"))
+    });
     g.finish();
 }
 
 fn field(c: &mut Criterion) {
     let s = Scenario::builtin("curve").expect("built-in");
-    let t = Target { position: s.goal.position(), motion_heading_rad: s.goal.theta };
+    let t = Target {
+        position: s.goal.position(),
+        motion_heading_rad: s.goal.theta,
+    };
     let p = PlanOptions::new(FieldKind::Improved).apf;
     c.bench_function("field_force/curve", |b| {
-        b.iter(|| field_force(&s.map, black_box(Vec2::new(12.0, 2.0)), &t, 1.0, FieldKind::Improved, &p))
+        b.iter(|| {
+            field_force(
+                &s.map,
+                black_box(Vec2::new(12.0, 2.0)),
+                &t,
+                1.0,
+                FieldKind::Improved,
+                &p,
+            )
+        })
     });
 }
 
 fn reference(c: &mut Criterion) {
     let s = Scenario::builtin("curve").expect("built-in");
     c.bench_function("theta_star/curve", |b| {
-        b.iter(|| astar(&s.map, s.start.position(), s.goal.position(), 1.0, &AstarParams::default()).expect("route"))
+        b.iter(|| {
+            astar(
+                &s.map,
+                s.start.position(),
+                s.goal.position(),
+                1.0,
+                &AstarParams::default(),
+            )
+            .expect("route")
+        })
     });
 }
 

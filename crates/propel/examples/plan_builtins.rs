@@ -24,13 +24,24 @@ fn main() {
                         m.plan_time_ms
                     );
                     if field == FieldKind::Improved {
-                        assert!(m.final_heading_error_deg <= 2.0, "{name}: heading error {}", m.final_heading_error_deg);
-                        assert!(m.min_clearance_m > 0.0, "{name}: clearance {}", m.min_clearance_m);
+                        assert!(
+                            m.final_heading_error_deg <= 2.0,
+                            "{name}: heading error {}",
+                            m.final_heading_error_deg
+                        );
+                        assert!(
+                            m.min_clearance_m > 0.0,
+                            "{name}: clearance {}",
+                            m.min_clearance_m
+                        );
                     }
                 }
                 Err(e) => {
                     println!("{name:18} {:13} FAIL {e}", field.name());
-                    assert!(field == FieldKind::Classic, "the improved planner failed on {name}: {e}");
+                    assert!(
+                        field == FieldKind::Classic,
+                        "the improved planner failed on {name}: {e}"
+                    );
                 }
             }
         }

@@ -134,7 +134,10 @@ impl ApfParams {
     /// The classic baseline: the same gains, no escape (it is the baseline's
     /// failure that the improved field answers).
     pub fn classic() -> Self {
-        Self { escape: false, ..Self::improved() }
+        Self {
+            escape: false,
+            ..Self::improved()
+        }
     }
 
     /// Checks ranges; returns the name and value of the first bad parameter.
@@ -156,7 +159,11 @@ impl ApfParams {
                 return Err((name, v));
             }
         }
-        for (name, v) in [("n", self.n), ("mu", self.mu), ("lead_in_m", self.lead_in_m)] {
+        for (name, v) in [
+            ("n", self.n),
+            ("mu", self.mu),
+            ("lead_in_m", self.lead_in_m),
+        ] {
             if !(v.is_finite() && v >= 0.0) {
                 return Err((name, v));
             }
@@ -181,14 +188,25 @@ pub struct Target {
 }
 
 /// The total force of the field at `q` (eq. 5 or eq. 15).
-pub fn field_force(map: &Map, q: Vec2, target: &Target, footprint_radius_m: f64, kind: FieldKind, p: &ApfParams) -> Vec2 {
+pub fn field_force(
+    map: &Map,
+    q: Vec2,
+    target: &Target,
+    footprint_radius_m: f64,
+    kind: FieldKind,
+    p: &ApfParams,
+) -> Vec2 {
     let d = target.position - q;
     let rt = d.norm();
     let u_goal = if rt > 1e-12 { d / rt } else { Vec2::zeros() };
     let mut f = match kind {
         FieldKind::Classic => d * p.eta,
         FieldKind::Improved => {
-            let att = if rt <= p.rho_d_m { d * p.eta } else { u_goal * (p.eta * p.rho_d_m) };
+            let att = if rt <= p.rho_d_m {
+                d * p.eta
+            } else {
+                u_goal * (p.eta * p.rho_d_m)
+            };
             let virt = -heading_vec(target.motion_heading_rad) * (p.mu * rt.min(p.rho_t_m));
             att + virt
         }
@@ -206,7 +224,11 @@ pub fn field_force(map: &Map, q: Vec2, target: &Target, footprint_radius_m: f64,
             FieldKind::Classic => f += nb.normal * (p.k_rep * a / (rho * rho)),
             FieldKind::Improved => {
                 let rep1 = p.k_rep * a * s.powf(p.n) / (rho * rho);
-                let rep2 = if far { 0.0 } else { 0.5 * p.n * p.k_rep * a * a * s.powf(p.n - 1.0) / p.rho_d_m };
+                let rep2 = if far {
+                    0.0
+                } else {
+                    0.5 * p.n * p.k_rep * a * a * s.powf(p.n - 1.0) / p.rho_d_m
+                };
                 f += nb.normal * rep1 + u_goal * rep2;
             }
         }
@@ -245,7 +267,9 @@ pub fn descend(
         let n = (p.lead_in_m / p.step_m).ceil().max(1.0) as usize;
         for i in 1..=n {
             let q = start + h * (p.lead_in_m * i as f64 / n as f64);
-            if map.clearance(q, footprint_radius_m) <= 0.0 || (q - target.position).norm() <= p.goal_tolerance_m {
+            if map.clearance(q, footprint_radius_m) <= 0.0
+                || (q - target.position).norm() <= p.goal_tolerance_m
+            {
                 break;
             }
             raw.push(q);
@@ -263,7 +287,12 @@ pub fn descend(
             if (target.position - q).norm() > 0.0 {
                 raw.push(target.position);
             }
-            return Descent { raw, iterations, escapes, stalled_at: None };
+            return Descent {
+                raw,
+                iterations,
+                escapes,
+                stalled_at: None,
+            };
         }
         let f = field_force(map, q, target, footprint_radius_m, kind, p);
         let fnorm = f.norm();
@@ -293,7 +322,12 @@ pub fn descend(
         }
         let q = *raw.last().expect("non-empty");
         if !p.escape || escapes >= p.max_escapes || iterations >= max_steps {
-            return Descent { raw, iterations, escapes, stalled_at: Some(q) };
+            return Descent {
+                raw,
+                iterations,
+                escapes,
+                stalled_at: Some(q),
+            };
         }
         escapes += 1;
         // Stalling again where it stalled before: the field leads back into the
@@ -305,12 +339,38 @@ pub fn descend(
         // clearance held at the stall, if more), then closer (a narrow gap closes the level set of a wide clearance);
         // keep the shorter way that gets past.
         let budget_left = max_steps.saturating_sub(iterations);
-        let mut keep = (map.nearest(q).distance - footprint_radius_m).max(0.5 * p.rho0_m).min(p.rho0_m);
+        let mut keep = (map.nearest(q).distance - footprint_radius_m)
+            .max(0.5 * p.rho0_m)
+            .min(p.rho0_m);
         let best = loop {
             // The second side only needs to beat the first one's length.
-            let first = follow_boundary(map, q, target, footprint_radius_m, kind, p, 1.0, keep, margin, budget_left);
-            let limit = first.as_ref().map_or(budget_left, |seg| seg.len().saturating_sub(1));
-            let second = follow_boundary(map, q, target, footprint_radius_m, kind, p, -1.0, keep, margin, limit);
+            let first = follow_boundary(
+                map,
+                q,
+                target,
+                footprint_radius_m,
+                kind,
+                p,
+                1.0,
+                keep,
+                margin,
+                budget_left,
+            );
+            let limit = first
+                .as_ref()
+                .map_or(budget_left, |seg| seg.len().saturating_sub(1));
+            let second = follow_boundary(
+                map,
+                q,
+                target,
+                footprint_radius_m,
+                kind,
+                p,
+                -1.0,
+                keep,
+                margin,
+                limit,
+            );
             let found = second.or(first);
             if found.is_some() || keep < 2.0 * MIN_FOLLOW_CLEARANCE_M {
                 break found;
@@ -323,7 +383,14 @@ pub fn descend(
                 raw.extend(seg);
                 resume_index = raw.len() - 1;
             }
-            None => return Descent { raw, iterations, escapes, stalled_at: Some(q) },
+            None => {
+                return Descent {
+                    raw,
+                    iterations,
+                    escapes,
+                    stalled_at: Some(q),
+                }
+            }
         }
     }
 }
@@ -394,18 +461,41 @@ mod tests {
     #[test]
     fn classic_force_without_obstacles_is_the_attraction_of_eq_2() {
         let p = ApfParams::classic();
-        let t = Target { position: Vec2::new(10.0, 0.0), motion_heading_rad: 0.0 };
-        let f = field_force(&open_map(), Vec2::new(0.0, 0.0), &t, 1.0, FieldKind::Classic, &p);
+        let t = Target {
+            position: Vec2::new(10.0, 0.0),
+            motion_heading_rad: 0.0,
+        };
+        let f = field_force(
+            &open_map(),
+            Vec2::new(0.0, 0.0),
+            &t,
+            1.0,
+            FieldKind::Classic,
+            &p,
+        );
         assert_relative_eq!(f, Vec2::new(10.0 * p.eta, 0.0), epsilon = 1e-12);
     }
 
     #[test]
     fn improved_repulsion_is_minus_the_gradient_of_eq_9() {
         // Closed form check by finite differences of U_rep1 = ½k(1/ρ−1/ρ0)²(ρt/ρd)^n.
-        let p = ApfParams { mu: 0.0, eta: 1e-9, ..ApfParams::improved() };
+        let p = ApfParams {
+            mu: 0.0,
+            eta: 1e-9,
+            ..ApfParams::improved()
+        };
         let mut map = open_map();
-        map.obstacles.push(Obstacle { name: "rock".into(), shape: Shape::Circle { center: Vec2::new(3.0, 1.5), radius: 0.5 } });
-        let t = Target { position: Vec2::new(8.0, 0.0), motion_heading_rad: 0.0 };
+        map.obstacles.push(Obstacle {
+            name: "rock".into(),
+            shape: Shape::Circle {
+                center: Vec2::new(3.0, 1.5),
+                radius: 0.5,
+            },
+        });
+        let t = Target {
+            position: Vec2::new(8.0, 0.0),
+            motion_heading_rad: 0.0,
+        };
         let r_fp = 0.4;
         let u = |q: Vec2| {
             let rho = (q - Vec2::new(3.0, 1.5)).norm() - 0.5 - r_fp;
@@ -428,16 +518,42 @@ mod tests {
     #[test]
     fn virtual_obstacle_makes_the_machine_arrive_on_the_required_heading() {
         // Start beside the goal line; the required heading is +x.
-        let p = ApfParams { lead_in_m: 0.0, ..ApfParams::improved() };
-        let t = Target { position: Vec2::new(20.0, 0.0), motion_heading_rad: 0.0 };
-        let d = descend(&open_map(), Vec2::new(0.0, 8.0), rad(-30.0), &t, 1.0, FieldKind::Improved, &p);
+        let p = ApfParams {
+            lead_in_m: 0.0,
+            ..ApfParams::improved()
+        };
+        let t = Target {
+            position: Vec2::new(20.0, 0.0),
+            motion_heading_rad: 0.0,
+        };
+        let d = descend(
+            &open_map(),
+            Vec2::new(0.0, 8.0),
+            rad(-30.0),
+            &t,
+            1.0,
+            FieldKind::Improved,
+            &p,
+        );
         assert!(d.stalled_at.is_none());
         let n = d.raw.len();
         let last = d.raw[n - 1] - d.raw[n - 8];
         let heading = last.y.atan2(last.x);
-        assert!(angle_diff(heading, 0.0).abs() < rad(2.0), "arrival heading {} deg", heading.to_degrees());
+        assert!(
+            angle_diff(heading, 0.0).abs() < rad(2.0),
+            "arrival heading {} deg",
+            heading.to_degrees()
+        );
         // The classic field arrives along the straight line from the start instead.
-        let c = descend(&open_map(), Vec2::new(0.0, 8.0), rad(-30.0), &t, 1.0, FieldKind::Classic, &p);
+        let c = descend(
+            &open_map(),
+            Vec2::new(0.0, 8.0),
+            rad(-30.0),
+            &t,
+            1.0,
+            FieldKind::Classic,
+            &p,
+        );
         let n = c.raw.len();
         let last = c.raw[n - 1] - c.raw[n - 8];
         assert!(angle_diff(last.y.atan2(last.x), 0.0).abs() > rad(15.0));
@@ -447,17 +563,51 @@ mod tests {
     fn classic_field_stalls_in_front_of_a_wall_and_says_where() {
         // A wide polygon square across the way: the textbook local minimum.
         let mut map = open_map();
-        let wall = crate::map::convex_polygon(vec![Vec2::new(8.0, -6.0), Vec2::new(9.0, -6.0), Vec2::new(9.0, 6.0), Vec2::new(8.0, 6.0)]).unwrap();
-        map.obstacles.push(Obstacle { name: "wall".into(), shape: Shape::Polygon { vertices: wall } });
-        let t = Target { position: Vec2::new(16.0, 0.0), motion_heading_rad: 0.0 };
+        let wall = crate::map::convex_polygon(vec![
+            Vec2::new(8.0, -6.0),
+            Vec2::new(9.0, -6.0),
+            Vec2::new(9.0, 6.0),
+            Vec2::new(8.0, 6.0),
+        ])
+        .unwrap();
+        map.obstacles.push(Obstacle {
+            name: "wall".into(),
+            shape: Shape::Polygon { vertices: wall },
+        });
+        let t = Target {
+            position: Vec2::new(16.0, 0.0),
+            motion_heading_rad: 0.0,
+        };
         let p = ApfParams::classic();
-        let d = descend(&map, Vec2::new(0.0, 0.0), 0.0, &t, 1.0, FieldKind::Classic, &p);
-        let at = d.stalled_at.expect("classic APF must stall in front of the wall");
+        let d = descend(
+            &map,
+            Vec2::new(0.0, 0.0),
+            0.0,
+            &t,
+            1.0,
+            FieldKind::Classic,
+            &p,
+        );
+        let at = d
+            .stalled_at
+            .expect("classic APF must stall in front of the wall");
         assert!(at.x < 8.0 - 1.0 && at.y.abs() < 1.0, "stalled at {at:?}");
         // The improved planner escapes round it and reports it.
         let p = ApfParams::improved();
-        let d = descend(&map, Vec2::new(0.0, 0.0), 0.0, &t, 1.0, FieldKind::Improved, &p);
-        assert!(d.stalled_at.is_none(), "improved stalled at {:?}", d.stalled_at);
+        let d = descend(
+            &map,
+            Vec2::new(0.0, 0.0),
+            0.0,
+            &t,
+            1.0,
+            FieldKind::Improved,
+            &p,
+        );
+        assert!(
+            d.stalled_at.is_none(),
+            "improved stalled at {:?}",
+            d.stalled_at
+        );
         assert!(d.escapes >= 1);
         for q in &d.raw {
             assert!(map.clearance(*q, 1.0) > 0.0);

@@ -28,7 +28,10 @@ pub struct AstarParams {
 
 impl Default for AstarParams {
     fn default() -> Self {
-        Self { resolution_m: 0.25, max_cells: 4_000_000 }
+        Self {
+            resolution_m: 0.25,
+            max_cells: 4_000_000,
+        }
     }
 }
 
@@ -70,16 +73,25 @@ pub fn segment_free(map: &Map, a: Vec2, b: Vec2, r_fp: f64, step_m: f64) -> bool
 pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> Result<Route> {
     let res = p.resolution_m;
     if !(res.is_finite() && res > 0.0) {
-        return Err(PropelError::NoPath { why: format!("resolution_m = {res} must be positive") });
+        return Err(PropelError::NoPath {
+            why: format!("resolution_m = {res} must be positive"),
+        });
     }
     let span = map.max - map.min;
     let nx = (span.x / res).ceil() as usize + 1;
     let ny = (span.y / res).ceil() as usize + 1;
     if nx.saturating_mul(ny) > p.max_cells {
-        return Err(PropelError::NoPath { why: format!("grid of {nx} x {ny} cells exceeds max_cells {}", p.max_cells) });
+        return Err(PropelError::NoPath {
+            why: format!(
+                "grid of {nx} x {ny} cells exceeds max_cells {}",
+                p.max_cells
+            ),
+        });
     }
     let center = |i: usize| map.min + Vec2::new((i % nx) as f64 * res, (i / nx) as f64 * res);
-    let free: Vec<bool> = (0..nx * ny).map(|i| map.clearance(center(i), r_fp) > 0.0).collect();
+    let free: Vec<bool> = (0..nx * ny)
+        .map(|i| map.clearance(center(i), r_fp) > 0.0)
+        .collect();
     let cell_of = |q: Vec2| -> usize {
         let ix = (((q.x - map.min.x) / res).round().max(0.0) as usize).min(nx - 1);
         let iy = (((q.y - map.min.y) / res).round().max(0.0) as usize).min(ny - 1);
@@ -96,12 +108,23 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
             .flat_map(|r| (-r..=r).flat_map(move |dx| (-r..=r).map(move |dy| (dx, dy))))
             .filter_map(|(dx, dy)| {
                 let (x, y) = (cx + dx, cy + dy);
-                (x >= 0 && y >= 0 && (x as usize) < nx && (y as usize) < ny).then(|| y as usize * nx + x as usize)
+                (x >= 0 && y >= 0 && (x as usize) < nx && (y as usize) < ny)
+                    .then(|| y as usize * nx + x as usize)
             })
             .find(|&i| free[i])
     };
-    let s = snap(start).ok_or_else(|| PropelError::NoPath { why: format!("start ({:.2}, {:.2}) has no free cell near it", start.x, start.y) })?;
-    let g = snap(goal).ok_or_else(|| PropelError::NoPath { why: format!("goal ({:.2}, {:.2}) has no free cell near it", goal.x, goal.y) })?;
+    let s = snap(start).ok_or_else(|| PropelError::NoPath {
+        why: format!(
+            "start ({:.2}, {:.2}) has no free cell near it",
+            start.x, start.y
+        ),
+    })?;
+    let g = snap(goal).ok_or_else(|| PropelError::NoPath {
+        why: format!(
+            "goal ({:.2}, {:.2}) has no free cell near it",
+            goal.x, goal.y
+        ),
+    })?;
     let h = |i: usize| {
         let dx = ((i % nx) as f64 - (g % nx) as f64).abs();
         let dy = ((i / nx) as f64 - (g / nx) as f64).abs();
@@ -111,7 +134,9 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
     let grid_sight = |a: usize, b: usize| -> bool {
         let (ax, ay) = ((a % nx) as f64, (a / nx) as f64);
         let (bx, by) = ((b % nx) as f64, (b / nx) as f64);
-        let n = (((bx - ax).abs().max((by - ay).abs())) * 4.0).ceil().max(1.0) as usize;
+        let n = (((bx - ax).abs().max((by - ay).abs())) * 4.0)
+            .ceil()
+            .max(1.0) as usize;
         (0..=n).all(|k| {
             let t = k as f64 / n as f64;
             let x = (ax + (bx - ax) * t).round() as usize;
@@ -136,7 +161,16 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
             break;
         }
         let (x, y) = ((idx % nx) as i64, (idx / nx) as i64);
-        for (dx, dy) in [(1, 0), (-1, 0), (0, 1), (0, -1), (1, 1), (1, -1), (-1, 1), (-1, -1)] {
+        for (dx, dy) in [
+            (1, 0),
+            (-1, 0),
+            (0, 1),
+            (0, -1),
+            (1, 1),
+            (1, -1),
+            (-1, 1),
+            (-1, -1),
+        ] {
             let (xx, yy) = (x + dx, y + dy);
             if xx < 0 || yy < 0 || xx as usize >= nx || yy as usize >= ny {
                 continue;
@@ -146,7 +180,10 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
                 continue;
             }
             // No corner cutting past an occupied cell.
-            if dx != 0 && dy != 0 && (!free[y as usize * nx + xx as usize] || !free[yy as usize * nx + x as usize]) {
+            if dx != 0
+                && dy != 0
+                && (!free[y as usize * nx + xx as usize] || !free[yy as usize * nx + x as usize])
+            {
                 continue;
             }
             // Theta*: inherit the grandparent when it sees the neighbour.
@@ -154,18 +191,27 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
             let (from, c) = if pa != usize::MAX && grid_sight(pa, j) {
                 (pa, cost[pa] + (center(pa) - center(j)).norm())
             } else {
-                let step = if dx != 0 && dy != 0 { res * std::f64::consts::SQRT_2 } else { res };
+                let step = if dx != 0 && dy != 0 {
+                    res * std::f64::consts::SQRT_2
+                } else {
+                    res
+                };
                 (idx, cost[idx] + step)
             };
             if c < cost[j] {
                 cost[j] = c;
                 parent[j] = from;
-                open.push(Open { f: c + h(j), idx: j });
+                open.push(Open {
+                    f: c + h(j),
+                    idx: j,
+                });
             }
         }
     }
     if !closed[g] {
-        return Err(PropelError::NoPath { why: format!("goal unreachable after expanding {expanded} cells") });
+        return Err(PropelError::NoPath {
+            why: format!("goal unreachable after expanding {expanded} cells"),
+        });
     }
     let mut cells = vec![g];
     while let Some(&c) = cells.last() {
@@ -190,7 +236,11 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
         short.push(pts[j]);
         i = j;
     }
-    Ok(Route { length_m: polyline_length(&short), points: short, expanded })
+    Ok(Route {
+        length_m: polyline_length(&short),
+        points: short,
+        expanded,
+    })
 }
 
 #[cfg(test)]
@@ -202,7 +252,14 @@ mod tests {
     #[test]
     fn open_site_gives_the_straight_line() {
         let map = Map::new(Vec2::new(0.0, 0.0), Vec2::new(20.0, 10.0));
-        let r = astar(&map, Vec2::new(2.0, 2.0), Vec2::new(18.0, 8.0), 1.0, &AstarParams::default()).unwrap();
+        let r = astar(
+            &map,
+            Vec2::new(2.0, 2.0),
+            Vec2::new(18.0, 8.0),
+            1.0,
+            &AstarParams::default(),
+        )
+        .unwrap();
         assert_relative_eq!(r.length_m, (16.0f64.powi(2) + 36.0).sqrt(), epsilon = 1e-9);
     }
 
@@ -210,24 +267,63 @@ mod tests {
     fn detour_round_a_disc_is_close_to_the_taut_string_length() {
         // Going round a disc of radius R + r_fp: the shortest path is two tangents and an arc.
         let mut map = Map::new(Vec2::new(-15.0, -15.0), Vec2::new(15.0, 15.0));
-        map.obstacles.push(Obstacle { name: "pile".into(), shape: Shape::Circle { center: Vec2::zeros(), radius: 3.0 } });
+        map.obstacles.push(Obstacle {
+            name: "pile".into(),
+            shape: Shape::Circle {
+                center: Vec2::zeros(),
+                radius: 3.0,
+            },
+        });
         let r_fp = 1.0;
         let a = Vec2::new(-10.0, 0.0);
         let b = Vec2::new(10.0, 0.0);
-        let route = astar(&map, a, b, r_fp, &AstarParams { resolution_m: 0.1, ..Default::default() }).unwrap();
+        let route = astar(
+            &map,
+            a,
+            b,
+            r_fp,
+            &AstarParams {
+                resolution_m: 0.1,
+                ..Default::default()
+            },
+        )
+        .unwrap();
         let big_r: f64 = 4.0;
         let d: f64 = 10.0;
         let tangent = (d * d - big_r * big_r).sqrt();
         let arc = big_r * (std::f64::consts::PI - 2.0 * (big_r / d).acos());
         let exact = 2.0 * tangent + arc;
-        assert!(route.length_m >= exact - 1e-6, "{} < {exact}", route.length_m);
-        assert!(route.length_m <= exact * 1.03, "{} vs {exact}", route.length_m);
+        assert!(
+            route.length_m >= exact - 1e-6,
+            "{} < {exact}",
+            route.length_m
+        );
+        assert!(
+            route.length_m <= exact * 1.03,
+            "{} vs {exact}",
+            route.length_m
+        );
     }
 
     #[test]
     fn a_closed_road_has_no_path() {
         let mut map = Map::new(Vec2::new(0.0, 0.0), Vec2::new(20.0, 6.0));
-        map.obstacles.push(Obstacle { name: "slide".into(), shape: Shape::Circle { center: Vec2::new(10.0, 3.0), radius: 2.5 } });
-        assert!(matches!(astar(&map, Vec2::new(2.0, 3.0), Vec2::new(18.0, 3.0), 1.0, &AstarParams::default()), Err(PropelError::NoPath { .. })));
+        map.obstacles.push(Obstacle {
+            name: "slide".into(),
+            shape: Shape::Circle {
+                center: Vec2::new(10.0, 3.0),
+                radius: 2.5,
+            },
+        });
+        assert!(matches!(
+            astar(
+                &map,
+                Vec2::new(2.0, 3.0),
+                Vec2::new(18.0, 3.0),
+                1.0,
+                &AstarParams::default()
+            ),
+            Err(PropelError::NoPath { .. })
+        ));
     }
 }

@@ -72,7 +72,10 @@ impl std::fmt::Display for PolygonFault {
         match self {
             PolygonFault::TooFewVertices(n) => write!(f, "has {n} vertices, needs at least 3"),
             PolygonFault::RepeatedVertex(i) => write!(f, "repeats vertex {i} (0-based)"),
-            PolygonFault::NotConvex(i) => write!(f, "is not convex: it turns the other way at vertex {i} (0-based)"),
+            PolygonFault::NotConvex(i) => write!(
+                f,
+                "is not convex: it turns the other way at vertex {i} (0-based)"
+            ),
             PolygonFault::Degenerate => write!(f, "has zero area"),
         }
     }
@@ -122,7 +125,11 @@ impl Shape {
             Shape::Circle { center, radius } => {
                 let d = p - center;
                 let r = d.norm();
-                let normal = if r > 1e-12 { d / r } else { Vec2::new(1.0, 0.0) };
+                let normal = if r > 1e-12 {
+                    d / r
+                } else {
+                    Vec2::new(1.0, 0.0)
+                };
                 (r - radius, normal)
             }
             Shape::Polygon { vertices } => {
@@ -142,7 +149,11 @@ impl Shape {
                         inside = false;
                     }
                     let len2 = e.norm_squared();
-                    let t = if len2 > 0.0 { (ap.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+                    let t = if len2 > 0.0 {
+                        (ap.dot(&e) / len2).clamp(0.0, 1.0)
+                    } else {
+                        0.0
+                    };
                     let q = a + e * t;
                     let d2 = (p - q).norm_squared();
                     if d2 < best2 {
@@ -170,7 +181,10 @@ impl Shape {
     /// Axis-aligned bounds (min, max).
     pub fn bounds(&self) -> (Vec2, Vec2) {
         match self {
-            Shape::Circle { center, radius } => (center - Vec2::repeat(*radius), center + Vec2::repeat(*radius)),
+            Shape::Circle { center, radius } => (
+                center - Vec2::repeat(*radius),
+                center + Vec2::repeat(*radius),
+            ),
             Shape::Polygon { vertices } => bounds_of(vertices),
         }
     }
@@ -195,7 +209,11 @@ fn polyline_nearest(points: &[Vec2], p: Vec2) -> (f64, Vec2) {
         let e = b - a;
         let ap = p - a;
         let len2 = e.norm_squared();
-        let t = if len2 > 0.0 { (ap.dot(&e) / len2).clamp(0.0, 1.0) } else { 0.0 };
+        let t = if len2 > 0.0 {
+            (ap.dot(&e) / len2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
         let q = a + e * t;
         let d2 = (p - q).norm_squared();
         if d2 < best2 {
@@ -231,7 +249,12 @@ pub struct Map {
 impl Map {
     /// An empty site.
     pub fn new(min: Vec2, max: Vec2) -> Self {
-        Self { min, max, obstacles: Vec::new(), boundaries: Vec::new() }
+        Self {
+            min,
+            max,
+            obstacles: Vec::new(),
+            boundaries: Vec::new(),
+        }
     }
 
     /// Number of elements that [`Map::for_each_nearest`] visits (obstacles, boundaries, site edge).
@@ -262,12 +285,20 @@ impl Map {
     pub fn for_each_nearest(&self, p: Vec2, mut f: impl FnMut(Nearest)) {
         for (i, o) in self.obstacles.iter().enumerate() {
             let (distance, normal) = o.shape.nearest(p);
-            f(Nearest { distance, normal, element: i });
+            f(Nearest {
+                distance,
+                normal,
+                element: i,
+            });
         }
         let no = self.obstacles.len();
         for (i, b) in self.boundaries.iter().enumerate() {
             let (distance, normal) = polyline_nearest(&b.points, p);
-            f(Nearest { distance, normal, element: no + i });
+            f(Nearest {
+                distance,
+                normal,
+                element: no + i,
+            });
         }
         // Site edge: distance to the nearest side, positive inside.
         let sides = [
@@ -276,13 +307,30 @@ impl Map {
             (p.y - self.min.y, Vec2::new(0.0, 1.0)),
             (self.max.y - p.y, Vec2::new(0.0, -1.0)),
         ];
-        let (distance, normal) = sides.into_iter().fold((f64::INFINITY, Vec2::zeros()), |acc, s| if s.0 < acc.0 { s } else { acc });
-        f(Nearest { distance, normal, element: no + self.boundaries.len() });
+        let (distance, normal) =
+            sides
+                .into_iter()
+                .fold((f64::INFINITY, Vec2::zeros()), |acc, s| {
+                    if s.0 < acc.0 {
+                        s
+                    } else {
+                        acc
+                    }
+                });
+        f(Nearest {
+            distance,
+            normal,
+            element: no + self.boundaries.len(),
+        });
     }
 
     /// The nearest element to `p` (smallest signed distance).
     pub fn nearest(&self, p: Vec2) -> Nearest {
-        let mut best = Nearest { distance: f64::INFINITY, normal: Vec2::zeros(), element: 0 };
+        let mut best = Nearest {
+            distance: f64::INFINITY,
+            normal: Vec2::zeros(),
+            element: 0,
+        };
         self.for_each_nearest(p, |n| {
             if n.distance < best.distance {
                 best = n;
@@ -306,7 +354,12 @@ mod tests {
     use proptest::prelude::*;
 
     fn square() -> Vec<Vec2> {
-        vec![Vec2::new(0.0, 0.0), Vec2::new(2.0, 0.0), Vec2::new(2.0, 2.0), Vec2::new(0.0, 2.0)]
+        vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 0.0),
+            Vec2::new(2.0, 2.0),
+            Vec2::new(0.0, 2.0),
+        ]
     }
 
     #[test]
@@ -314,12 +367,36 @@ mod tests {
         assert!(convex_polygon(square()).is_ok());
         let mut cw = square();
         cw.reverse();
-        assert_eq!(convex_polygon(cw).unwrap(), square().into_iter().rev().collect::<Vec<_>>().into_iter().rev().collect::<Vec<_>>());
-        let dart = vec![Vec2::new(0.0, 0.0), Vec2::new(2.0, 1.0), Vec2::new(4.0, 0.0), Vec2::new(2.0, 3.0)];
-        assert!(matches!(convex_polygon(dart), Err(PolygonFault::NotConvex(_))));
-        assert!(matches!(convex_polygon(vec![Vec2::zeros(), Vec2::new(1.0, 0.0)]), Err(PolygonFault::TooFewVertices(2))));
+        assert_eq!(
+            convex_polygon(cw).unwrap(),
+            square()
+                .into_iter()
+                .rev()
+                .collect::<Vec<_>>()
+                .into_iter()
+                .rev()
+                .collect::<Vec<_>>()
+        );
+        let dart = vec![
+            Vec2::new(0.0, 0.0),
+            Vec2::new(2.0, 1.0),
+            Vec2::new(4.0, 0.0),
+            Vec2::new(2.0, 3.0),
+        ];
         assert!(matches!(
-            convex_polygon(vec![Vec2::zeros(), Vec2::new(1.0, 0.0), Vec2::new(2.0, 0.0)]),
+            convex_polygon(dart),
+            Err(PolygonFault::NotConvex(_))
+        ));
+        assert!(matches!(
+            convex_polygon(vec![Vec2::zeros(), Vec2::new(1.0, 0.0)]),
+            Err(PolygonFault::TooFewVertices(2))
+        ));
+        assert!(matches!(
+            convex_polygon(vec![
+                Vec2::zeros(),
+                Vec2::new(1.0, 0.0),
+                Vec2::new(2.0, 0.0)
+            ]),
             Err(PolygonFault::Degenerate) | Err(PolygonFault::NotConvex(_))
         ));
     }
@@ -339,7 +416,10 @@ mod tests {
 
     #[test]
     fn circle_distance_is_to_the_rim() {
-        let c = Shape::Circle { center: Vec2::new(1.0, 1.0), radius: 0.5 };
+        let c = Shape::Circle {
+            center: Vec2::new(1.0, 1.0),
+            radius: 0.5,
+        };
         let (d, n) = c.nearest(Vec2::new(1.0, 3.0));
         assert_relative_eq!(d, 1.5);
         assert_relative_eq!(n, Vec2::new(0.0, 1.0));
@@ -348,11 +428,20 @@ mod tests {
     #[test]
     fn clearance_subtracts_the_footprint_and_sees_the_site_edge() {
         let mut m = Map::new(Vec2::new(0.0, 0.0), Vec2::new(10.0, 10.0));
-        m.boundaries.push(Boundary { name: "edge".into(), points: vec![Vec2::new(0.0, 8.0), Vec2::new(10.0, 8.0)] });
+        m.boundaries.push(Boundary {
+            name: "edge".into(),
+            points: vec![Vec2::new(0.0, 8.0), Vec2::new(10.0, 8.0)],
+        });
         assert_relative_eq!(m.clearance(Vec2::new(5.0, 5.0), 1.0), 2.0);
-        assert_eq!(m.element_name(m.nearest(Vec2::new(5.0, 7.0)).element), "edge");
+        assert_eq!(
+            m.element_name(m.nearest(Vec2::new(5.0, 7.0)).element),
+            "edge"
+        );
         assert_relative_eq!(m.clearance(Vec2::new(0.5, 5.0), 1.0), -0.5);
-        assert_eq!(m.element_name(m.nearest(Vec2::new(0.5, 5.0)).element), "site edge");
+        assert_eq!(
+            m.element_name(m.nearest(Vec2::new(0.5, 5.0)).element),
+            "site edge"
+        );
     }
 
     proptest! {

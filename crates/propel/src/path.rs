@@ -88,11 +88,16 @@ impl Path {
 
     /// Every sample with the direction of its leg, in travel order.
     pub fn samples(&self) -> impl Iterator<Item = (Direction, &PathPoint)> {
-        self.legs.iter().flat_map(|l| l.points.iter().map(move |p| (l.direction, p)))
+        self.legs
+            .iter()
+            .flat_map(|l| l.points.iter().map(move |p| (l.direction, p)))
     }
 
     /// The final pose, if any.
     pub fn end_pose(&self) -> Option<Pose2> {
-        self.legs.last().and_then(|l| l.points.last()).map(|p| p.pose)
+        self.legs
+            .last()
+            .and_then(|l| l.points.last())
+            .map(|p| p.pose)
     }
 }

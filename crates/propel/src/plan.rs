@@ -33,7 +33,11 @@ impl PlanOptions {
             FieldKind::Classic => ApfParams::classic(),
             FieldKind::Improved => ApfParams::improved(),
         };
-        Self { field, apf, smooth: SmoothParams::default() }
+        Self {
+            field,
+            apf,
+            smooth: SmoothParams::default(),
+        }
     }
 }
 
@@ -100,8 +104,20 @@ const APPROACH_CHECK_M: f64 = 1.0;
 
 /// Checks that the machine can stand at `pose` and leave or arrive along its
 /// motion heading.
-fn check_pose(map: &Map, r_fp: f64, which: &'static str, pose: Pose2, motion_heading: f64, arriving: bool) -> Result<()> {
-    let bad = |why: String| PropelError::BadPose { which, x: pose.x, y: pose.y, why };
+fn check_pose(
+    map: &Map,
+    r_fp: f64,
+    which: &'static str,
+    pose: Pose2,
+    motion_heading: f64,
+    arriving: bool,
+) -> Result<()> {
+    let bad = |why: String| PropelError::BadPose {
+        which,
+        x: pose.x,
+        y: pose.y,
+        why,
+    };
     if !pose.is_finite() {
         return Err(bad(format!("not finite (heading {})", pose.theta)));
     }
@@ -147,16 +163,29 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
     let t0 = Instant::now();
     let map = &scenario.map;
     let r_fp = scenario.footprint_radius_m;
-    opts.apf.validate().map_err(|(name, v)| PropelError::Invalid {
-        file: "<planner options>".into(),
-        line: 0,
-        what: format!("{name} = {v} is out of range"),
-    })?;
+    opts.apf
+        .validate()
+        .map_err(|(name, v)| PropelError::Invalid {
+            file: "<planner options>".into(),
+            line: 0,
+            what: format!("{name} = {v} is out of range"),
+        })?;
     let legs_spec = scenario.legs();
     for (i, (from, to, dir)) in legs_spec.iter().enumerate() {
         let which_from = if i == 0 { "start" } else { "midpoint" };
-        let which_to = if i + 1 == legs_spec.len() { "goal" } else { "midpoint" };
-        check_pose(map, r_fp, which_from, *from, dir.motion_heading(from.theta), false)?;
+        let which_to = if i + 1 == legs_spec.len() {
+            "goal"
+        } else {
+            "midpoint"
+        };
+        check_pose(
+            map,
+            r_fp,
+            which_from,
+            *from,
+            dir.motion_heading(from.theta),
+            false,
+        )?;
         check_pose(map, r_fp, which_to, *to, dir.motion_heading(to.theta), true)?;
     }
 
@@ -166,8 +195,19 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
     let mut total_iter = 0;
     let mut total_esc = 0;
     for (i, (from, to, dir)) in legs_spec.iter().enumerate() {
-        let target = Target { position: to.position(), motion_heading_rad: dir.motion_heading(to.theta) };
-        let d = descend(map, from.position(), dir.motion_heading(from.theta), &target, r_fp, opts.field, &opts.apf);
+        let target = Target {
+            position: to.position(),
+            motion_heading_rad: dir.motion_heading(to.theta),
+        };
+        let d = descend(
+            map,
+            from.position(),
+            dir.motion_heading(from.theta),
+            &target,
+            r_fp,
+            opts.field,
+            &opts.apf,
+        );
         total_iter += d.iterations;
         total_esc += d.escapes;
         if let Some(q) = d.stalled_at {
@@ -193,7 +233,11 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
                 });
             }
         }
-        let keep = if opts.apf.lead_in_m > 0.0 { ((opts.apf.lead_in_m / opts.apf.step_m).ceil() as usize).min(d.raw.len() - 1) } else { 0 };
+        let keep = if opts.apf.lead_in_m > 0.0 {
+            ((opts.apf.lead_in_m / opts.apf.step_m).ceil() as usize).min(d.raw.len() - 1)
+        } else {
+            0
+        };
         let mut spacing = opts.smooth.control_spacing_m;
         let samples = loop {
             let samples = smooth(&d.raw, spacing, opts.smooth.sample_spacing_m, keep);
@@ -218,7 +262,11 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
                 _ => break samples,
             }
         };
-        let flip = if *dir == Direction::Reverse { std::f64::consts::PI } else { 0.0 };
+        let flip = if *dir == Direction::Reverse {
+            std::f64::consts::PI
+        } else {
+            0.0
+        };
         let mut last_tangent = heading_vec(dir.motion_heading(from.theta));
         let points: Vec<PathPoint> = samples
             .iter()
@@ -226,13 +274,26 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
                 if c.tangent.norm() > 0.5 {
                     last_tangent = c.tangent;
                 }
-                let theta = autoshovel_core::wrap_angle(last_tangent.y.atan2(last_tangent.x) + flip);
-                PathPoint { pose: Pose2::new(c.point.x, c.point.y, theta), s_m: s_offset + c.s, curvature_per_m: c.curvature }
+                let theta =
+                    autoshovel_core::wrap_angle(last_tangent.y.atan2(last_tangent.x) + flip);
+                PathPoint {
+                    pose: Pose2::new(c.point.x, c.point.y, theta),
+                    s_m: s_offset + c.s,
+                    curvature_per_m: c.curvature,
+                }
             })
             .collect();
-        let leg = Leg { direction: *dir, raw: d.raw.clone(), points };
+        let leg = Leg {
+            direction: *dir,
+            raw: d.raw.clone(),
+            points,
+        };
         s_offset += leg.length_m();
-        let end_err = leg.points.last().map(|p| angle_diff(p.pose.theta, to.theta).abs().to_degrees()).unwrap_or(f64::NAN);
+        let end_err = leg
+            .points
+            .last()
+            .map(|p| angle_diff(p.pose.theta, to.theta).abs().to_degrees())
+            .unwrap_or(f64::NAN);
         stats.push(LegStats {
             direction: *dir,
             iterations: d.iterations,
@@ -249,7 +310,11 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
     metrics.escapes = total_esc;
     metrics.iterations = total_iter;
     metrics.plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
-    Ok(Plan { path, legs: stats, metrics })
+    Ok(Plan {
+        path,
+        legs: stats,
+        metrics,
+    })
 }
 
 /// Measures a path against its scenario: length, clearance, heading errors, curvature.
@@ -270,12 +335,19 @@ pub fn measure(path: &Path, scenario: &Scenario) -> PlanMetrics {
         sum_k += p.curvature_per_m.abs();
         n += 1;
     }
-    let final_err = path.end_pose().map(|e| angle_diff(e.theta, scenario.goal.theta).abs().to_degrees()).unwrap_or(f64::NAN);
+    let final_err = path
+        .end_pose()
+        .map(|e| angle_diff(e.theta, scenario.goal.theta).abs().to_degrees())
+        .unwrap_or(f64::NAN);
     let start_err = path
         .legs
         .first()
         .and_then(|l| l.points.first())
-        .map(|p| angle_diff(p.pose.theta, scenario.start.theta).abs().to_degrees())
+        .map(|p| {
+            angle_diff(p.pose.theta, scenario.start.theta)
+                .abs()
+                .to_degrees()
+        })
         .unwrap_or(f64::NAN);
     let mut cusp: f64 = 0.0;
     for w in path.legs.windows(2) {

@@ -48,9 +48,15 @@ use crate::path::Direction;
 /// The built-in scenarios (name, TOML text).
 pub const BUILTINS: &[(&str, &str)] = &[
     ("straight", include_str!("../scenarios/straight.toml")),
-    ("straight-reverse", include_str!("../scenarios/straight-reverse.toml")),
+    (
+        "straight-reverse",
+        include_str!("../scenarios/straight-reverse.toml"),
+    ),
     ("curve", include_str!("../scenarios/curve.toml")),
-    ("curve-reverse", include_str!("../scenarios/curve-reverse.toml")),
+    (
+        "curve-reverse",
+        include_str!("../scenarios/curve-reverse.toml"),
+    ),
     ("v-shape", include_str!("../scenarios/v-shape.toml")),
 ];
 
@@ -77,17 +83,20 @@ impl Scenario {
     /// The legs (from, to, direction): one leg, or reverse-then-forward through the midpoint.
     pub fn legs(&self) -> Vec<(Pose2, Pose2, Direction)> {
         match self.midpoint {
-            Some(m) => vec![(self.start, m, Direction::Reverse), (m, self.goal, Direction::Forward)],
+            Some(m) => vec![
+                (self.start, m, Direction::Reverse),
+                (m, self.goal, Direction::Forward),
+            ],
             None => vec![(self.start, self.goal, self.direction)],
         }
     }
 
     /// A built-in scenario by name.
     pub fn builtin(name: &str) -> Option<Scenario> {
-        BUILTINS
-            .iter()
-            .find(|(n, _)| *n == name)
-            .map(|(n, text)| Scenario::from_toml(text, &format!("<builtin {n}>")).expect("built-in scenarios are valid"))
+        BUILTINS.iter().find(|(n, _)| *n == name).map(|(n, text)| {
+            Scenario::from_toml(text, &format!("<builtin {n}>"))
+                .expect("built-in scenarios are valid")
+        })
     }
 
     /// A built-in name, else a TOML file path.
@@ -101,13 +110,20 @@ impl Scenario {
         }
         Err(PropelError::UnknownScenario {
             name: name_or_path.to_string(),
-            known: BUILTINS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+            known: BUILTINS
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", "),
         })
     }
 
     /// Reads a TOML scenario file.
     pub fn load(path: &FsPath) -> Result<Scenario> {
-        let text = std::fs::read_to_string(path).map_err(|source| PropelError::Io { path: path.to_path_buf(), source })?;
+        let text = std::fs::read_to_string(path).map_err(|source| PropelError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
         Scenario::from_toml(&text, &path.display().to_string())
     }
 
@@ -115,7 +131,12 @@ impl Scenario {
     pub fn from_toml(text: &str, file: &str) -> Result<Scenario> {
         let raw: ScenarioFile = toml::from_str(text).map_err(|e| {
             let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
-            PropelError::Parse { file: file.to_string(), line, column, message: e.message().to_string() }
+            PropelError::Parse {
+                file: file.to_string(),
+                line,
+                column,
+                message: e.message().to_string(),
+            }
         })?;
         raw.validate(text, file)
     }
@@ -124,7 +145,10 @@ impl Scenario {
 fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let before = &text[..offset.min(text.len())];
     let line = before.matches('\n').count() + 1;
-    let column = before.rfind('\n').map(|i| before.len() - i).unwrap_or(before.len() + 1);
+    let column = before
+        .rfind('\n')
+        .map(|i| before.len() - i)
+        .unwrap_or(before.len() + 1);
     (line, column)
 }
 
@@ -188,10 +212,17 @@ pub const DEFAULT_FOOTPRINT_RADIUS_M: f64 = 1.0;
 
 impl ScenarioFile {
     fn validate(self, text: &str, file: &str) -> Result<Scenario> {
-        let err = |span: std::ops::Range<usize>, what: String| PropelError::Invalid { file: file.to_string(), line: line_col(text, span.start).0, what };
+        let err = |span: std::ops::Range<usize>, what: String| PropelError::Invalid {
+            file: file.to_string(),
+            line: line_col(text, span.start).0,
+            what,
+        };
         let finite = |span: &std::ops::Range<usize>, what: &str, vals: &[f64]| -> Result<()> {
             match vals.iter().find(|v| !v.is_finite()) {
-                Some(v) => Err(err(span.clone(), format!("{what} has a non-finite number ({v})"))),
+                Some(v) => Err(err(
+                    span.clone(),
+                    format!("{what} has a non-finite number ({v})"),
+                )),
                 None => Ok(()),
             }
         };
@@ -199,25 +230,48 @@ impl ScenarioFile {
             Some(s) => {
                 let v = *s.get_ref();
                 if !(v.is_finite() && v > 0.0) {
-                    return Err(err(s.span(), format!("footprint_radius_m = {v} must be a positive number")));
+                    return Err(err(
+                        s.span(),
+                        format!("footprint_radius_m = {v} must be a positive number"),
+                    ));
                 }
                 v
             }
             None => DEFAULT_FOOTPRINT_RADIUS_M,
         };
         let site = self.site.get_ref();
-        finite(&self.site.span(), "[site]", &[site.min_m[0], site.min_m[1], site.max_m[0], site.max_m[1]])?;
+        finite(
+            &self.site.span(),
+            "[site]",
+            &[site.min_m[0], site.min_m[1], site.max_m[0], site.max_m[1]],
+        )?;
         if !(site.max_m[0] > site.min_m[0] && site.max_m[1] > site.min_m[1]) {
-            return Err(err(self.site.span(), format!("[site] max_m {:?} must exceed min_m {:?} in x and y", site.max_m, site.min_m)));
+            return Err(err(
+                self.site.span(),
+                format!(
+                    "[site] max_m {:?} must exceed min_m {:?} in x and y",
+                    site.max_m, site.min_m
+                ),
+            ));
         }
         let extent = (site.max_m[0] - site.min_m[0]).max(site.max_m[1] - site.min_m[1]);
         if extent > 10_000.0 {
-            return Err(err(self.site.span(), format!("[site] spans {extent} m; planning sites are limited to 10 km")));
+            return Err(err(
+                self.site.span(),
+                format!("[site] spans {extent} m; planning sites are limited to 10 km"),
+            ));
         }
-        let mut map = Map::new(Vec2::new(site.min_m[0], site.min_m[1]), Vec2::new(site.max_m[0], site.max_m[1]));
+        let mut map = Map::new(
+            Vec2::new(site.min_m[0], site.min_m[1]),
+            Vec2::new(site.max_m[0], site.max_m[1]),
+        );
         let pose = |s: &Spanned<PoseSpec>, which: &str| -> Result<Pose2> {
             let p = s.get_ref();
-            finite(&s.span(), &format!("[{which}]"), &[p.x_m, p.y_m, p.heading_deg])?;
+            finite(
+                &s.span(),
+                &format!("[{which}]"),
+                &[p.x_m, p.y_m, p.heading_deg],
+            )?;
             Ok(Pose2::new(p.x_m, p.y_m, rad(p.heading_deg)))
         };
         let start = pose(&self.start, "start")?;
@@ -228,42 +282,94 @@ impl ScenarioFile {
         };
         for (i, c) in self.circle.iter().enumerate() {
             let spec = c.get_ref();
-            let what = format!("circle #{} '{}'", i + 1, spec.name.as_deref().unwrap_or("circle"));
-            finite(&c.span(), &what, &[spec.center_m[0], spec.center_m[1], spec.radius_m])?;
+            let what = format!(
+                "circle #{} '{}'",
+                i + 1,
+                spec.name.as_deref().unwrap_or("circle")
+            );
+            finite(
+                &c.span(),
+                &what,
+                &[spec.center_m[0], spec.center_m[1], spec.radius_m],
+            )?;
             if spec.radius_m <= 0.0 {
-                return Err(err(c.span(), format!("{what}: radius_m = {} must be positive", spec.radius_m)));
+                return Err(err(
+                    c.span(),
+                    format!("{what}: radius_m = {} must be positive", spec.radius_m),
+                ));
             }
             map.obstacles.push(Obstacle {
-                name: spec.name.clone().unwrap_or_else(|| format!("circle {}", i + 1)),
-                shape: Shape::Circle { center: Vec2::new(spec.center_m[0], spec.center_m[1]), radius: spec.radius_m },
+                name: spec
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| format!("circle {}", i + 1)),
+                shape: Shape::Circle {
+                    center: Vec2::new(spec.center_m[0], spec.center_m[1]),
+                    radius: spec.radius_m,
+                },
             });
         }
         for (i, p) in self.polygon.iter().enumerate() {
             let spec = p.get_ref();
-            let what = format!("polygon #{} '{}'", i + 1, spec.name.as_deref().unwrap_or("polygon"));
+            let what = format!(
+                "polygon #{} '{}'",
+                i + 1,
+                spec.name.as_deref().unwrap_or("polygon")
+            );
             let flat: Vec<f64> = spec.vertices_m.iter().flatten().copied().collect();
             finite(&p.span(), &what, &flat)?;
             if spec.vertices_m.len() > 1000 {
-                return Err(err(p.span(), format!("{what} has {} vertices; at most 1000", spec.vertices_m.len())));
+                return Err(err(
+                    p.span(),
+                    format!(
+                        "{what} has {} vertices; at most 1000",
+                        spec.vertices_m.len()
+                    ),
+                ));
             }
-            let verts = spec.vertices_m.iter().map(|v| Vec2::new(v[0], v[1])).collect();
-            let verts = convex_polygon(verts).map_err(|fault| err(p.span(), format!("{what} {fault}")))?;
+            let verts = spec
+                .vertices_m
+                .iter()
+                .map(|v| Vec2::new(v[0], v[1]))
+                .collect();
+            let verts =
+                convex_polygon(verts).map_err(|fault| err(p.span(), format!("{what} {fault}")))?;
             map.obstacles.push(Obstacle {
-                name: spec.name.clone().unwrap_or_else(|| format!("polygon {}", i + 1)),
+                name: spec
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| format!("polygon {}", i + 1)),
                 shape: Shape::Polygon { vertices: verts },
             });
         }
         for (i, b) in self.boundary.iter().enumerate() {
             let spec = b.get_ref();
-            let what = format!("boundary #{} '{}'", i + 1, spec.name.as_deref().unwrap_or("boundary"));
+            let what = format!(
+                "boundary #{} '{}'",
+                i + 1,
+                spec.name.as_deref().unwrap_or("boundary")
+            );
             let flat: Vec<f64> = spec.points_m.iter().flatten().copied().collect();
             finite(&b.span(), &what, &flat)?;
             if spec.points_m.len() < 2 {
-                return Err(err(b.span(), format!("{what} has {} points, needs at least 2", spec.points_m.len())));
+                return Err(err(
+                    b.span(),
+                    format!(
+                        "{what} has {} points, needs at least 2",
+                        spec.points_m.len()
+                    ),
+                ));
             }
             map.boundaries.push(Boundary {
-                name: spec.name.clone().unwrap_or_else(|| format!("boundary {}", i + 1)),
-                points: spec.points_m.iter().map(|v| Vec2::new(v[0], v[1])).collect(),
+                name: spec
+                    .name
+                    .clone()
+                    .unwrap_or_else(|| format!("boundary {}", i + 1)),
+                points: spec
+                    .points_m
+                    .iter()
+                    .map(|v| Vec2::new(v[0], v[1]))
+                    .collect(),
             });
         }
         Ok(Scenario {
@@ -286,7 +392,10 @@ mod tests {
     fn every_builtin_parses() {
         for (name, _) in BUILTINS {
             let s = Scenario::builtin(name).unwrap();
-            assert!(!s.map.obstacles.is_empty() || name.starts_with("straight"), "{name}");
+            assert!(
+                !s.map.obstacles.is_empty() || name.starts_with("straight"),
+                "{name}"
+            );
         }
     }
 
@@ -305,25 +414,62 @@ mod tests {
     #[test]
     fn malformed_toml_names_file_and_line() {
         let text = base() + "[[circle]]\ncenter_m = [1.0, 2.0\n";
-        let e = Scenario::from_toml(&text, "bad.toml").unwrap_err().to_string();
+        let e = Scenario::from_toml(&text, "bad.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.starts_with("bad.toml:14:"), "{e}");
     }
 
     #[test]
     fn nan_and_non_convex_polygons_are_refused_with_their_line() {
         let text = base() + "[[circle]]\nname = \"rock\"\ncenter_m = [nan, 2.0]\nradius_m = 1.0\n";
-        let e = Scenario::from_toml(&text, "n.toml").unwrap_err().to_string();
-        assert!(e.contains("n.toml:12") && e.contains("rock") && e.contains("NaN"), "{e}");
+        let e = Scenario::from_toml(&text, "n.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.contains("n.toml:12") && e.contains("rock") && e.contains("NaN"),
+            "{e}"
+        );
         let text = base() + "\n[[polygon]]\nname = \"dart\"\nvertices_m = [[0.0, 0.0], [2.0, 1.0], [4.0, 0.0], [2.0, 3.0]]\n";
-        let e = Scenario::from_toml(&text, "p.toml").unwrap_err().to_string();
+        let e = Scenario::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("p.toml:13") && e.contains("not convex"), "{e}");
     }
 
     #[test]
     fn unknown_fields_and_names_are_refused() {
         let text = base() + "speed = 3\n";
-        assert!(Scenario::from_toml(&text, "u.toml").unwrap_err().to_string().contains("speed"));
-        let e = Scenario::resolve("no-such-scenario").unwrap_err().to_string();
+        assert!(Scenario::from_toml(&text, "u.toml")
+            .unwrap_err()
+            .to_string()
+            .contains("speed"));
+        let e = Scenario::resolve("no-such-scenario")
+            .unwrap_err()
+            .to_string();
         assert!(e.contains("curve") && e.contains("no-such-scenario"), "{e}");
+    }
+
+    proptest::proptest! {
+        // Untrusted input: any text, and any byte-level damage to a valid
+        // file, gives a scenario or an error, never a panic.
+        #[test]
+        fn arbitrary_text_never_panics(text in ".{0,400}") {
+            let _ = Scenario::from_toml(&text, "fuzz.toml");
+        }
+
+        #[test]
+        fn damaged_builtins_never_panic(which in 0usize..5, pos in 0usize..2000, byte in 0u8..128, cut in proptest::bool::ANY) {
+            let text = BUILTINS[which % BUILTINS.len()].1;
+            let mut bytes = text.as_bytes().to_vec();
+            let pos = pos % bytes.len();
+            if cut { bytes.truncate(pos) } else { bytes[pos] = byte }
+            if let Ok(t) = String::from_utf8(bytes) {
+                if let Ok(s) = Scenario::from_toml(&t, "fuzz.toml") {
+                    // Whatever parses plans or fails cleanly.
+                    let _ = crate::plan_path(&s, &crate::PlanOptions::new(crate::FieldKind::Improved));
+                }
+            }
+        }
     }
 }

@@ -25,7 +25,11 @@ pub struct SmoothParams {
 
 impl Default for SmoothParams {
     fn default() -> Self {
-        Self { control_spacing_m: 1.0, sample_spacing_m: 0.1, min_control_spacing_m: 0.1 }
+        Self {
+            control_spacing_m: 1.0,
+            sample_spacing_m: 0.1,
+            min_control_spacing_m: 0.1,
+        }
     }
 }
 
@@ -36,14 +40,21 @@ impl Default for SmoothParams {
 /// back-and-forth of a descent that hesitated.
 pub fn decimate(raw: &[Vec2], spacing_m: f64, keep: usize) -> Vec<Vec2> {
     let mut out: Vec<Vec2> = Vec::new();
-    let Some(&first) = raw.first() else { return out };
+    let Some(&first) = raw.first() else {
+        return out;
+    };
     out.push(first);
     for i in 1..raw.len() {
         let last = i + 1 == raw.len();
         let from_kept = (raw[i] - out[out.len() - 1]).norm();
         if last || i == keep || from_kept >= spacing_m {
             // Avoid a near-duplicate final control point (it would bend the end tangent).
-            if last && from_kept < 0.5 * spacing_m && out.len() > 1 && i != keep && out.len() - 1 != keep_index(&out, raw, keep) {
+            if last
+                && from_kept < 0.5 * spacing_m
+                && out.len() > 1
+                && i != keep
+                && out.len() - 1 != keep_index(&out, raw, keep)
+            {
                 out.pop();
             }
             out.push(raw[i]);
@@ -54,11 +65,18 @@ pub fn decimate(raw: &[Vec2], spacing_m: f64, keep: usize) -> Vec<Vec2> {
 
 /// Index in `out` of the lead-in control point (raw[keep]), or usize::MAX.
 fn keep_index(out: &[Vec2], raw: &[Vec2], keep: usize) -> usize {
-    raw.get(keep).and_then(|k| out.iter().position(|p| p == k)).unwrap_or(usize::MAX)
+    raw.get(keep)
+        .and_then(|k| out.iter().position(|p| p == k))
+        .unwrap_or(usize::MAX)
 }
 
 /// Smooths `raw` into samples spaced `sample_spacing_m` apart.
-pub fn smooth(raw: &[Vec2], control_spacing_m: f64, sample_spacing_m: f64, keep: usize) -> Vec<CurveSample> {
+pub fn smooth(
+    raw: &[Vec2],
+    control_spacing_m: f64,
+    sample_spacing_m: f64,
+    keep: usize,
+) -> Vec<CurveSample> {
     let ctrl = decimate(raw, control_spacing_m, keep);
     match CubicBSpline::clamped(ctrl) {
         Some(spline) => spline.sample_by_arc_length(sample_spacing_m),
@@ -84,11 +102,17 @@ mod tests {
     #[test]
     fn zigzag_is_smoothed_towards_its_mean_line() {
         // A descent oscillating ±5 cm about y = 0 becomes (nearly) straight.
-        let raw: Vec<Vec2> = (0..=200).map(|i| Vec2::new(0.1 * i as f64, if i % 2 == 0 { 0.05 } else { -0.05 })).collect();
+        let raw: Vec<Vec2> = (0..=200)
+            .map(|i| Vec2::new(0.1 * i as f64, if i % 2 == 0 { 0.05 } else { -0.05 }))
+            .collect();
         let s = smooth(&raw, 1.0, 0.1, 0);
         let max_dev = s.iter().map(|c| c.point.y.abs()).fold(0.0, f64::max);
         assert!(max_dev <= 0.05 + 1e-12);
-        let max_kappa = s.iter().skip(2).map(|c| c.curvature.abs()).fold(0.0, f64::max);
+        let max_kappa = s
+            .iter()
+            .skip(2)
+            .map(|c| c.curvature.abs())
+            .fold(0.0, f64::max);
         assert!(max_kappa < 0.5, "curvature {max_kappa}");
     }
 }

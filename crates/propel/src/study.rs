@@ -36,20 +36,31 @@ pub struct StudyParams {
 
 impl Default for StudyParams {
     fn default() -> Self {
-        Self { maps: 500, seed: 1, min_obstacles: 3, max_obstacles: 12, road_length_m: 60.0, heading_tolerance_deg: 2.0 }
+        Self {
+            maps: 500,
+            seed: 1,
+            min_obstacles: 3,
+            max_obstacles: 12,
+            road_length_m: 60.0,
+            heading_tolerance_deg: 2.0,
+        }
     }
 }
 
 /// Generates map `index` of the study (same seed and index, same map).
 pub fn random_road(params: &StudyParams, index: usize) -> Scenario {
-    let mut rng = ChaCha8Rng::seed_from_u64(params.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index as u64);
+    let mut rng =
+        ChaCha8Rng::seed_from_u64(params.seed.wrapping_mul(0x9E37_79B9_7F4A_7C15) ^ index as u64);
     let len = params.road_length_m;
     let amp = rng.gen_range(0.0..4.0);
     let wavelength = rng.gen_range(1.0..2.0) * len;
     let phase = rng.gen_range(0.0..std::f64::consts::TAU);
     let width = rng.gen_range(12.0..16.0);
     let center = |x: f64| amp * (std::f64::consts::TAU * x / wavelength + phase).sin();
-    let slope = |x: f64| amp * std::f64::consts::TAU / wavelength * (std::f64::consts::TAU * x / wavelength + phase).cos();
+    let slope = |x: f64| {
+        amp * std::f64::consts::TAU / wavelength
+            * (std::f64::consts::TAU * x / wavelength + phase).cos()
+    };
     let at = |x: f64, off: f64| {
         let t = Vec2::new(1.0, slope(x)).normalize();
         Vec2::new(x, center(x)) + perp(t) * off
@@ -59,9 +70,18 @@ pub fn random_road(params: &StudyParams, index: usize) -> Scenario {
     let south: Vec<Vec2> = xs.iter().map(|&x| at(x, -0.5 * width)).collect();
     let ymin = south.iter().map(|p| p.y).fold(f64::INFINITY, f64::min) - 2.0;
     let ymax = north.iter().map(|p| p.y).fold(f64::NEG_INFINITY, f64::max) + 2.0;
-    let mut map = Map::new(Vec2::new(north[0].x.min(south[0].x).min(0.0), ymin), Vec2::new(len.max(north[40].x).max(south[40].x), ymax));
-    map.boundaries.push(Boundary { name: "north edge".into(), points: north });
-    map.boundaries.push(Boundary { name: "south edge".into(), points: south });
+    let mut map = Map::new(
+        Vec2::new(north[0].x.min(south[0].x).min(0.0), ymin),
+        Vec2::new(len.max(north[40].x).max(south[40].x), ymax),
+    );
+    map.boundaries.push(Boundary {
+        name: "north edge".into(),
+        points: north,
+    });
+    map.boundaries.push(Boundary {
+        name: "south edge".into(),
+        points: south,
+    });
     let heading = |x: f64| slope(x).atan();
     let start = Pose2::new(3.0, center(3.0), heading(3.0));
     let goal = Pose2::new(len - 3.0, center(len - 3.0), heading(len - 3.0));
@@ -74,18 +94,33 @@ pub fn random_road(params: &StudyParams, index: usize) -> Scenario {
         let off = rng.gen_range(-0.5 * width..0.5 * width);
         let c = at(x, off);
         let shape = if rng.gen_bool(0.5) {
-            Shape::Circle { center: c, radius: rng.gen_range(0.5..2.0) }
+            Shape::Circle {
+                center: c,
+                radius: rng.gen_range(0.5..2.0),
+            }
         } else {
             let (l, w) = (rng.gen_range(2.0..7.0), rng.gen_range(1.5..3.5));
             let a = heading(x) + rng.gen_range(-0.6..0.6);
             let (u, v) = (heading_vec(a), perp(heading_vec(a)));
-            let verts = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)].iter().map(|(p, q)| c + u * (p * l) + v * (q * w)).collect();
-            Shape::Polygon { vertices: convex_polygon(verts).expect("a rectangle is convex") }
+            let verts = [(-0.5, -0.5), (0.5, -0.5), (0.5, 0.5), (-0.5, 0.5)]
+                .iter()
+                .map(|(p, q)| c + u * (p * l) + v * (q * w))
+                .collect();
+            Shape::Polygon {
+                vertices: convex_polygon(verts).expect("a rectangle is convex"),
+            }
         };
         let ok = |p: Pose2| shape.nearest(p.position()).0 - r_fp > 1.5;
         if ok(start) && ok(goal) {
-            let kind = if matches!(shape, Shape::Circle { .. }) { "rock" } else { "truck" };
-            map.obstacles.push(Obstacle { name: format!("{kind} {}", map.obstacles.len() + 1), shape });
+            let kind = if matches!(shape, Shape::Circle { .. }) {
+                "rock"
+            } else {
+                "truck"
+            };
+            map.obstacles.push(Obstacle {
+                name: format!("{kind} {}", map.obstacles.len() + 1),
+                shape,
+            });
         }
     }
     Scenario {
@@ -170,7 +205,15 @@ fn outcome(scenario: &Scenario, field: FieldKind, tol_deg: f64) -> Outcome {
 /// Runs the study on map `index`.
 pub fn run_map(params: &StudyParams, index: usize) -> MapRow {
     let s = random_road(params, index);
-    let reference = astar(&s.map, s.start.position(), s.goal.position(), s.footprint_radius_m, &AstarParams::default()).ok().map(|r| r.length_m);
+    let reference = astar(
+        &s.map,
+        s.start.position(),
+        s.goal.position(),
+        s.footprint_radius_m,
+        &AstarParams::default(),
+    )
+    .ok()
+    .map(|r| r.length_m);
     MapRow {
         index,
         obstacles: s.map.obstacles.len(),
@@ -215,11 +258,19 @@ pub struct Aggregate {
 
 /// Aggregates rows for one planner (`pick` selects its outcome).
 pub fn aggregate(rows: &[MapRow], planner: &str, pick: impl Fn(&MapRow) -> &Outcome) -> Aggregate {
-    let solved: Vec<&MapRow> = rows.iter().filter(|r| r.reference_length_m.is_some()).collect();
+    let solved: Vec<&MapRow> = rows
+        .iter()
+        .filter(|r| r.reference_length_m.is_some())
+        .collect();
     let n = solved.len().max(1) as f64;
-    let reached: Vec<(&MapRow, &Outcome)> = solved.iter().map(|r| (*r, pick(r))).filter(|(_, o)| o.reached).collect();
+    let reached: Vec<(&MapRow, &Outcome)> = solved
+        .iter()
+        .map(|r| (*r, pick(r)))
+        .filter(|(_, o)| o.reached)
+        .collect();
     let m = reached.len().max(1) as f64;
-    let ratio = |(r, o): &(&MapRow, &Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
+    let ratio =
+        |(r, o): &(&MapRow, &Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
     let max = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::max);
     let min = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::min);
     Aggregate {
@@ -228,13 +279,22 @@ pub fn aggregate(rows: &[MapRow], planner: &str, pick: impl Fn(&MapRow) -> &Outc
         reached_pct: 100.0 * reached.len() as f64 / n,
         success_pct: 100.0 * solved.iter().filter(|r| pick(r).success).count() as f64 / n,
         local_minima: solved.iter().filter(|r| pick(r).local_minimum).count(),
-        other_failures: solved.iter().filter(|r| !pick(r).reached && !pick(r).local_minimum).count(),
+        other_failures: solved
+            .iter()
+            .filter(|r| !pick(r).reached && !pick(r).local_minimum)
+            .count(),
         mean_length_ratio: reached.iter().map(ratio).sum::<f64>() / m,
         max_length_ratio: max(&mut reached.iter().map(ratio)),
         mean_min_clearance_m: reached.iter().map(|(_, o)| o.min_clearance_m).sum::<f64>() / m,
         min_min_clearance_m: min(&mut reached.iter().map(|(_, o)| o.min_clearance_m)),
-        mean_final_heading_error_deg: reached.iter().map(|(_, o)| o.final_heading_error_deg).sum::<f64>() / m,
-        max_final_heading_error_deg: max(&mut reached.iter().map(|(_, o)| o.final_heading_error_deg)),
+        mean_final_heading_error_deg: reached
+            .iter()
+            .map(|(_, o)| o.final_heading_error_deg)
+            .sum::<f64>()
+            / m,
+        max_final_heading_error_deg: max(&mut reached
+            .iter()
+            .map(|(_, o)| o.final_heading_error_deg)),
         maps_with_escapes: reached.iter().filter(|(_, o)| o.escapes > 0).count(),
         mean_plan_time_ms: reached.iter().map(|(_, o)| o.plan_time_ms).sum::<f64>() / m,
     }
@@ -255,17 +315,26 @@ mod tests {
         assert_eq!(random_road(&p, 7), random_road(&p, 7));
         assert_ne!(random_road(&p, 7), random_road(&p, 8));
         let s = random_road(&p, 3);
-        assert!(s.map.obstacles.len() >= p.min_obstacles && s.map.obstacles.len() <= p.max_obstacles);
+        assert!(
+            s.map.obstacles.len() >= p.min_obstacles && s.map.obstacles.len() <= p.max_obstacles
+        );
     }
 
     #[test]
     fn a_small_study_runs_and_the_improved_field_beats_the_classic() {
-        let p = StudyParams { maps: 20, ..Default::default() };
+        let p = StudyParams {
+            maps: 20,
+            ..Default::default()
+        };
         let rows: Vec<MapRow> = (0..p.maps).map(|i| run_map(&p, i)).collect();
         let c = aggregate(&rows, "apf", |r| &r.classic);
         let i = aggregate(&rows, "improved-apf", |r| &r.improved);
         assert!(c.maps > 10);
         assert!(i.success_pct > c.success_pct);
-        assert!(i.mean_length_ratio >= 1.0 - 1e-9, "the reference is a lower bound: {}", i.mean_length_ratio);
+        assert!(
+            i.mean_length_ratio >= 1.0 - 1e-9,
+            "the reference is a lower bound: {}",
+            i.mean_length_ratio
+        );
     }
 }

@@ -26,6 +26,9 @@
 //! # }
 //! ```
 
+// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
 mod clip;
 mod csv;
 mod error;
