@@ -1,0 +1,1 @@
+//! Fuzzy inference (being written).
