@@ -29,10 +29,10 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let key = format!("plan-path {name} {}", field.name());
         let sub = format!("plan-path-{name}-{}", field.name());
         let dir = prepare_dir(&out.join(&sub))?;
-        let job = crate::plan_path::job(&scenario, field, Some(&dir))?;
+        let job = crate::plan_path::job(&scenario, field, 2.0, Some(&dir))?;
         if !json_only {
             let s = &job.summary;
-            println!(
+            crate::say!(
                 "{key:40} {}",
                 if s["success"].as_bool() == Some(true) {
                     format!(
@@ -65,7 +65,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     let dir = prepare_dir(&out.join(sub))?;
     let (summary, written) = crate::study::study(&params, Some(&dir), !json_only)?;
     if !json_only {
-        println!("{}", crate::study::markdown_table(&summary));
+        crate::say!("{}", crate::study::markdown_table(&summary));
     }
     sections.push(section(
         "study-paths (100 maps)",
@@ -82,7 +82,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     if json_only {
         print_json(&json!({ "job": "demo", "jobs": all }))?;
     } else {
-        println!("report: {}", index.display());
+        crate::say!("report: {}", index.display());
     }
     Ok(())
 }

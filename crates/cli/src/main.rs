@@ -2,6 +2,15 @@
 //! each writes `summary.json`, CSV data and SVG+PNG plots with `--out DIR`
 //! and prints the summary alone with `--json`.
 
+/// `println!` that ignores a closed stdout (`autoshovel ... | head`) instead of panicking.
+macro_rules! say {
+    ($($arg:tt)*) => {{
+        use std::io::Write as _;
+        let _ = writeln!(std::io::stdout().lock(), $($arg)*);
+    }};
+}
+pub(crate) use say;
+
 mod demo;
 mod output;
 mod plan_path;
@@ -71,7 +80,8 @@ fn main() -> ExitCode {
             .find(|(n, _)| *n == name)
         {
             Some((_, text)) => {
-                print!("{text}");
+                use std::io::Write as _;
+                let _ = write!(std::io::stdout().lock(), "{text}");
                 Ok(())
             }
             None => Err(anyhow::anyhow!(

@@ -20,7 +20,7 @@ pub fn prepare_dir(dir: &Path) -> Result<PathBuf> {
 
 /// Prints the summary as pretty JSON on stdout.
 pub fn print_json(summary: &serde_json::Value) -> Result<()> {
-    println!("{}", serde_json::to_string_pretty(summary)?);
+    crate::say!("{}", serde_json::to_string_pretty(summary)?);
     Ok(())
 }
 

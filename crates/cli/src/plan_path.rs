@@ -32,6 +32,9 @@ pub struct Args {
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
+    /// Success needs every leg to end within this of its required heading [deg].
+    #[arg(long, default_value_t = 2.0)]
+    pub heading_tolerance_deg: f64,
 }
 
 /// Result of one plan-path job.
@@ -40,32 +43,43 @@ pub struct Job {
     pub summary: Value,
     /// Files written (when an output folder was given).
     pub written: Written,
-    /// The planning error, if planning failed.
-    pub error: Option<PropelError>,
+    /// Why the job failed, if it did.
+    pub error: Option<String>,
 }
 
 /// Runs `plan-path` as the command line asks.
 pub fn run(args: &Args) -> Result<()> {
     let scenario = Scenario::resolve(&args.scenario)?;
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    let job = job(&scenario, args.planner.into(), out.as_deref())?;
+    if !(args.heading_tolerance_deg.is_finite() && args.heading_tolerance_deg >= 0.0) {
+        anyhow::bail!(
+            "--heading-tolerance-deg {} must be a non-negative number",
+            args.heading_tolerance_deg
+        );
+    }
+    let job = job(
+        &scenario,
+        args.planner.into(),
+        args.heading_tolerance_deg,
+        out.as_deref(),
+    )?;
     if args.json {
         print_json(&job.summary)?;
     } else {
         print_human(&job.summary);
         if let Some(dir) = &out {
-            println!(
+            crate::say!(
                 "wrote {} (summary.json, CSV, SVG and PNG plots)",
                 dir.display()
             );
         }
     }
     match job.error {
-        Some(e) => Err(anyhow::Error::new(e).context(format!(
-            "{} could not plan scenario '{}'",
+        Some(e) => Err(anyhow::anyhow!(
+            "{} could not plan scenario '{}': {e}",
             job.summary["planner"].as_str().unwrap_or("planner"),
             scenario.name
-        ))),
+        )),
         None => Ok(()),
     }
 }
@@ -76,7 +90,7 @@ fn print_human(s: &Value) {
             .map(|v| format!("{v:.3}"))
             .unwrap_or_else(|| "-".into())
     };
-    println!(
+    crate::say!(
         "{} on {}: {}",
         s["planner"].as_str().unwrap_or(""),
         s["scenario"].as_str().unwrap_or(""),
@@ -86,7 +100,7 @@ fn print_human(s: &Value) {
             "FAILED"
         }
     );
-    println!(
+    crate::say!(
         "  length            {} m (reference {} m, ratio {})",
         f("length_m"),
         s["reference"]["length_m"]
@@ -98,19 +112,24 @@ fn print_human(s: &Value) {
             .map(|v| format!("{v:.3}"))
             .unwrap_or("-".into())
     );
-    println!("  min clearance     {} m", f("min_clearance_m"));
-    println!(
+    crate::say!("  min clearance     {} m", f("min_clearance_m"));
+    crate::say!(
         "  heading error     {} deg at the goal, {} deg at the start",
         f("final_heading_error_deg"),
         f("start_heading_error_deg")
     );
-    println!("  max curvature     {} 1/m", f("max_curvature_per_m"));
-    println!("  escapes           {}", s["escapes"]);
-    println!("  plan time         {} ms", f("plan_time_ms"));
+    crate::say!("  max curvature     {} 1/m", f("max_curvature_per_m"));
+    crate::say!("  escapes           {}", s["escapes"]);
+    crate::say!("  plan time         {} ms", f("plan_time_ms"));
 }
 
 /// Plans one scenario, writes the outputs into `out` if given, and returns the summary.
-pub fn job(scenario: &Scenario, field: FieldKind, out: Option<&Path>) -> Result<Job> {
+pub fn job(
+    scenario: &Scenario,
+    field: FieldKind,
+    heading_tolerance_deg: f64,
+    out: Option<&Path>,
+) -> Result<Job> {
     let opts = PlanOptions::new(field);
     let result = plan_path(scenario, &opts);
     // The reference route, leg by leg (heading-free, so a near lower bound on length).
@@ -142,6 +161,27 @@ pub fn job(scenario: &Scenario, field: FieldKind, out: Option<&Path>) -> Result<
         ),
         Err(e) => summary_err(scenario, field, &opts, e, reference.as_ref().map(|r| r.0)),
     };
+    // A path that arrives off its heading would need a turn on the spot: not a success.
+    let mut error = result.as_ref().err().map(|e| e.to_string());
+    if let Ok(plan) = &result {
+        if let Some((i, l)) = plan.legs.iter().enumerate().find(|(_, l)| {
+            l.end_heading_error_deg.is_nan() || l.end_heading_error_deg > heading_tolerance_deg
+        }) {
+            let which = if i + 1 == plan.legs.len() {
+                "the goal".to_string()
+            } else {
+                format!("the midpoint (end of leg {})", i + 1)
+            };
+            let e = format!(
+                "the required heading cannot be met: the path arrives at {which} {:.2} deg off it (tolerance {heading_tolerance_deg} deg); the machine would have to turn on the spot",
+                l.end_heading_error_deg
+            );
+            summary["success"] = json!(false);
+            summary["error"] = json!(e);
+            error = Some(e);
+        }
+    }
+    summary["heading_tolerance_deg"] = json!(heading_tolerance_deg);
     let mut written = Written::default();
     if let Some(dir) = out {
         write_outputs(
@@ -163,7 +203,7 @@ pub fn job(scenario: &Scenario, field: FieldKind, out: Option<&Path>) -> Result<
     Ok(Job {
         summary,
         written,
-        error: result.err(),
+        error,
     })
 }
 

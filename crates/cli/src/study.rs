@@ -49,9 +49,9 @@ pub fn run(args: &Args) -> Result<()> {
     if args.json {
         print_json(&summary)?;
     } else {
-        println!("{}", markdown_table(&summary));
+        crate::say!("{}", markdown_table(&summary));
         if let Some(dir) = &out {
-            println!("wrote {}", dir.display());
+            crate::say!("wrote {}", dir.display());
         }
     }
     Ok(())

@@ -9,7 +9,7 @@ use autoshovel_core::Vec2;
 #[non_exhaustive]
 pub enum PropelError {
     /// A scenario file could not be read.
-    #[error("cannot read scenario file {path}: {source}")]
+    #[error("cannot read scenario file {path}")]
     Io {
         /// The file.
         path: PathBuf,

@@ -195,6 +195,30 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
     let mut total_iter = 0;
     let mut total_esc = 0;
     for (i, (from, to, dir)) in legs_spec.iter().enumerate() {
+        if (to.position() - from.position()).norm() <= opts.apf.goal_tolerance_m {
+            // Already there: a leg of one pose (its heading error says whether it is enough).
+            let point = PathPoint {
+                pose: *from,
+                s_m: s_offset,
+                curvature_per_m: 0.0,
+            };
+            let leg = Leg {
+                direction: *dir,
+                raw: vec![from.position()],
+                points: vec![point],
+            };
+            stats.push(LegStats {
+                direction: *dir,
+                iterations: 0,
+                escapes: 0,
+                control_spacing_m: 0.0,
+                raw_length_m: 0.0,
+                length_m: 0.0,
+                end_heading_error_deg: angle_diff(from.theta, to.theta).abs().to_degrees(),
+            });
+            legs.push(leg);
+            continue;
+        }
         let target = Target {
             position: to.position(),
             motion_heading_rad: dir.motion_heading(to.theta),

@@ -217,22 +217,44 @@ impl ScenarioFile {
             line: line_col(text, span.start).0,
             what,
         };
-        let finite = |span: &std::ops::Range<usize>, what: &str, vals: &[f64]| -> Result<()> {
-            match vals.iter().find(|v| !v.is_finite()) {
-                Some(v) => Err(err(
-                    span.clone(),
-                    format!("{what} has a non-finite number ({v})"),
-                )),
-                None => Ok(()),
+        // The line of `key` inside a table's span (the header's line if not found).
+        let key_line = |span: &std::ops::Range<usize>, key: &str| -> usize {
+            let start = span.start.min(text.len());
+            let end = span.end.min(text.len());
+            let body = &text[start..end];
+            let mut offset = start;
+            for l in body.split_inclusive('\n') {
+                let t = l.trim_start();
+                if t.starts_with(key) && t[key.len()..].trim_start().starts_with('=') {
+                    return line_col(text, offset).0;
+                }
+                offset += l.len();
             }
+            line_col(text, start).0
         };
+        // Every number finite and within ±1000 km (a planning site, not a globe).
+        let finite =
+            |span: &std::ops::Range<usize>, what: &str, vals: &[(&str, f64)]| -> Result<()> {
+                match vals.iter().find(|(_, v)| !v.is_finite() || v.abs() > 1e6) {
+                    Some((key, v)) => Err(PropelError::Invalid {
+                        file: file.to_string(),
+                        line: key_line(span, key),
+                        what: if v.is_finite() {
+                            format!("{what}: {key} has {v:e}, beyond the ±1e6 m a site may span")
+                        } else {
+                            format!("{what}: {key} has a non-finite number ({v})")
+                        },
+                    }),
+                    None => Ok(()),
+                }
+            };
         let r_fp = match &self.footprint_radius_m {
             Some(s) => {
                 let v = *s.get_ref();
-                if !(v.is_finite() && v > 0.0) {
+                if !(v.is_finite() && v > 0.0 && v < 1e3) {
                     return Err(err(
                         s.span(),
-                        format!("footprint_radius_m = {v} must be a positive number"),
+                        format!("footprint_radius_m = {v} must be a positive number below 1000"),
                     ));
                 }
                 v
@@ -243,7 +265,12 @@ impl ScenarioFile {
         finite(
             &self.site.span(),
             "[site]",
-            &[site.min_m[0], site.min_m[1], site.max_m[0], site.max_m[1]],
+            &[
+                ("min_m", site.min_m[0]),
+                ("min_m", site.min_m[1]),
+                ("max_m", site.max_m[0]),
+                ("max_m", site.max_m[1]),
+            ],
         )?;
         if !(site.max_m[0] > site.min_m[0] && site.max_m[1] > site.min_m[1]) {
             return Err(err(
@@ -270,7 +297,11 @@ impl ScenarioFile {
             finite(
                 &s.span(),
                 &format!("[{which}]"),
-                &[p.x_m, p.y_m, p.heading_deg],
+                &[
+                    ("x_m", p.x_m),
+                    ("y_m", p.y_m),
+                    ("heading_deg", p.heading_deg),
+                ],
             )?;
             Ok(Pose2::new(p.x_m, p.y_m, rad(p.heading_deg)))
         };
@@ -290,13 +321,18 @@ impl ScenarioFile {
             finite(
                 &c.span(),
                 &what,
-                &[spec.center_m[0], spec.center_m[1], spec.radius_m],
+                &[
+                    ("center_m", spec.center_m[0]),
+                    ("center_m", spec.center_m[1]),
+                    ("radius_m", spec.radius_m),
+                ],
             )?;
             if spec.radius_m <= 0.0 {
-                return Err(err(
-                    c.span(),
-                    format!("{what}: radius_m = {} must be positive", spec.radius_m),
-                ));
+                return Err(PropelError::Invalid {
+                    file: file.to_string(),
+                    line: key_line(&c.span(), "radius_m"),
+                    what: format!("{what}: radius_m = {} must be positive", spec.radius_m),
+                });
             }
             map.obstacles.push(Obstacle {
                 name: spec
@@ -316,7 +352,12 @@ impl ScenarioFile {
                 i + 1,
                 spec.name.as_deref().unwrap_or("polygon")
             );
-            let flat: Vec<f64> = spec.vertices_m.iter().flatten().copied().collect();
+            let flat: Vec<(&str, f64)> = spec
+                .vertices_m
+                .iter()
+                .flatten()
+                .map(|v| ("vertices_m", *v))
+                .collect();
             finite(&p.span(), &what, &flat)?;
             if spec.vertices_m.len() > 1000 {
                 return Err(err(
@@ -349,7 +390,12 @@ impl ScenarioFile {
                 i + 1,
                 spec.name.as_deref().unwrap_or("boundary")
             );
-            let flat: Vec<f64> = spec.points_m.iter().flatten().copied().collect();
+            let flat: Vec<(&str, f64)> = spec
+                .points_m
+                .iter()
+                .flatten()
+                .map(|v| ("points_m", *v))
+                .collect();
             finite(&b.span(), &what, &flat)?;
             if spec.points_m.len() < 2 {
                 return Err(err(
@@ -427,7 +473,7 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(
-            e.contains("n.toml:12") && e.contains("rock") && e.contains("NaN"),
+            e.contains("n.toml:14") && e.contains("rock") && e.contains("NaN"),
             "{e}"
         );
         let text = base() + "\n[[polygon]]\nname = \"dart\"\nvertices_m = [[0.0, 0.0], [2.0, 1.0], [4.0, 0.0], [2.0, 3.0]]\n";

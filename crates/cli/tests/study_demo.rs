@@ -1,0 +1,215 @@
+//! `autoshovel study-paths` (seeded, so repeatable) and `autoshovel demo`.
+
+mod common;
+
+use common::*;
+use serde_json::Value;
+
+fn study(seed: &str) -> Value {
+    let r = run(&["study-paths", "--maps", "20", "--seed", seed, "--json"]).ok();
+    assert!(
+        r.stderr.is_empty(),
+        "--json: no progress bar or other text on stderr expected:\n{}",
+        r.stderr
+    );
+    r.json()
+}
+
+#[test]
+fn study_is_repeatable_for_a_seed() {
+    let a = study("3");
+    let b = study("3");
+    assert_eq!(a["job"], "study-paths");
+    assert_eq!(a["maps"], 20);
+    assert_eq!(a["seed"], 3);
+    assert_eq!(a["success"], true);
+    let names: Vec<&str> = a["planners"]
+        .as_array()
+        .expect("planners")
+        .iter()
+        .map(|p| p["planner"].as_str().expect("planner name"))
+        .collect();
+    assert_eq!(names, ["apf", "improved-apf"]);
+    let solved = a["reference"]["solved"].as_u64().expect("reference.solved");
+    assert!(solved <= 20, "{solved}");
+    for (pa, pb) in a["planners"]
+        .as_array()
+        .expect("planners")
+        .iter()
+        .zip(b["planners"].as_array().expect("planners"))
+    {
+        let name = &pa["planner"];
+        for k in [
+            "success_pct",
+            "reached_pct",
+            "local_minima",
+            "maps",
+            "mean_length_ratio",
+            "max_final_heading_error_deg",
+        ] {
+            assert_eq!(
+                pa[k], pb[k],
+                "{name}.{k} differs between two runs with --seed 3"
+            );
+        }
+        let pct = f64_field(pa, "success_pct");
+        assert!((0.0..=100.0).contains(&pct), "{name}: success_pct {pct}");
+        assert_eq!(
+            pa["maps"].as_u64(),
+            Some(solved),
+            "{name}: judged over the maps the reference solves"
+        );
+    }
+    assert_eq!(a["reference"]["solved"], b["reference"]["solved"]);
+    // Everything but the wall-clock timings is identical.
+    assert_eq!(without_timing(&a), without_timing(&b));
+    // The improved field beats the classic one on these roads (README table).
+    let pct = |v: &Value, i: usize| f64_field(&v["planners"][i], "success_pct");
+    assert!(
+        pct(&a, 1) > pct(&a, 0),
+        "improved {} % vs classic {} %",
+        pct(&a, 1),
+        pct(&a, 0)
+    );
+}
+
+#[test]
+fn study_out_dir_gets_csv_summary_and_plot() {
+    let dir = TempDir::new("study-out");
+    let r = run(&[
+        "study-paths".as_ref(),
+        "--maps".as_ref(),
+        "5".as_ref(),
+        "--seed".as_ref(),
+        "7".as_ref(),
+        "--json".as_ref(),
+        "--out".as_ref(),
+        dir.path().as_os_str(),
+    ])
+    .ok();
+    let printed = r.json();
+    let csv = std::fs::read_to_string(dir.path().join("maps.csv")).expect("maps.csv");
+    let mut lines = csv.lines();
+    assert!(lines
+        .next()
+        .expect("header")
+        .starts_with("map,obstacles,reference_length_m,apf_success,"));
+    assert_eq!(lines.count(), 5, "one row per map");
+    let summary: Value = serde_json::from_str(
+        &std::fs::read_to_string(dir.path().join("summary.json")).expect("summary.json"),
+    )
+    .expect("summary JSON");
+    assert_eq!(summary, printed, "--json prints what summary.json holds");
+    for f in ["success_by_obstacles.svg", "success_by_obstacles.png"] {
+        assert!(dir.path().join(f).is_file(), "{f} missing");
+    }
+}
+
+#[test]
+fn study_refuses_zero_maps_and_bad_obstacle_ranges() {
+    for json in [false, true] {
+        let mut args = vec!["study-paths", "--maps", "0"];
+        if json {
+            args.push("--json");
+        }
+        let r = run(&args).fails();
+        assert_eq!(r.error_message(), "--maps 0 must be between 1 and 100000");
+        assert!(r.stdout.is_empty(), "{}", r.stdout);
+    }
+    let r = run(&[
+        "study-paths",
+        "--maps",
+        "3",
+        "--min-obstacles",
+        "5",
+        "--max-obstacles",
+        "2",
+    ])
+    .fails();
+    assert!(
+        r.error_message()
+            .starts_with("--min-obstacles 5 and --max-obstacles 2"),
+        "{}",
+        r.stderr
+    );
+    let r = run(&["study-paths", "--maps", "3", "--max-obstacles", "61"]).fails();
+    assert!(
+        r.error_message().contains("--max-obstacles 61"),
+        "{}",
+        r.stderr
+    );
+}
+
+// `demo` plans six scenarios and a 100-map study: about 3–4 s in release,
+// roughly 10 s in the test profile (opt-level 1, dependencies at 2).
+#[test]
+fn demo_writes_index_and_summary() {
+    let dir = TempDir::new("demo");
+    let out = dir.path().join("report");
+    let r = run_with_timeout(
+        &["demo".as_ref(), "--out".as_ref(), out.as_os_str()],
+        std::time::Duration::from_secs(120),
+    )
+    .ok();
+    assert!(
+        r.stdout
+            .contains(&format!("report: {}", out.join("index.html").display())),
+        "{}",
+        r.stdout
+    );
+    let index = std::fs::read_to_string(out.join("index.html")).expect("index.html");
+    assert!(
+        index.contains("plan-path curve improved-apf"),
+        "index.html should have the curve section"
+    );
+    assert!(
+        index.contains("study-paths"),
+        "index.html should have the study section"
+    );
+    let text = std::fs::read_to_string(out.join("summary.json")).expect("summary.json");
+    assert!(
+        text.contains("plan-path curve improved-apf"),
+        "summary.json should mention `plan-path curve improved-apf`"
+    );
+    let s = parse_one_json(&text).expect("summary.json is JSON");
+    assert_eq!(s["job"], "demo");
+    let jobs = s["jobs"].as_object().expect("jobs object");
+    let mut keys: Vec<&str> = jobs.keys().map(|k| k.as_str()).collect();
+    keys.sort();
+    assert_eq!(
+        keys,
+        [
+            "plan-path curve apf",
+            "plan-path curve improved-apf",
+            "plan-path curve-reverse improved-apf",
+            "plan-path straight improved-apf",
+            "plan-path v-shape apf",
+            "plan-path v-shape improved-apf",
+            "study-paths"
+        ]
+    );
+    assert_eq!(jobs["plan-path curve improved-apf"]["success"], true);
+    assert_eq!(jobs["plan-path curve apf"]["success"], false);
+    assert_eq!(jobs["plan-path curve apf"]["local_minimum"], true);
+    assert_eq!(jobs["study-paths"]["maps"], 100);
+    // Each job's plots are where the index links them.
+    for sub in [
+        "plan-path-curve-improved-apf/path.png",
+        "plan-path-curve-improved-apf/profile.svg",
+        "study-paths/maps.csv",
+    ] {
+        assert!(out.join(sub).is_file(), "{sub} missing");
+        assert!(index.contains(sub), "index.html should link {sub}");
+    }
+}
+
+/// The time-limit helper itself: a run that outlives its limit is killed and
+/// fails the test (so a hang in any other test cannot go unnoticed).
+#[test]
+#[should_panic(expected = "did not finish within")]
+fn timeout_helper_kills_a_slow_run() {
+    run_with_timeout(
+        &["study-paths", "--maps", "100000", "--json"],
+        std::time::Duration::from_millis(200),
+    );
+}

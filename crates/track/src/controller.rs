@@ -1,0 +1,176 @@
+//! The tracker seam: a controller turns the deviations of eqs. 21–22 into the
+//! speed difference between the right and left track motors.
+//!
+//! Sign convention (SPEC §3): deviations are positive left of the path, and
+//! every controller returns `steer_rpm` = n_right − n_left, positive turning
+//! the machine left (counter-clockwise). Turning the body turns the direction
+//! of motion the same way whether the machine goes forward or in reverse, so
+//! no controller needs a special case for reverse legs: the geometry already
+//! measures "left" and "ahead" in the direction of motion.
+
+use autoshovel_core::Pose2;
+
+use crate::geometry::{Deviations, RefLeg};
+use crate::plant::CrawlerParams;
+
+/// What a controller sees at one control tick.
+#[derive(Debug, Clone, Copy)]
+pub struct ControlInput<'a> {
+    /// The leg being tracked.
+    pub leg: &'a RefLeg,
+    /// Measured pose (RTK, converted to the library's frame).
+    pub pose: Pose2,
+    /// Deviations at this pose.
+    pub dev: &'a Deviations,
+    /// Reference centroid speed, signed (negative in reverse) [m/s].
+    pub speed_mps: f64,
+    /// Time since the previous tick [s].
+    pub dt_s: f64,
+    /// The machine.
+    pub crawler: &'a CrawlerParams,
+}
+
+/// A trajectory-tracking controller.
+pub trait Controller {
+    /// Short name (`fuzzy`, `pid`, `pure-pursuit`).
+    fn name(&self) -> &'static str;
+    /// Forgets internal state (between legs, after a stop).
+    fn reset(&mut self);
+    /// Speed difference n_right − n_left [rpm]; positive turns left.
+    fn step(&mut self, input: &ControlInput) -> f64;
+}
+
+/// PID on the lateral error e = d + α·d0 (eq. 23), the paper's baseline of
+/// §5.4 (kp 800, ki 100, kd 300), with anti-windup by clamping the integral
+/// term and not integrating while the output saturates.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PidParams {
+    /// Proportional gain [rpm/m].
+    pub kp: f64,
+    /// Integral gain [rpm/(m·s)].
+    pub ki: f64,
+    /// Derivative gain [rpm·s/m].
+    pub kd: f64,
+    /// Weight α of the centroid deviation in e (eq. 23).
+    pub alpha: f64,
+    /// Output limit [rpm].
+    pub max_steer_rpm: f64,
+}
+
+impl Default for PidParams {
+    fn default() -> Self {
+        Self {
+            kp: 800.0,
+            ki: 100.0,
+            kd: 300.0,
+            alpha: 0.5,
+            max_steer_rpm: 2700.0,
+        }
+    }
+}
+
+/// The PID tracker.
+#[derive(Debug, Clone)]
+pub struct Pid {
+    /// Parameters.
+    pub params: PidParams,
+    integral: f64,
+    prev_e: Option<f64>,
+}
+
+impl Pid {
+    /// A PID tracker at rest.
+    pub fn new(params: PidParams) -> Self {
+        Self {
+            params,
+            integral: 0.0,
+            prev_e: None,
+        }
+    }
+}
+
+impl Controller for Pid {
+    fn name(&self) -> &'static str {
+        "pid"
+    }
+
+    fn reset(&mut self) {
+        self.integral = 0.0;
+        self.prev_e = None;
+    }
+
+    fn step(&mut self, input: &ControlInput) -> f64 {
+        let p = self.params;
+        let e = input.dev.d_m + p.alpha * input.dev.d0_m;
+        let de = match self.prev_e {
+            Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
+            _ => 0.0,
+        };
+        self.prev_e = Some(e);
+        let unsat = p.kp * e + p.ki * (self.integral + e * input.dt_s) + p.kd * de;
+        if unsat.abs() < p.max_steer_rpm && p.ki > 0.0 {
+            self.integral += e * input.dt_s;
+            let cap = 0.5 * p.max_steer_rpm / p.ki;
+            self.integral = self.integral.clamp(-cap, cap);
+        }
+        let u =
+            (p.kp * e + p.ki * self.integral + p.kd * de).clamp(-p.max_steer_rpm, p.max_steer_rpm);
+        // e > 0: left of the path → turn right → n_r < n_l.
+        -u
+    }
+}
+
+/// Pure pursuit (Coulter 1992): steer onto the circle through the machine
+/// and the path point a look-ahead distance on; in reverse, the circle is
+/// taken in the direction of motion.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PurePursuitParams {
+    /// Look-ahead at standstill [m].
+    pub lookahead_m: f64,
+    /// Look-ahead growth with speed [s].
+    pub lookahead_gain_s: f64,
+    /// Output limit [rpm].
+    pub max_steer_rpm: f64,
+}
+
+impl Default for PurePursuitParams {
+    fn default() -> Self {
+        Self {
+            lookahead_m: 1.5,
+            lookahead_gain_s: 1.0,
+            max_steer_rpm: 2700.0,
+        }
+    }
+}
+
+/// The pure-pursuit tracker.
+#[derive(Debug, Clone)]
+pub struct PurePursuit {
+    /// Parameters.
+    pub params: PurePursuitParams,
+}
+
+impl Controller for PurePursuit {
+    fn name(&self) -> &'static str {
+        "pure-pursuit"
+    }
+
+    fn reset(&mut self) {}
+
+    fn step(&mut self, input: &ControlInput) -> f64 {
+        let p = self.params;
+        let ld = p.lookahead_m + p.lookahead_gain_s * input.speed_mps.abs();
+        let (target, _) = input.leg.point_at(input.dev.s_a_m + ld);
+        let motion = input.leg.direction.motion_heading(input.pose.theta);
+        let rel = target - input.pose.position();
+        let (c, s) = (motion.cos(), motion.sin());
+        let y_left = -s * rel.x + c * rel.y;
+        let dist2 = rel.norm_squared().max(1e-6);
+        let curvature = 2.0 * y_left / dist2;
+        let omega = curvature * input.speed_mps.abs();
+        let dv = omega * input.crawler.gauge_m;
+        (dv / input.crawler.mps_per_rpm()).clamp(-p.max_steer_rpm, p.max_steer_rpm)
+    }
+}

@@ -1,0 +1,400 @@
+//! The closed loop (SPEC §3): planner path → controller at the RTK rate →
+//! crawler plant at a finer fixed step, leg by leg. Each leg runs a speed
+//! profile that ramps up, cruises and ramps down to a stop at its end; at a
+//! cusp (V-shape) the machine comes to rest before the next leg starts the
+//! other way. Safety in the loop: a pose older than `pose_timeout_s` or a
+//! jump no machine can make commands both tracks to zero and is logged.
+//!
+//! Metrics are measured on the *true* state (not the noisy fixes): centroid
+//! deviation from the path, convergence distance, final position and heading error.
+
+use autoshovel_core::{angle_diff, Pose2};
+use serde::{Deserialize, Serialize};
+
+use crate::controller::{ControlInput, Controller};
+use crate::geometry::{deviations, RefLeg};
+use crate::plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
+use crate::sensor::{Rtk, RtkParams};
+
+/// Closed-loop settings.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SimParams {
+    /// Plant integration step [s].
+    pub plant_dt_s: f64,
+    /// Cruise centroid speed [m/s].
+    pub speed_mps: f64,
+    /// Acceleration and braking of the speed profile [m/s²].
+    pub accel_mps2: f64,
+    /// Slowest speed before the end of a leg [m/s].
+    pub creep_mps: f64,
+    /// Preview distance L at standstill (eq. 21) [m].
+    pub preview_m: f64,
+    /// Growth of L with speed [s].
+    pub preview_gain_s: f64,
+    /// Stop when the newest fix is older than this [s].
+    pub pose_timeout_s: f64,
+    /// Largest plausible speed over ground; a fix implying more is a jump [m/s].
+    pub max_plausible_speed_mps: f64,
+    /// Give up after this much simulated time per metre of path (plus 30 s).
+    pub time_per_m_limit_s: f64,
+}
+
+impl Default for SimParams {
+    fn default() -> Self {
+        Self {
+            plant_dt_s: 0.001,
+            speed_mps: 0.5,
+            accel_mps2: 0.5,
+            creep_mps: 0.05,
+            preview_m: 0.6,
+            preview_gain_s: 0.6,
+            pose_timeout_s: 0.3,
+            max_plausible_speed_mps: 5.0,
+            time_per_m_limit_s: 20.0,
+        }
+    }
+}
+
+/// A sample of the run at one control tick.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Sample {
+    /// Time [s].
+    pub t_s: f64,
+    /// Leg index.
+    pub leg: usize,
+    /// True pose.
+    pub truth: Pose2,
+    /// Measured pose (the last fix).
+    pub measured: Pose2,
+    /// True signed centroid deviation from the path [m].
+    pub centroid_dev_m: f64,
+    /// Measured preview deviation d [m].
+    pub d_m: f64,
+    /// Measured centroid deviation d0 [m].
+    pub d0_m: f64,
+    /// Reference speed [m/s].
+    pub speed_ref_mps: f64,
+    /// Commanded steering n_r − n_l [rpm].
+    pub steer_rpm: f64,
+    /// Commanded motors.
+    pub command: TrackCommand,
+    /// Distance travelled so far [m].
+    pub travelled_m: f64,
+}
+
+/// Something the safety layer or the runner did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct Event {
+    /// Time [s].
+    pub t_s: f64,
+    /// Kind: "stale-pose", "pose-jump", "pose-recovered", "leg-end", "timeout".
+    pub kind: &'static str,
+    /// Human text.
+    pub message: String,
+}
+
+/// Measures of a run (SPEC §3, §6).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct Metrics {
+    /// Largest |centroid deviation| after convergence [m].
+    pub max_centroid_dev_m: f64,
+    /// Mean |centroid deviation| after convergence [m].
+    pub mean_centroid_dev_m: f64,
+    /// RMS centroid deviation after convergence [m].
+    pub rms_centroid_dev_m: f64,
+    /// Largest |centroid deviation| over the whole run [m].
+    pub max_centroid_dev_overall_m: f64,
+    /// Mean |centroid deviation| over the whole run [m].
+    pub mean_centroid_dev_overall_m: f64,
+    /// Travel until |deviation| < `converged_below_m` for good [m] (NaN: never).
+    pub convergence_distance_m: f64,
+    /// The convergence threshold [m].
+    pub converged_below_m: f64,
+    /// Distance of the final centroid from the path's end [m].
+    pub final_position_error_m: f64,
+    /// Final heading minus the required one [deg].
+    pub final_heading_error_deg: f64,
+    /// Distance travelled [m].
+    pub travelled_m: f64,
+    /// Simulated time [s].
+    pub duration_s: f64,
+    /// The run ended at the path's end (no safety stop, no timeout).
+    pub completed: bool,
+}
+
+/// A finished run.
+#[derive(Debug, Clone)]
+pub struct Run {
+    /// Control-tick samples.
+    pub samples: Vec<Sample>,
+    /// Safety and runner events.
+    pub events: Vec<Event>,
+    /// Measures.
+    pub metrics: Metrics,
+}
+
+/// Everything that defines one closed-loop run.
+#[derive(Debug, Clone)]
+pub struct Setup {
+    /// The legs, in order.
+    pub legs: Vec<RefLeg>,
+    /// The crawler's true start pose.
+    pub start: Pose2,
+    /// Machine.
+    pub crawler: CrawlerParams,
+    /// Ground.
+    pub slip: SlipParams,
+    /// Sensor.
+    pub rtk: RtkParams,
+    /// Loop.
+    pub sim: SimParams,
+}
+
+/// Convergence threshold: |centroid deviation| below this for good (SPEC §3) [m].
+pub const CONVERGED_BELOW_M: f64 = 0.05;
+
+/// Runs the closed loop.
+pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
+    let sp = setup.sim;
+    let mut crawler = Crawler::new(setup.crawler, setup.slip, setup.start);
+    let mut rtk = Rtk::new(setup.rtk);
+    let control_dt = rtk.period_s();
+    let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);
+    let dt = control_dt / substeps as f64;
+    let total_len: f64 = setup.legs.iter().map(RefLeg::length_m).sum();
+    let t_limit = 30.0 + sp.time_per_m_limit_s * total_len;
+    let mut samples = Vec::new();
+    let mut events = Vec::new();
+    let mut t = 0.0;
+    let mut travelled = 0.0;
+    let mut last_fix: Option<(f64, Pose2)> = None;
+    let mut stale = false;
+    let mut completed = true;
+    let k_rpm = setup.crawler.mps_per_rpm();
+    'legs: for (li, leg) in setup.legs.iter().enumerate() {
+        controller.reset();
+        let dir = leg.direction.sign();
+        let mut s_hint: Option<f64> = None;
+        let mut speed_ref = 0.0f64;
+        let mut stopping = false;
+        let mut true_hint: Option<f64> = None;
+        loop {
+            if t > t_limit {
+                events.push(Event {
+                    t_s: t,
+                    kind: "timeout",
+                    message: format!("leg {li} not finished after {t:.1} s; stopped"),
+                });
+                completed = false;
+                break 'legs;
+            }
+            // Sense.
+            let truth = crawler.state.pose;
+            if let Some(fix) = rtk.measure(truth, t) {
+                let pose = fix.to_pose();
+                if let Some((tf, prev)) = last_fix {
+                    let implied = (pose.position() - prev.position()).norm() / (t - tf).max(1e-9);
+                    if implied > sp.max_plausible_speed_mps
+                        && (pose.position() - prev.position()).norm() > 0.5
+                    {
+                        events.push(Event {
+                            t_s: t,
+                            kind: "pose-jump",
+                            message: format!(
+                                "fix jumped {:.2} m in {:.2} s ({implied:.1} m/s): tracks stopped",
+                                (pose.position() - prev.position()).norm(),
+                                t - tf
+                            ),
+                        });
+                        completed = false;
+                        stop_machine(&mut crawler, dt, &mut t);
+                        break 'legs;
+                    }
+                }
+                if stale {
+                    events.push(Event {
+                        t_s: t,
+                        kind: "pose-recovered",
+                        message: "fixes are back; resuming".into(),
+                    });
+                    stale = false;
+                }
+                last_fix = Some((t, pose));
+            }
+            let Some((tf, measured)) = last_fix else {
+                completed = false;
+                events.push(Event {
+                    t_s: t,
+                    kind: "stale-pose",
+                    message: "no fix at the start: tracks stopped".into(),
+                });
+                break 'legs;
+            };
+            let cmd;
+            let mut steer = 0.0;
+            let dev = deviations(
+                leg,
+                measured,
+                sp.preview_m + sp.preview_gain_s * speed_ref.abs(),
+                s_hint,
+            );
+            if t - tf > sp.pose_timeout_s {
+                if !stale {
+                    events.push(Event {
+                        t_s: t,
+                        kind: "stale-pose",
+                        message: format!(
+                            "newest fix is {:.0} ms old (limit {:.0} ms): tracks stopped",
+                            (t - tf) * 1e3,
+                            sp.pose_timeout_s * 1e3
+                        ),
+                    });
+                    stale = true;
+                }
+                speed_ref = 0.0;
+                cmd = TrackCommand::STOP;
+            } else {
+                s_hint = Some(dev.s_a_m);
+                let remaining = leg.length_m() - dev.s_a_m;
+                if remaining <= 0.02 || stopping {
+                    stopping = true;
+                    speed_ref = 0.0;
+                    cmd = TrackCommand::STOP;
+                } else {
+                    let brake = (2.0 * sp.accel_mps2 * remaining).sqrt().max(sp.creep_mps);
+                    let want = sp.speed_mps.min(brake);
+                    speed_ref = (speed_ref.abs() + sp.accel_mps2 * control_dt).min(want) * dir;
+                    let input = ControlInput {
+                        leg,
+                        pose: measured,
+                        dev: &dev,
+                        speed_mps: speed_ref,
+                        dt_s: control_dt,
+                        crawler: &setup.crawler,
+                    };
+                    steer = controller.step(&input);
+                    let base = speed_ref / k_rpm;
+                    cmd = TrackCommand {
+                        left_rpm: base - 0.5 * steer,
+                        right_rpm: base + 0.5 * steer,
+                    }
+                    .saturate(setup.crawler.motor_max_rpm);
+                }
+            }
+            // True deviation from the path for the metrics.
+            let true_dev = deviations(leg, truth, 0.0, true_hint);
+            true_hint = Some(true_dev.s_a_m);
+            samples.push(Sample {
+                t_s: t,
+                leg: li,
+                truth,
+                measured,
+                centroid_dev_m: true_dev.d0_m,
+                d_m: dev.d_m,
+                d0_m: dev.d0_m,
+                speed_ref_mps: speed_ref,
+                steer_rpm: steer,
+                command: cmd,
+                travelled_m: travelled,
+            });
+            if stopping && crawler.state.left_rpm.abs() < 1.0 && crawler.state.right_rpm.abs() < 1.0
+            {
+                events.push(Event {
+                    t_s: t,
+                    kind: "leg-end",
+                    message: format!("leg {li} ({}) done, machine at rest", leg.direction.name()),
+                });
+                break;
+            }
+            for _ in 0..substeps {
+                let before = crawler.state.pose.position();
+                crawler.step(cmd, dt);
+                travelled += (crawler.state.pose.position() - before).norm();
+                t += dt;
+            }
+        }
+    }
+    let metrics = measure(&samples, setup, crawler.state.pose, travelled, t, completed);
+    Run {
+        samples,
+        events,
+        metrics,
+    }
+}
+
+fn stop_machine(crawler: &mut Crawler, dt: f64, t: &mut f64) {
+    for _ in 0..100_000 {
+        if crawler.state.left_rpm.abs() < 1.0 && crawler.state.right_rpm.abs() < 1.0 {
+            break;
+        }
+        crawler.step(TrackCommand::STOP, dt);
+        *t += dt;
+    }
+}
+
+fn measure(
+    samples: &[Sample],
+    setup: &Setup,
+    end: Pose2,
+    travelled: f64,
+    t: f64,
+    completed: bool,
+) -> Metrics {
+    // Converged from the first sample after which |dev| stays below the threshold.
+    let mut conv_index = None;
+    for (i, s) in samples.iter().enumerate().rev() {
+        if s.centroid_dev_m.abs() >= CONVERGED_BELOW_M {
+            conv_index = if i + 1 < samples.len() {
+                Some(i + 1)
+            } else {
+                None
+            };
+            break;
+        }
+        conv_index = Some(i);
+    }
+    let after: &[Sample] = conv_index.map(|i| &samples[i..]).unwrap_or(&[]);
+    let stats = |xs: &[Sample]| {
+        if xs.is_empty() {
+            return (f64::NAN, f64::NAN, f64::NAN);
+        }
+        let n = xs.len() as f64;
+        let max = xs
+            .iter()
+            .map(|s| s.centroid_dev_m.abs())
+            .fold(0.0, f64::max);
+        let mean = xs.iter().map(|s| s.centroid_dev_m.abs()).sum::<f64>() / n;
+        let rms = (xs.iter().map(|s| s.centroid_dev_m.powi(2)).sum::<f64>() / n).sqrt();
+        (max, mean, rms)
+    };
+    let (max_a, mean_a, rms_a) = stats(after);
+    let (max_o, mean_o, _) = stats(samples);
+    let last = setup.legs.last();
+    let (fpe, fhe) = match last {
+        Some(leg) => {
+            let goal = *leg.points.last().expect("legs have points");
+            (
+                (end.position() - goal).norm(),
+                angle_diff(end.theta, leg.end_heading_rad).to_degrees(),
+            )
+        }
+        None => (f64::NAN, f64::NAN),
+    };
+    Metrics {
+        max_centroid_dev_m: max_a,
+        mean_centroid_dev_m: mean_a,
+        rms_centroid_dev_m: rms_a,
+        max_centroid_dev_overall_m: max_o,
+        mean_centroid_dev_overall_m: mean_o,
+        convergence_distance_m: conv_index
+            .map(|i| samples[i].travelled_m)
+            .unwrap_or(f64::NAN),
+        converged_below_m: CONVERGED_BELOW_M,
+        final_position_error_m: fpe,
+        final_heading_error_deg: fhe,
+        travelled_m: travelled,
+        duration_s: t,
+        completed,
+    }
+}
