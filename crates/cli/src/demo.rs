@@ -57,6 +57,80 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         ));
         summaries.insert(key, job.summary);
     }
+    let track_runs: [(&str, crate::track::ControllerArg, bool, &str); 6] = [
+        (
+            "fig9a",
+            crate::track::ControllerArg::Fuzzy,
+            false,
+            "Fig. 9a: path (0,0)→(30,30), start (2,−2) at 2 m/s, noise off.",
+        ),
+        (
+            "fig9b",
+            crate::track::ControllerArg::Fuzzy,
+            false,
+            "Fig. 9b: start (0,5) at 1 m/s, noise off.",
+        ),
+        (
+            "straight",
+            crate::track::ControllerArg::Fuzzy,
+            false,
+            "§5.3 straight run at 0.5 m/s with RTK noise and slip.",
+        ),
+        (
+            "curve",
+            crate::track::ControllerArg::Fuzzy,
+            false,
+            "§5.3 curve round the truck and stockpile, RTK noise and slip.",
+        ),
+        (
+            "v-shape",
+            crate::track::ControllerArg::Fuzzy,
+            false,
+            "§5.3 V-shape: reverse, stop at the cusp, forward; RTK noise and slip.",
+        ),
+        (
+            "curve",
+            crate::track::ControllerArg::Fuzzy,
+            true,
+            "Every controller on the curve run, same seed (§5.4 compares fuzzy with PID).",
+        ),
+    ];
+    for (name, ctl, compare, description) in track_runs {
+        let scenario = autoshovel_track::scenario::resolve(name, None, 1)?;
+        let key = if compare {
+            format!("track {name} --compare")
+        } else {
+            format!("track {name} fuzzy")
+        };
+        let sub = if compare {
+            format!("track-{name}-compare")
+        } else {
+            format!("track-{name}-fuzzy")
+        };
+        let dir = prepare_dir(&out.join(&sub))?;
+        let job = crate::track::job(&scenario, ctl, compare, Some(&dir))?;
+        if !json_only {
+            let s = &job.summary;
+            let g = |k: &str| s[k].as_f64().unwrap_or(f64::NAN);
+            crate::say!(
+                "{key:40} {}: max dev {:.3} m, mean {:.3} m, reached after {:.2} m, final heading error {:.2} deg",
+                if job.error.is_none() { "ok" } else { "FAILED" },
+                g("max_centroid_dev_m"),
+                g("mean_centroid_dev_m"),
+                g("reached_distance_m"),
+                g("final_heading_error_deg")
+            );
+        }
+        sections.push(section(
+            &key,
+            description,
+            &job.summary,
+            &sub,
+            &job.written.plots,
+            &job.written.files,
+        ));
+        summaries.insert(key, job.summary);
+    }
     let params = StudyParams {
         maps: 100,
         ..Default::default()
@@ -99,6 +173,7 @@ fn section(
     if let Some(o) = s.as_object_mut() {
         o.remove("params");
         o.remove("files");
+        o.remove("events");
     }
     Section {
         title: title.to_string(),

@@ -16,6 +16,7 @@ mod output;
 mod plan_path;
 mod plots;
 mod study;
+mod track;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -34,6 +35,8 @@ struct Cli {
 enum Command {
     /// Plan the crawler's walk to the next face with a potential field (SPEC §2).
     PlanPath(plan_path::Args),
+    /// Drive the crawler along a path: fuzzy, PID or pure-pursuit tracking in the simulator (SPEC §3).
+    Track(track::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
     /// Print a built-in scenario as TOML, to copy and edit.
@@ -75,6 +78,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),
+        Command::Track(args) => track::run(&args),
         Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
             .iter()
             .find(|(n, _)| *n == name)

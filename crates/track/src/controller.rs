@@ -162,7 +162,15 @@ impl Controller for PurePursuit {
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
         let ld = p.lookahead_m + p.lookahead_gain_s * input.speed_mps.abs();
-        let (target, _) = input.leg.point_at(input.dev.s_a_m + ld);
+        // Past the end the look-ahead point runs on along the last tangent, so
+        // the machine is not pulled round onto the end point as it arrives.
+        let s_target = input.dev.s_a_m + ld;
+        let (end_point, end_tangent) = input.leg.point_at(input.leg.length_m());
+        let target = if s_target > input.leg.length_m() {
+            end_point + end_tangent * (s_target - input.leg.length_m())
+        } else {
+            input.leg.point_at(s_target).0
+        };
         let motion = input.leg.direction.motion_heading(input.pose.theta);
         let rel = target - input.pose.position();
         let (c, s) = (motion.cos(), motion.sin());

@@ -8,12 +8,15 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod controller;
+pub mod fuzzy_tracker;
 pub mod geometry;
 pub mod plant;
+pub mod scenario;
 pub mod sensor;
 pub mod sim;
 
 pub use controller::{ControlInput, Controller, Pid, PidParams, PurePursuit, PurePursuitParams};
+pub use fuzzy_tracker::{FuzzyParams, FuzzyTracker};
 pub use geometry::{deviations, Deviations, RefLeg};
 pub use plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
 pub use sensor::{Rtk, RtkFix, RtkParams};

@@ -47,8 +47,8 @@ impl Default for SimParams {
             speed_mps: 0.5,
             accel_mps2: 0.5,
             creep_mps: 0.05,
-            preview_m: 0.6,
-            preview_gain_s: 0.6,
+            preview_m: 0.16,
+            preview_gain_s: 0.66,
             pose_timeout_s: 0.3,
             max_plausible_speed_mps: 5.0,
             time_per_m_limit_s: 20.0,
@@ -69,6 +69,8 @@ pub struct Sample {
     pub measured: Pose2,
     /// True signed centroid deviation from the path [m].
     pub centroid_dev_m: f64,
+    /// True heading of motion minus the path's tangent [rad].
+    pub heading_error_rad: f64,
     /// Measured preview deviation d [m].
     pub d_m: f64,
     /// Measured centroid deviation d0 [m].
@@ -97,12 +99,17 @@ pub struct Event {
 /// Measures of a run (SPEC §3, §6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Metrics {
-    /// Largest |centroid deviation| after convergence [m].
+    /// Largest |centroid deviation| once the machine has reached the path
+    /// (first |deviation| < `converged_below_m`) [m].
     pub max_centroid_dev_m: f64,
-    /// Mean |centroid deviation| after convergence [m].
+    /// Mean |centroid deviation| once on the path [m].
     pub mean_centroid_dev_m: f64,
-    /// RMS centroid deviation after convergence [m].
+    /// RMS centroid deviation once on the path [m].
     pub rms_centroid_dev_m: f64,
+    /// Travel until |deviation| < `converged_below_m` for the first time [m] (NaN: never).
+    pub reached_distance_m: f64,
+    /// Travel until |deviation| < 1 cm for good [m] (NaN: never).
+    pub settled_1cm_distance_m: f64,
     /// Largest |centroid deviation| over the whole run [m].
     pub max_centroid_dev_overall_m: f64,
     /// Mean |centroid deviation| over the whole run [m].
@@ -291,6 +298,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
                 truth,
                 measured,
                 centroid_dev_m: true_dev.d0_m,
+                heading_error_rad: true_dev.heading_error_rad,
                 d_m: dev.d_m,
                 d0_m: dev.d0_m,
                 speed_ref_mps: speed_ref,
@@ -341,20 +349,24 @@ fn measure(
     t: f64,
     completed: bool,
 ) -> Metrics {
-    // Converged from the first sample after which |dev| stays below the threshold.
-    let mut conv_index = None;
-    for (i, s) in samples.iter().enumerate().rev() {
-        if s.centroid_dev_m.abs() >= CONVERGED_BELOW_M {
-            conv_index = if i + 1 < samples.len() {
-                Some(i + 1)
-            } else {
-                None
-            };
-            break;
+    // From the first sample after which |dev| stays below `threshold`.
+    let for_good = |threshold: f64| -> Option<usize> {
+        match samples
+            .iter()
+            .rposition(|s| s.centroid_dev_m.abs() >= threshold)
+        {
+            None if samples.is_empty() => None,
+            None => Some(0),
+            Some(i) if i + 1 < samples.len() => Some(i + 1),
+            Some(_) => None,
         }
-        conv_index = Some(i);
-    }
-    let after: &[Sample] = conv_index.map(|i| &samples[i..]).unwrap_or(&[]);
+    };
+    let conv_index = for_good(CONVERGED_BELOW_M);
+    let settled_index = for_good(0.01);
+    let reached_index = samples
+        .iter()
+        .position(|s| s.centroid_dev_m.abs() < CONVERGED_BELOW_M);
+    let after: &[Sample] = reached_index.map(|i| &samples[i..]).unwrap_or(&[]);
     let stats = |xs: &[Sample]| {
         if xs.is_empty() {
             return (f64::NAN, f64::NAN, f64::NAN);
@@ -370,6 +382,7 @@ fn measure(
     };
     let (max_a, mean_a, rms_a) = stats(after);
     let (max_o, mean_o, _) = stats(samples);
+    let at = |i: Option<usize>| i.map(|i| samples[i].travelled_m).unwrap_or(f64::NAN);
     let last = setup.legs.last();
     let (fpe, fhe) = match last {
         Some(leg) => {
@@ -387,9 +400,9 @@ fn measure(
         rms_centroid_dev_m: rms_a,
         max_centroid_dev_overall_m: max_o,
         mean_centroid_dev_overall_m: mean_o,
-        convergence_distance_m: conv_index
-            .map(|i| samples[i].travelled_m)
-            .unwrap_or(f64::NAN),
+        convergence_distance_m: at(conv_index),
+        reached_distance_m: at(reached_index),
+        settled_1cm_distance_m: at(settled_index),
         converged_below_m: CONVERGED_BELOW_M,
         final_position_error_m: fpe,
         final_heading_error_deg: fhe,
