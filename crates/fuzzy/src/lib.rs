@@ -17,7 +17,7 @@
 //! let y = Variable::evenly_spaced_triangles("y", -10.0, 10.0, &names)?;
 //! let mut rules = RuleBase::new();
 //! for t in names {
-//!     rules.add(&[x.clone()], &y, &[t], t, 1.0)?;
+//!     rules.add(std::slice::from_ref(&x), &y, &[t], t, 1.0)?;
 //! }
 //! let sys = MamdaniSystem::new(vec![x], y, rules)?;
 //! assert!(sys.infer(&[0.0])?.abs() < 1e-9);

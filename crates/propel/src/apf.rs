@@ -117,7 +117,7 @@ impl ApfParams {
             k_rep: 0.7,
             rho0_m: 2.0,
             n: 2.0,
-            mu: 0.7,
+            mu: 0.85,
             rho_t_m: 5.0,
             step_m: 0.1,
             goal_tolerance_m: 0.15,

@@ -60,6 +60,26 @@ pub fn decimate(raw: &[Vec2], spacing_m: f64, keep: usize) -> Vec<Vec2> {
             out.push(raw[i]);
         }
     }
+    // The clamped spline leaves along its last control leg: make that leg the
+    // descent's own final approach (the raw point about a fifth of the
+    // spacing before the goal), not a chord of the last metre's curve.
+    let n = out.len();
+    if n >= 3 && raw.len() >= 3 {
+        let goal = raw[raw.len() - 1];
+        let near = 0.2 * spacing_m;
+        if (out[n - 1] - out[n - 2]).norm() > 1.5 * near {
+            if let Some(q) = raw
+                .iter()
+                .rev()
+                .skip(1)
+                .find(|q| (**q - goal).norm() >= near)
+            {
+                if (q - out[n - 2]).norm() > 1e-9 {
+                    out.insert(n - 1, *q);
+                }
+            }
+        }
+    }
     out
 }
 
@@ -100,10 +120,36 @@ mod tests {
     }
 
     #[test]
+    fn the_end_tangent_is_the_descents_final_approach() {
+        // A quarter circle of radius 5 from (0, 0) heading +x to (5, 5) heading +y: the chord of
+        // its last metre is ~6° off, the final approach is not.
+        let raw: Vec<Vec2> = (0..=80)
+            .map(|i| {
+                let a = std::f64::consts::FRAC_PI_2 * i as f64 / 80.0;
+                Vec2::new(5.0 * a.sin(), 5.0 - 5.0 * a.cos())
+            })
+            .collect();
+        let s = smooth(&raw, 1.0, 0.1, 0);
+        let t = s.last().unwrap().tangent;
+        let err = t.y.atan2(t.x).to_degrees() - 90.0;
+        assert!(err.abs() < 2.5, "end tangent {err} deg off");
+    }
+
+    #[test]
     fn zigzag_is_smoothed_towards_its_mean_line() {
-        // A descent oscillating ±5 cm about y = 0 becomes (nearly) straight.
+        // A descent oscillating ±5 cm about y = 0 (settling onto it for the
+        // last half metre, as a descent does at its goal) becomes (nearly) straight.
         let raw: Vec<Vec2> = (0..=200)
-            .map(|i| Vec2::new(0.1 * i as f64, if i % 2 == 0 { 0.05 } else { -0.05 }))
+            .map(|i| {
+                let y = if i > 195 {
+                    0.0
+                } else if i % 2 == 0 {
+                    0.05
+                } else {
+                    -0.05
+                };
+                Vec2::new(0.1 * i as f64, y)
+            })
             .collect();
         let s = smooth(&raw, 1.0, 0.1, 0);
         let max_dev = s.iter().map(|c| c.point.y.abs()).fold(0.0, f64::max);

@@ -60,17 +60,22 @@ pub struct FuzzyParams {
     pub k2: f64,
     /// Scaling factor k3 of u (eq. 24): u = k3·u_f.
     pub k3: f64,
+    /// Time constant of the first-order low-pass on ec [s] (0 = none): the
+    /// rate of a centimetre-noisy RTK error at 10 Hz is mostly noise.
+    pub ec_filter_s: f64,
 }
 
 impl Default for FuzzyParams {
     fn default() -> Self {
         // Tuned by a seeded random search on fig9a/b (noise off) and the
-        // straight / curve / V-shape runs with RTK noise (seed 1); see docs/track.md.
+        // straight / curve / V-shape runs with RTK noise (seeds 11–13; the tests
+        // check seeds 1–6); see docs/track.md.
         Self {
             alpha: 0.36,
             k1: 2.5,
             k2: 25.5,
             k3: 0.94,
+            ec_filter_s: 0.3,
         }
     }
 }
@@ -83,6 +88,7 @@ pub struct FuzzyTracker {
     system: MamdaniSystem,
     scratch: Scratch,
     prev_e: Option<f64>,
+    ec_filtered: f64,
     /// Last inputs fed to the rule base (e_f, ec_f) and its output u_f.
     pub last: (f64, f64, f64),
 }
@@ -97,6 +103,7 @@ impl FuzzyTracker {
             system,
             scratch,
             prev_e: None,
+            ec_filtered: 0.0,
             last: (0.0, 0.0, 0.0),
         }
     }
@@ -114,16 +121,24 @@ impl Controller for FuzzyTracker {
 
     fn reset(&mut self) {
         self.prev_e = None;
+        self.ec_filtered = 0.0;
     }
 
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
         let e = input.dev.d_m + p.alpha * input.dev.d0_m;
-        let ec = match self.prev_e {
+        let raw = match self.prev_e {
             Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
             _ => 0.0,
         };
         self.prev_e = Some(e);
+        let a = if p.ec_filter_s > 0.0 {
+            input.dt_s / (p.ec_filter_s + input.dt_s)
+        } else {
+            1.0
+        };
+        self.ec_filtered += a * (raw - self.ec_filtered);
+        let ec = self.ec_filtered;
         let x = [p.k1 * e, p.k2 * ec];
         let u_f = if x.iter().all(|v| v.is_finite()) {
             self.system.infer_with(&x, &mut self.scratch).unwrap_or(0.0)
@@ -143,10 +158,10 @@ mod tests {
     #[test]
     fn table1_steers_back_towards_the_path() {
         let s = table1_system().unwrap();
-        // Large positive e (left of the path), ec = ZE → PM: positive u, and the
-        // tracker turns right (negative n_r − n_l).
-        let u = s.infer(&[0.3, 0.0]).unwrap();
-        assert!(u > 1000.0, "{u}");
+        // Large positive e (PB, left of the path), ec = ZE → PM: u at PM's peak,
+        // and the tracker turns right (negative n_r − n_l).
+        let u = s.infer(&[0.45, 0.0]).unwrap();
+        assert_relative_eq!(u, 1800.0, epsilon = 60.0);
         assert_relative_eq!(s.infer(&[0.0, 0.0]).unwrap(), 0.0, epsilon = 1e-9);
         // Odd symmetry of the table.
         assert_relative_eq!(

@@ -175,7 +175,14 @@ pub fn deviations(leg: &RefLeg, pose: Pose2, preview_m: f64, s_hint: Option<f64>
         None => (f64::NEG_INFINITY, f64::INFINITY),
     };
     let (a, s_a, t_a) = leg.nearest(o, lo, hi);
-    let (b, _, _) = leg.nearest(c, s_a - SEARCH_BACK_M, s_a + preview_m + SEARCH_AHEAD_M);
+    let (mut b, s_b, _) = leg.nearest(c, s_a - SEARCH_BACK_M, s_a + preview_m + SEARCH_AHEAD_M);
+    // Near the end the preview point runs past the path: measure it against
+    // the path continued along its last tangent, not against the end point,
+    // so the machine arrives aligned with the last segment.
+    if s_b >= leg.length_m() - 1e-9 {
+        let (end, t_end) = leg.point_at(leg.length_m());
+        b = end + t_end * (c - end).dot(&t_end).max(0.0);
+    }
     let d0 = cross(t_a, o - a).signum() * (o - a).norm();
     let ab = b - a;
     let d = if ab.norm() > 1e-9 {

@@ -420,6 +420,12 @@ pub fn validate(setup: &Setup) -> Result<(), String> {
             return Err(format!("[sim] {k} = {v} must be zero or positive"));
         }
     }
+    if !(s.control_rate_hz.is_finite() && s.control_rate_hz > 0.0 && s.control_rate_hz <= 1000.0) {
+        return Err(format!(
+            "[sim] control_rate_hz = {} must be in (0, 1000]",
+            s.control_rate_hz
+        ));
+    }
     if s.plant_dt_s > 0.1 {
         return Err(format!(
             "[sim] plant_dt_s = {} is too coarse (at most 0.1 s)",

@@ -119,6 +119,7 @@ pub struct Rtk {
     pub params: RtkParams,
     rng: ChaCha8Rng,
     dropout_until_s: f64,
+    next_fix_s: f64,
 }
 
 impl Rtk {
@@ -128,6 +129,7 @@ impl Rtk {
             params,
             rng: ChaCha8Rng::seed_from_u64(params.seed),
             dropout_until_s: f64::NEG_INFINITY,
+            next_fix_s: 0.0,
         }
     }
 
@@ -143,6 +145,19 @@ impl Rtk {
         let n = Normal::new(0.0, sigma).expect("sigma is positive and finite");
         let v: f64 = n.sample(&mut self.rng);
         v.clamp(-3.0 * sigma, 3.0 * sigma)
+    }
+
+    /// Called by a control loop at any rate: a fix when one is due at
+    /// `time_s` (every 1/rate seconds) and not in a dropout, else `None`.
+    pub fn poll(&mut self, truth: Pose2, time_s: f64) -> Option<RtkFix> {
+        if time_s + 1e-9 < self.next_fix_s {
+            return None;
+        }
+        let period = self.period_s();
+        while self.next_fix_s <= time_s + 1e-9 {
+            self.next_fix_s += period;
+        }
+        self.measure(truth, time_s)
     }
 
     /// Measures the true crawler pose at `time_s`; `None` during a dropout.

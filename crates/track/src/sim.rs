@@ -22,6 +22,8 @@ use crate::sensor::{Rtk, RtkParams};
 pub struct SimParams {
     /// Plant integration step [s].
     pub plant_dt_s: f64,
+    /// Control loop rate [Hz] (the RTK delivers fixes at its own rate).
+    pub control_rate_hz: f64,
     /// Cruise centroid speed [m/s].
     pub speed_mps: f64,
     /// Acceleration and braking of the speed profile [m/s²].
@@ -32,6 +34,13 @@ pub struct SimParams {
     pub preview_m: f64,
     /// Growth of L with speed [s].
     pub preview_gain_s: f64,
+    /// Within `terminal_zone_m` of a leg's end, L is at least this [m]: the
+    /// preview then runs onto the path's continued last tangent, so the
+    /// machine lines up with it as it stops (at creep speed L would shrink
+    /// to where centimetre RTK noise hides the heading).
+    pub terminal_preview_m: f64,
+    /// See `terminal_preview_m` [m].
+    pub terminal_zone_m: f64,
     /// Stop when the newest fix is older than this [s].
     pub pose_timeout_s: f64,
     /// Largest plausible speed over ground; a fix implying more is a jump [m/s].
@@ -44,11 +53,14 @@ impl Default for SimParams {
     fn default() -> Self {
         Self {
             plant_dt_s: 0.001,
+            control_rate_hz: 10.0,
             speed_mps: 0.5,
             accel_mps2: 0.5,
             creep_mps: 0.05,
             preview_m: 0.16,
             preview_gain_s: 0.66,
+            terminal_preview_m: 1.0,
+            terminal_zone_m: 2.0,
             pose_timeout_s: 0.3,
             max_plausible_speed_mps: 5.0,
             time_per_m_limit_s: 20.0,
@@ -166,7 +178,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
     let sp = setup.sim;
     let mut crawler = Crawler::new(setup.crawler, setup.slip, setup.start);
     let mut rtk = Rtk::new(setup.rtk);
-    let control_dt = rtk.period_s();
+    let control_dt = 1.0 / sp.control_rate_hz;
     let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);
     let dt = control_dt / substeps as f64;
     let total_len: f64 = setup.legs.iter().map(RefLeg::length_m).sum();
@@ -198,7 +210,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
             }
             // Sense.
             let truth = crawler.state.pose;
-            if let Some(fix) = rtk.measure(truth, t) {
+            if let Some(fix) = rtk.poll(truth, t) {
                 let pose = fix.to_pose();
                 if let Some((tf, prev)) = last_fix {
                     let implied = (pose.position() - prev.position()).norm() / (t - tf).max(1e-9);
@@ -240,12 +252,12 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
             };
             let cmd;
             let mut steer = 0.0;
-            let dev = deviations(
-                leg,
-                measured,
-                sp.preview_m + sp.preview_gain_s * speed_ref.abs(),
-                s_hint,
-            );
+            let remaining_hint = s_hint.map(|h| leg.length_m() - h).unwrap_or(f64::INFINITY);
+            let mut preview = sp.preview_m + sp.preview_gain_s * speed_ref.abs();
+            if remaining_hint <= sp.terminal_zone_m {
+                preview = preview.max(sp.terminal_preview_m);
+            }
+            let dev = deviations(leg, measured, preview, s_hint);
             if t - tf > sp.pose_timeout_s {
                 if !stale {
                     events.push(Event {
