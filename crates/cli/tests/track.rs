@@ -1,0 +1,165 @@
+//! `autoshovel track`: the paper's cases, the comparison, the outputs and bad input.
+
+mod common;
+
+use common::*;
+
+fn track_file(body: &str) -> (TempDir, std::path::PathBuf) {
+    let dir = TempDir::new("track");
+    let path = dir.write("run.toml", body);
+    (dir, path)
+}
+
+const GOOD: &str = "name = \"mine\"\nspeed_mps = 0.5\nnoise = \"rtk\"\n[start]\nx_m = 0.0\ny_m = 0.3\nheading_deg = 0.0\n[[leg]]\ndirection = \"forward\"\npoints_m = [[0.0, 0.0], [10.0, 0.0], [20.0, 3.0]]\n";
+
+#[test]
+fn fig9_cases_meet_the_paper() {
+    for name in ["fig9a", "fig9b"] {
+        let s = run(&["track", "--scenario", name, "--json"]).ok().json();
+        for key in [
+            "max_centroid_dev_m",
+            "mean_centroid_dev_m",
+            "convergence_distance_m",
+            "final_heading_error_deg",
+            "final_position_error_m",
+        ] {
+            assert!(s[key].is_number(), "{name}: {key} missing: {s:#}");
+        }
+        assert!(f64_field(&s, "reached_distance_m") <= 5.0, "{name}: {s:#}");
+        assert_eq!(s["noise"], "off");
+        assert!(f64_field(&s, "realtime_factor") > 1000.0);
+    }
+}
+
+#[test]
+fn compare_runs_every_controller_on_the_same_seed_and_writes_the_table() {
+    let dir = TempDir::new("compare");
+    let out = dir.path().join("out");
+    let s = run(&[
+        "track".as_ref(),
+        "--scenario".as_ref(),
+        "straight".as_ref(),
+        "--compare".as_ref(),
+        "--json".as_ref(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
+    .ok()
+    .json();
+    let rows = s["compare"].as_array().expect("compare rows");
+    let names: Vec<&str> = rows
+        .iter()
+        .map(|r| r["controller"].as_str().unwrap())
+        .collect();
+    assert_eq!(names, ["fuzzy", "pid", "pure-pursuit"]);
+    for f in [
+        "summary.json",
+        "compare.csv",
+        "track_fuzzy.csv",
+        "track_pid.csv",
+        "track_pure-pursuit.csv",
+        "track_path.svg",
+        "track_path.png",
+        "track_deviation_heading.svg",
+        "fuzzy_surface.csv",
+        "fuzzy_surface.svg",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
+    assert_eq!(csv.lines().count(), 4, "{csv}");
+    // Same seed, same fuzzy numbers as a run on its own.
+    let alone = run(&["track", "--scenario", "straight", "--json"])
+        .ok()
+        .json();
+    assert_eq!(alone["max_centroid_dev_m"], rows[0]["max_centroid_dev_m"]);
+}
+
+#[test]
+fn a_users_tracking_file_and_a_plan_path_file_both_run() {
+    let (_d, p) = track_file(GOOD);
+    let s = run(&[
+        "track".as_ref(),
+        "--scenario".as_ref(),
+        p.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(s["scenario"], "mine");
+    assert_eq!(s["noise"], "rtk");
+    assert!(f64_field(&s, "max_centroid_dev_m") < 0.3);
+    let dir = TempDir::new("travel");
+    let travel = dir.write("road.toml", builtin_text("curve"));
+    let s = run(&[
+        "track".as_ref(),
+        "--scenario".as_ref(),
+        travel.as_os_str(),
+        "--controller".as_ref(),
+        "pid".as_ref(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(s["controller"], "pid");
+}
+
+#[test]
+fn bad_tracking_input_is_refused_clearly() {
+    let cases: [(&str, String, &str); 7] = [
+        (
+            "one point",
+            GOOD.replace("[[0.0, 0.0], [10.0, 0.0], [20.0, 3.0]]", "[[0.0, 0.0]]"),
+            "needs at least 2",
+        ),
+        (
+            "repeated",
+            GOOD.replace(
+                "[[0.0, 0.0], [10.0, 0.0], [20.0, 3.0]]",
+                "[[0.0, 0.0], [10.0, 0.0], [10.0, 0.0]]",
+            ),
+            "repeats point",
+        ),
+        (
+            "far start",
+            GOOD.replace("y_m = 0.3", "y_m = 300.0"),
+            "from the first leg",
+        ),
+        (
+            "nan",
+            GOOD.replace("y_m = 0.3", "y_m = nan"),
+            "not a finite number",
+        ),
+        (
+            "zero gauge",
+            format!("{GOOD}[crawler]\ngauge_m = 0.0\n"),
+            "gauge_m = 0",
+        ),
+        (
+            "negative limit",
+            format!("{GOOD}[crawler]\nmotor_max_rpm = -5.0\n"),
+            "motor_max_rpm = -5",
+        ),
+        (
+            "too fast",
+            GOOD.replace("speed_mps = 0.5", "speed_mps = 9.0"),
+            "speed limit",
+        ),
+    ];
+    for (what, text, expect) in cases {
+        let (_d, p) = track_file(&text);
+        let r = run(&["track".as_ref(), "--scenario".as_ref(), p.as_os_str()]).fails();
+        assert!(
+            r.error_message().contains(expect),
+            "{what}: {}",
+            r.error_message()
+        );
+        assert!(
+            r.error_message().contains("run.toml"),
+            "{what}: the file is not named: {}",
+            r.error_message()
+        );
+    }
+    let r = run(&["track", "--scenario", "nosuch"]).fails();
+    assert!(r.error_message().contains("fig9a"), "{}", r.error_message());
+}
