@@ -112,6 +112,12 @@ pub fn run(args: &Args) -> Result<()> {
     validate(&scenario.setup).map_err(|e| anyhow::anyhow!("{}: {e}", args.scenario))?;
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
     let job = job(&scenario, args.controller, args.compare, out.as_deref())?;
+    // The safety log: on stderr, so stdout stays the summary alone with --json.
+    if let Some(events) = job.summary["events"].as_array() {
+        for e in events.iter().filter(|e| e["kind"] != "leg-end") {
+            eprintln!("safety: t = {:.2} s: {} ({})", e["t_s"].as_f64().unwrap_or(f64::NAN), e["message"].as_str().unwrap_or(""), e["kind"].as_str().unwrap_or(""));
+        }
+    }
     if args.json {
         print_json(&job.summary)?;
     } else {

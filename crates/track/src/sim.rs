@@ -258,7 +258,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
                 preview = preview.max(sp.terminal_preview_m);
             }
             let dev = deviations(leg, measured, preview, s_hint);
-            if t - tf > sp.pose_timeout_s {
+            if t - tf > sp.pose_timeout_s + 1e-6 {
                 if !stale {
                     events.push(Event {
                         t_s: t,
