@@ -115,7 +115,12 @@ pub fn run(args: &Args) -> Result<()> {
     // The safety log: on stderr, so stdout stays the summary alone with --json.
     if let Some(events) = job.summary["events"].as_array() {
         for e in events.iter().filter(|e| e["kind"] != "leg-end") {
-            eprintln!("safety: t = {:.2} s: {} ({})", e["t_s"].as_f64().unwrap_or(f64::NAN), e["message"].as_str().unwrap_or(""), e["kind"].as_str().unwrap_or(""));
+            eprintln!(
+                "safety: t = {:.2} s: {} ({})",
+                e["t_s"].as_f64().unwrap_or(f64::NAN),
+                e["message"].as_str().unwrap_or(""),
+                e["kind"].as_str().unwrap_or("")
+            );
         }
     }
     if args.json {

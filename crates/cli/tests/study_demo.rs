@@ -194,11 +194,25 @@ fn demo_writes_index_and_summary() {
             "track v-shape fuzzy"
         ]
     );
-    for key in ["track fig9a fuzzy", "track fig9b fuzzy", "track straight fuzzy", "track curve fuzzy", "track v-shape fuzzy"] {
+    for key in [
+        "track fig9a fuzzy",
+        "track fig9b fuzzy",
+        "track straight fuzzy",
+        "track curve fuzzy",
+        "track v-shape fuzzy",
+    ] {
         assert_eq!(jobs[key]["success"], true, "{key}");
-        assert!(jobs[key]["max_centroid_dev_m"].as_f64().unwrap() <= 0.10, "{key}");
+        assert!(
+            jobs[key]["max_centroid_dev_m"].as_f64().unwrap() <= 0.10,
+            "{key}"
+        );
     }
-    assert_eq!(jobs["track curve --compare"]["compare"].as_array().map(|a| a.len()), Some(3));
+    assert_eq!(
+        jobs["track curve --compare"]["compare"]
+            .as_array()
+            .map(|a| a.len()),
+        Some(3)
+    );
     assert_eq!(jobs["plan-path curve improved-apf"]["success"], true);
     assert_eq!(jobs["plan-path curve apf"]["success"], false);
     assert_eq!(jobs["plan-path curve apf"]["local_minimum"], true);

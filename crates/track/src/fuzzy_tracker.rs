@@ -71,11 +71,11 @@ impl Default for FuzzyParams {
         // straight / curve / V-shape runs with RTK noise (seeds 11–13; the tests
         // check seeds 1–6); see docs/track.md.
         Self {
-            alpha: 0.36,
-            k1: 2.5,
-            k2: 25.5,
-            k3: 0.94,
-            ec_filter_s: 0.3,
+            alpha: 0.30,
+            k1: 2.42,
+            k2: 32.1,
+            k3: 1.11,
+            ec_filter_s: 0.34,
         }
     }
 }
