@@ -62,3 +62,20 @@ fn rel(base: &Path, p: &Path) -> String {
         .to_string_lossy()
         .replace('\\', "/")
 }
+
+/// Lists every file a job wrote in its summary (`files`) and writes
+/// `summary.json` into `dir`.
+pub fn write_job_summary(
+    dir: &Path,
+    summary: &mut serde_json::Value,
+    written: &mut Written,
+) -> Result<()> {
+    written.file(dir, &dir.join(autoshovel_report::SUMMARY_FILE));
+    summary["files"] = serde_json::json!(written
+        .files
+        .iter()
+        .chain(written.plots.iter())
+        .collect::<Vec<_>>());
+    autoshovel_report::write_summary(dir, summary)?;
+    Ok(())
+}

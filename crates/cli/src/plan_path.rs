@@ -8,9 +8,7 @@ use autoshovel_core::Vec2;
 use autoshovel_propel::{
     astar, plan_path, AstarParams, FieldKind, Plan, PlanOptions, PropelError, Scenario,
 };
-use autoshovel_report::{
-    write_csv, write_figure, write_panels, write_summary, Figure, Layer, Rgb, Stroke,
-};
+use autoshovel_report::{write_csv, write_figure, write_panels, Figure, Layer, Rgb, Stroke};
 use serde_json::{json, Value};
 
 use crate::output::{num, prepare_dir, print_json, Written};
@@ -192,13 +190,7 @@ pub fn job(
             reference.as_ref().map(|r| &r.1),
             &mut written,
         )?;
-        written.file(dir, &dir.join("summary.json"));
-        summary["files"] = json!(written
-            .files
-            .iter()
-            .chain(written.plots.iter())
-            .collect::<Vec<_>>());
-        write_summary(dir, &summary)?;
+        crate::output::write_job_summary(dir, &mut summary, &mut written)?;
     }
     Ok(Job {
         summary,

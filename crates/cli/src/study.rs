@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use autoshovel_propel::study::{aggregate, run_map, Aggregate, MapRow, StudyParams};
-use autoshovel_report::{write_csv_cells, write_figure, write_summary, Figure, Layer, Rgb, Stroke};
+use autoshovel_report::{write_csv_cells, write_figure, Figure, Layer, Rgb, Stroke};
 use indicatif::{ParallelProgressIterator, ProgressBar, ProgressStyle};
 use rayon::prelude::*;
 use serde_json::{json, Value};
@@ -197,13 +197,7 @@ pub fn study(
             fig.push(Layer::points(pts, color, 4));
         }
         written.plot(dir, write_figure(&fig, dir, "success_by_obstacles")?);
-        written.file(dir, &dir.join("summary.json"));
-        summary["files"] = json!(written
-            .files
-            .iter()
-            .chain(written.plots.iter())
-            .collect::<Vec<_>>());
-        write_summary(dir, &summary)?;
+        crate::output::write_job_summary(dir, &mut summary, &mut written)?;
     }
     Ok((summary, written))
 }

@@ -6,8 +6,8 @@ use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
 use autoshovel_report::{
-    write_csv, write_csv_cells, write_figure, write_heatmap, write_panels, write_summary, Figure,
-    Heatmap, Layer, Rgb, Stroke,
+    write_csv, write_csv_cells, write_figure, write_heatmap, write_panels, Figure, Heatmap, Layer,
+    Rgb, Stroke,
 };
 use autoshovel_track::scenario::{resolve, validate, Noise, TrackScenario};
 use autoshovel_track::{
@@ -253,13 +253,7 @@ pub fn job(
     let mut written = Written::default();
     if let Some(dir) = out {
         write_outputs(dir, scenario, &runs, compare, &mut written)?;
-        written.file(dir, &dir.join("summary.json"));
-        summary["files"] = json!(written
-            .files
-            .iter()
-            .chain(written.plots.iter())
-            .collect::<Vec<_>>());
-        write_summary(dir, &summary)?;
+        crate::output::write_job_summary(dir, &mut summary, &mut written)?;
     }
     let error = if main.2.metrics.completed {
         None

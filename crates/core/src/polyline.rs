@@ -35,6 +35,8 @@ pub fn menger_curvature(a: Vec2, b: Vec2, c: Vec2) -> f64 {
 }
 
 /// Nearest point to `p` on the segment `a`–`b`, with its parameter t ∈ [0, 1].
+/// (Inlined across crates: it sits in every distance query's inner loop.)
+#[inline]
 pub fn segment_nearest(p: Vec2, a: Vec2, b: Vec2) -> (Vec2, f64) {
     let ab = b - a;
     let len2 = ab.norm_squared();

@@ -8,29 +8,11 @@
 //!
 //! Run: `cargo run -p autoshovel-fuzzy --example table1_surface`
 
-use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, RuleBase, Variable};
-
-const TERMS: [&str; 7] = ["NB", "NM", "NS", "ZE", "PS", "PM", "PB"];
-
-/// Table 1: row = ec term, column = e term, cell = u term.
-const TABLE1: [[&str; 7]; 7] = [
-    ["NB", "NB", "NM", "NM", "NS", "NS", "ZE"],
-    ["NB", "NM", "NM", "NS", "NS", "ZE", "PS"],
-    ["NM", "NM", "NS", "NS", "ZE", "PS", "PS"],
-    ["NM", "NS", "NS", "ZE", "PS", "PS", "PM"],
-    ["NS", "NS", "ZE", "PS", "PS", "PM", "PM"],
-    ["NS", "ZE", "PS", "PS", "PM", "PM", "PB"],
-    ["ZE", "PS", "PS", "PM", "PM", "PB", "PB"],
-];
+use autoshovel_fuzzy::presets::shovel_table1::{self, TERMS};
+use autoshovel_fuzzy::{FuzzyError, MamdaniSystem};
 
 fn build() -> Result<MamdaniSystem, FuzzyError> {
-    let e = Variable::evenly_spaced_triangles("e", -0.45, 0.45, &TERMS)?;
-    let ec = Variable::evenly_spaced_triangles("ec", -30.0, 30.0, &TERMS)?;
-    let u = Variable::evenly_spaced_triangles("u", -2700.0, 2700.0, &TERMS)?;
-    let rows: Vec<&[&str]> = TABLE1.iter().map(|r| &r[..]).collect();
-    // Columns are the first input (e), rows the second (ec).
-    let rules = RuleBase::from_table(&e, &ec, &u, &rows)?;
-    MamdaniSystem::new(vec![e, ec], u, rules)
+    shovel_table1::system()
 }
 
 /// Rounding noise around 0 (e.g. −2e−14) printed as 0, not "−0".

@@ -36,6 +36,7 @@
 mod error;
 mod mamdani;
 mod membership;
+pub mod presets;
 mod rules;
 mod surface;
 mod variable;

@@ -6,7 +6,7 @@
 //! The machine is a disc of radius `footprint_radius_m` (at least its
 //! half-width); clearance is the distance from that disc to the nearest element.
 
-use autoshovel_core::{perp, Vec2};
+use autoshovel_core::{perp, segment_nearest, Vec2};
 
 /// The shape of one obstacle.
 #[derive(Debug, Clone, PartialEq)]
@@ -148,13 +148,7 @@ impl Shape {
                     if e.x * ap.y - e.y * ap.x < 0.0 {
                         inside = false;
                     }
-                    let len2 = e.norm_squared();
-                    let t = if len2 > 0.0 {
-                        (ap.dot(&e) / len2).clamp(0.0, 1.0)
-                    } else {
-                        0.0
-                    };
-                    let q = a + e * t;
+                    let (q, _) = segment_nearest(p, a, b);
                     let d2 = (p - q).norm_squared();
                     if d2 < best2 {
                         best2 = d2;
@@ -206,15 +200,7 @@ fn polyline_nearest(points: &[Vec2], p: Vec2) -> (f64, Vec2) {
     let mut best_seg = 0;
     for (i, w) in points.windows(2).enumerate() {
         let (a, b) = (w[0], w[1]);
-        let e = b - a;
-        let ap = p - a;
-        let len2 = e.norm_squared();
-        let t = if len2 > 0.0 {
-            (ap.dot(&e) / len2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        let q = a + e * t;
+        let (q, _) = segment_nearest(p, a, b);
         let d2 = (p - q).norm_squared();
         if d2 < best2 {
             best2 = d2;

@@ -12,40 +12,16 @@
 //! for a large positive e, which must turn the machine right, back towards the
 //! path, so the controller commands n_right − n_left = −u.
 
-use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, RuleBase, Scratch, Variable};
+use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, Scratch};
 use serde::{Deserialize, Serialize};
 
 use crate::controller::{ControlInput, Controller};
 
-/// Term names, negative big to positive big.
-pub const TERMS: [&str; 7] = ["NB", "NM", "NS", "ZE", "PS", "PM", "PB"];
-
-/// Table 1 of the paper: rows ec (NB…PB), columns e (NB…PB).
-pub const TABLE1: [[&str; 7]; 7] = [
-    ["NB", "NB", "NM", "NM", "NS", "NS", "ZE"],
-    ["NB", "NM", "NM", "NS", "NS", "ZE", "PS"],
-    ["NM", "NM", "NS", "NS", "ZE", "PS", "PS"],
-    ["NM", "NS", "NS", "ZE", "PS", "PS", "PM"],
-    ["NS", "NS", "ZE", "PS", "PS", "PM", "PM"],
-    ["NS", "ZE", "PS", "PS", "PM", "PM", "PB"],
-    ["ZE", "PS", "PS", "PM", "PM", "PB", "PB"],
-];
-
-/// Universe of e [m] (§4.3).
-pub const E_UNIVERSE: f64 = 0.45;
-/// Universe of ec (§4.3).
-pub const EC_UNIVERSE: f64 = 30.0;
-/// Universe of u [rpm] (§4.3).
-pub const U_UNIVERSE: f64 = 2700.0;
+pub use autoshovel_fuzzy::presets::shovel_table1::{TABLE1, TERMS};
 
 /// Builds the Table 1 Mamdani system (inputs [e, ec], output u).
 pub fn table1_system() -> Result<MamdaniSystem, FuzzyError> {
-    let e = Variable::evenly_spaced_triangles("e", -E_UNIVERSE, E_UNIVERSE, &TERMS)?;
-    let ec = Variable::evenly_spaced_triangles("ec", -EC_UNIVERSE, EC_UNIVERSE, &TERMS)?;
-    let u = Variable::evenly_spaced_triangles("u", -U_UNIVERSE, U_UNIVERSE, &TERMS)?;
-    let rows: Vec<&[&str]> = TABLE1.iter().map(|r| r.as_slice()).collect();
-    let rules = RuleBase::from_table(&e, &ec, &u, &rows)?;
-    MamdaniSystem::new(vec![e, ec], u, rules)
+    autoshovel_fuzzy::presets::shovel_table1::system()
 }
 
 /// Parameters of the fuzzy tracker.

@@ -10,7 +10,7 @@
 //! motion. Eq. 21 writes C with the north-clockwise RTK heading ϕ; here the
 //! pose is already in the library's frame (θ = π/2 − ϕ converted at the sensor).
 
-use autoshovel_core::{arc_lengths, heading_vec, Pose2, Vec2};
+use autoshovel_core::{arc_lengths, heading_vec, segment_nearest, Pose2, Vec2};
 use autoshovel_propel::Direction;
 
 /// One leg of a reference path, as the tracker sees it.
@@ -106,17 +106,14 @@ impl RefLeg {
                 continue;
             }
             let (a, b) = (self.points[i], self.points[i + 1]);
-            let e = b - a;
-            let len2 = e.norm_squared();
-            let t = ((p - a).dot(&e) / len2).clamp(0.0, 1.0);
-            let q = a + e * t;
+            let (q, t) = segment_nearest(p, a, b);
             let d2 = (p - q).norm_squared();
             if d2 < best_d2 {
                 best_d2 = d2;
                 best = (
                     q,
                     self.s[i] + t * (self.s[i + 1] - self.s[i]),
-                    e / len2.sqrt(),
+                    (b - a).normalize(),
                 );
             }
         }
