@@ -1,0 +1,1 @@
+//! Surfaces (being written).
