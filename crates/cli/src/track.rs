@@ -299,6 +299,11 @@ fn write_outputs(
         "north y [m]",
     )
     .equal_aspect();
+    if let Some(map) = &scenario.map {
+        for l in crate::plots::map_layers(map) {
+            fig.push(l);
+        }
+    }
     for (i, leg) in setup.legs.iter().enumerate() {
         let l = Layer::line(
             leg.points.iter().map(|p| (p.x, p.y)),

@@ -56,6 +56,8 @@ pub struct TrackScenario {
     pub setup: Setup,
     /// Noise setting it was built with.
     pub noise: Noise,
+    /// The site, when the path was planned on one (for plots).
+    pub map: Option<autoshovel_propel::Map>,
 }
 
 /// Errors of tracking scenarios.
@@ -161,6 +163,7 @@ pub fn resolve(
                 name: name_or_path.to_string(),
                 setup: with(noise, setup),
                 noise,
+                map: None,
             })
         }
         "straight" | "curve" | "v-shape" => {
@@ -171,6 +174,7 @@ pub fn resolve(
                 name: name_or_path.to_string(),
                 setup: with(noise, setup),
                 noise,
+                map: Some(travel.map),
             })
         }
         path => {
@@ -294,6 +298,7 @@ pub fn from_toml(
             name: travel.name,
             setup,
             noise,
+            map: Some(travel.map),
         });
     }
     let spec: FileSpec = toml::from_str(text).map_err(parse_err)?;
@@ -369,6 +374,7 @@ pub fn from_toml(
         name: spec.name.unwrap_or_else(|| file.to_string()),
         setup,
         noise,
+        map: None,
     })
 }
 
