@@ -16,6 +16,8 @@ pub(crate) use say;
 
 mod demo;
 mod output;
+mod perceive;
+mod pile;
 mod plan_path;
 mod plots;
 mod study;
@@ -40,6 +42,10 @@ enum Command {
     PlanPath(plan_path::Args),
     /// Drive the crawler along a path: fuzzy, PID or pure-pursuit tracking in the simulator (SPEC §3).
     Track(track::Args),
+    /// Write a synthetic LiDAR scan of a muck pile (Fig. 7 shapes) to a point-cloud file.
+    GeneratePile(pile::Args),
+    /// Level, filter and fit a muck-pile scan (rope-shovel paper §3, SPEC §4.1).
+    Perceive(perceive::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
     /// Print a built-in scenario as TOML, to copy and edit.
@@ -82,6 +88,8 @@ fn main() -> ExitCode {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),
         Command::Track(args) => track::run(&args),
+        Command::GeneratePile(args) => pile::run(&args),
+        Command::Perceive(args) => perceive::run(&args),
         Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
             .iter()
             .find(|(n, _)| *n == name)

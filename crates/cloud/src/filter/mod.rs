@@ -1,1 +1,41 @@
-//! Filters (being written).
+//! The filters of the rope-shovel paper's combined filtering process (§3.2,
+//! eqs. 13–20), with PCL's semantics where PCL has the filter, so that a
+//! cloud filtered here keeps exactly the points PCL 1.13 keeps:
+//!
+//! | step | function | paper | PCL / Open3D counterpart |
+//! |---|---|---|---|
+//! | ground removal | [`pass_through`] | §3.2, first step | `pcl::PassThrough` |
+//! | radius outlier removal | [`radius_outlier_removal`] | eq. 13 | `pcl::RadiusOutlierRemoval` |
+//! | statistical outlier removal | [`statistical_outlier_removal`] | eqs. 14–16 | `pcl::StatisticalOutlierRemoval` |
+//! | down-sampling to voxel centroids | [`voxel_grid`] | eqs. 17–18 | `pcl::VoxelGrid` |
+//! | normals by PCA | [`estimate_normals`] | §3.2, before eq. 19 | `pcl::NormalEstimation` |
+//! | bilateral smoothing along normals | [`bilateral_normal_smoothing`] | eqs. 19–20 | none in PCL's filters or in Open3D |
+//!
+//! Every filter is a free function taking the cloud and a plain parameter
+//! struct with a `Default`; the removal filters also come as `*_indices`
+//! functions returning the kept indices in input order. Parameters are
+//! validated first ([`CloudError::BadParameter`](crate::CloudError::BadParameter)
+//! naming the value); an empty input, or a filter that removes every point,
+//! is [`CloudError::Emptied`](crate::CloudError::Emptied) with a hint of
+//! what to change. Non-finite points are dropped by every filter, as PCL's
+//! tools do. Neighbour searches build one k-d tree per call (`kdtree.rs`,
+//! which says why it is not `kiddo`) and query it in parallel with rayon, in
+//! tree order; results never depend on the number of threads.
+
+mod bilateral;
+mod kdtree;
+mod neighbours;
+mod normals;
+mod pass_through;
+mod radius_outlier;
+mod statistical_outlier;
+mod voxel_grid;
+
+pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
+pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
+pub use pass_through::{pass_through, pass_through_indices, Axis, PassThroughParams};
+pub use radius_outlier::{radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams};
+pub use statistical_outlier::{
+    statistical_outlier_removal, statistical_outlier_removal_indices, StatisticalOutlierParams,
+};
+pub use voxel_grid::{voxel_grid, VoxelGridParams};

@@ -1,0 +1,293 @@
+//! Normals by principal component analysis of each point's neighbourhood,
+//! the first half of the rope-shovel paper's bilateral smoothing (§3.2, "the
+//! unit normal vector of point P is first calculated using the points within
+//! the neighborhood range of point P", before eq. 19).
+//!
+//! The normal is the eigenvector of the smallest eigenvalue of the
+//! neighbourhood's covariance matrix (the point itself included, as in PCL's
+//! `NormalEstimation`, whose k nearest include the query point), in f64,
+//! by cyclic Jacobi rotations. It is oriented towards a viewpoint (PCL's
+//! `flipNormalTowardsViewpoint`: n·(v − p) ≥ 0), towards +z (a pile seen from
+//! above; Open3D's default when a cloud has no normals yet), or left as the
+//! solver returns it. A neighbourhood of fewer than three points, or one
+//! whose points are collinear (the smallest eigenvalue not unique), has no
+//! normal: `None` (PCL writes NaN).
+
+use super::kdtree::{KdTree, Nearest};
+use super::neighbours::{bad, empty_input, f32_at_most};
+use crate::{Point, PointCloud, Result};
+
+const FILTER: &str = "normal estimation";
+
+/// Which points make up a point's neighbourhood.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Neighbourhood {
+    /// The k nearest points, the point itself included (PCL's `setKSearch`).
+    Nearest(usize),
+    /// The points within this radius [m], inclusive (PCL's `setRadiusSearch`).
+    Radius(f64),
+}
+
+/// Which way normals point.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Orientation {
+    /// Towards this viewpoint [m], e.g. the sensor: n·(v − p) ≥ 0.
+    Viewpoint([f64; 3]),
+    /// Upwards: n_z ≥ 0.
+    PositiveZ,
+    /// As the eigen-solver returns them (sign arbitrary).
+    Unoriented,
+}
+
+/// Parameters of [`estimate_normals`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct NormalParams {
+    /// The neighbourhood.
+    pub neighbourhood: Neighbourhood,
+    /// The orientation.
+    pub orientation: Orientation,
+}
+
+impl Default for NormalParams {
+    /// The paper gives no value: the points within 10 cm (documented choice,
+    /// a few voxels of the 5 cm default down-sampling), oriented upwards.
+    fn default() -> Self {
+        Self {
+            neighbourhood: Neighbourhood::Radius(0.1),
+            orientation: Orientation::PositiveZ,
+        }
+    }
+}
+
+impl NormalParams {
+    fn validate(&self) -> Result<()> {
+        match self.neighbourhood {
+            Neighbourhood::Nearest(k) if k < 3 => {
+                return Err(bad(FILTER, format!("Nearest(k) needs k >= 3 points for a plane, got {k}")))
+            }
+            Neighbourhood::Radius(r) if !(r.is_finite() && r > 0.0) => {
+                return Err(bad(FILTER, format!("Radius(r) must be positive and finite, got {r}")))
+            }
+            _ => {}
+        }
+        if let Orientation::Viewpoint(v) = self.orientation {
+            if !v.iter().all(|c| c.is_finite()) {
+                return Err(bad(FILTER, format!("the viewpoint must be finite, got {v:?}")));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// The unit normal of every point, in input order (`None` where the
+/// neighbourhood is too small or degenerate, or the point is not finite).
+///
+/// ```
+/// use autoshovel_cloud::{filter, PointCloud};
+/// // A tilted plane z = 0.5 x: its upward normal is (−0.5, 0, 1)/|·|.
+/// let cloud = PointCloud::new(
+///     (0..100).map(|i| { let (x, y) = ((i % 10) as f32 * 0.1, (i / 10) as f32 * 0.1); [x, y, 0.5 * x] }).collect(),
+/// );
+/// let params = filter::NormalParams { neighbourhood: filter::Neighbourhood::Nearest(8), ..Default::default() };
+/// let normals = filter::estimate_normals(&cloud, &params).unwrap();
+/// let n = normals[55].unwrap();
+/// let s = 1.25_f64.sqrt();
+/// assert!((n[0] + 0.5 / s).abs() < 1e-6 && n[1].abs() < 1e-6 && (n[2] - 1.0 / s).abs() < 1e-6);
+/// ```
+pub fn estimate_normals(cloud: &PointCloud, params: &NormalParams) -> Result<Vec<Option<[f64; 3]>>> {
+    params.validate()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    // Search among the finite points only.
+    let finite: Vec<usize> = (0..cloud.len())
+        .filter(|&i| super::neighbours::is_finite(&cloud.points[i]))
+        .collect();
+    let points: Vec<Point> = finite.iter().map(|&i| cloud.points[i]).collect();
+    let tree = KdTree::new(&points);
+    let normals: Vec<Option<[f64; 3]>> = tree.map_points(
+        || Scratch::new(params.neighbourhood),
+        |scratch, _, p| {
+            let neighbours = scratch.neighbourhood(&tree, p);
+            let n = pca_normal(neighbours.iter().map(|&j| tree.points()[j as usize]))?;
+            Some(orient(n, p, params.orientation))
+        },
+    );
+    let mut out = vec![None; cloud.len()];
+    for (&i, n) in finite.iter().zip(normals) {
+        out[i] = n;
+    }
+    Ok(out)
+}
+
+/// Per-task buffers of a neighbourhood search.
+struct Scratch {
+    which: Neighbourhood,
+    knn: Nearest,
+    found: Vec<u32>,
+}
+
+impl Scratch {
+    fn new(which: Neighbourhood) -> Self {
+        let k = match which {
+            Neighbourhood::Nearest(k) => k,
+            Neighbourhood::Radius(_) => 1,
+        };
+        Self {
+            which,
+            knn: Nearest::new(k),
+            found: Vec::new(),
+        }
+    }
+
+    /// Tree positions of the neighbourhood of `p`.
+    fn neighbourhood(&mut self, tree: &KdTree, p: &Point) -> &[u32] {
+        match self.which {
+            Neighbourhood::Nearest(_) => {
+                tree.nearest(p, &mut self.knn);
+                self.knn.positions()
+            }
+            Neighbourhood::Radius(r) => {
+                tree.within(p, f32_at_most(r * r), &mut self.found);
+                &self.found
+            }
+        }
+    }
+}
+
+/// `n` flipped to the requested side.
+pub(crate) fn orient(n: [f64; 3], p: &Point, orientation: Orientation) -> [f64; 3] {
+    let flip = match orientation {
+        Orientation::Viewpoint(v) => {
+            let d = [0, 1, 2].map(|a| v[a] - f64::from(p[a]));
+            n[0] * d[0] + n[1] * d[1] + n[2] * d[2] < 0.0
+        }
+        Orientation::PositiveZ => n[2] < 0.0,
+        Orientation::Unoriented => false,
+    };
+    if flip {
+        n.map(|c| -c)
+    } else {
+        n
+    }
+}
+
+/// The unit normal (smallest principal axis) of these points, `None` for
+/// fewer than 3 points or collinear ones.
+pub(crate) fn pca_normal(points: impl Iterator<Item = Point> + Clone) -> Option<[f64; 3]> {
+    let mut count = 0usize;
+    let mut mean = [0.0_f64; 3];
+    for p in points.clone() {
+        count += 1;
+        for a in 0..3 {
+            mean[a] += f64::from(p[a]);
+        }
+    }
+    if count < 3 {
+        return None;
+    }
+    let mean = mean.map(|m| m / count as f64);
+    let mut cov = [[0.0_f64; 3]; 3];
+    for p in points {
+        let d = [0, 1, 2].map(|a| f64::from(p[a]) - mean[a]);
+        for r in 0..3 {
+            for c in 0..3 {
+                cov[r][c] += d[r] * d[c];
+            }
+        }
+    }
+    let (values, vectors) = symmetric_eigen3(cov);
+    // Collinear (or coincident) points: the two smallest eigenvalues vanish.
+    if !(values[1] > 1e-12 * values[2]) {
+        return None;
+    }
+    let n = [vectors[0][0], vectors[1][0], vectors[2][0]];
+    let len = (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt();
+    Some(n.map(|c| c / len))
+}
+
+/// Eigenvalues (ascending) and eigenvectors (as columns, in the same order)
+/// of a symmetric 3 × 3 matrix, by cyclic Jacobi rotations.
+pub(crate) fn symmetric_eigen3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
+    let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+    for _sweep in 0..50 {
+        let off = a[0][1].abs() + a[0][2].abs() + a[1][2].abs();
+        let diag = a[0][0].abs() + a[1][1].abs() + a[2][2].abs();
+        if off <= f64::EPSILON * 1e-3 * diag || off == 0.0 {
+            break;
+        }
+        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
+            if a[p][q] == 0.0 {
+                continue;
+            }
+            // The rotation in the (p, q) plane that zeroes a[p][q]
+            // (Numerical Recipes' `jacobi`, with A' = Jᵀ A J, V' = V J).
+            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
+            let c = 1.0 / (t * t + 1.0).sqrt();
+            let s = t * c;
+            let mut j = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
+            j[p][p] = c;
+            j[q][q] = c;
+            j[p][q] = s;
+            j[q][p] = -s;
+            a = mul(&transpose(&j), &mul(&a, &j));
+            a[p][q] = 0.0;
+            a[q][p] = 0.0;
+            v = mul(&v, &j);
+        }
+    }
+    let mut order = [0, 1, 2];
+    order.sort_by(|&i, &k| a[i][i].total_cmp(&a[k][k]));
+    let values = order.map(|i| a[i][i]);
+    let vectors = [0, 1, 2].map(|r| order.map(|i| v[r][i]));
+    (values, vectors)
+}
+
+fn mul(x: &[[f64; 3]; 3], y: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    let mut out = [[0.0; 3]; 3];
+    for (r, row) in out.iter_mut().enumerate() {
+        for (c, cell) in row.iter_mut().enumerate() {
+            *cell = (0..3).map(|k| x[r][k] * y[k][c]).sum();
+        }
+    }
+    out
+}
+
+fn transpose(x: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+    [0, 1, 2].map(|r| [0, 1, 2].map(|c| x[c][r]))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn jacobi_recovers_a_rotated_diagonal() {
+        // R diag(1, 4, 9) Rᵀ for a rotation R about an oblique axis.
+        let (ax, ang) = ([1.0_f64, 2.0, 2.0].map(|c| c / 3.0), 0.7_f64);
+        let (s, c) = ang.sin_cos();
+        let k = [[0.0, -ax[2], ax[1]], [ax[2], 0.0, -ax[0]], [-ax[1], ax[0], 0.0]];
+        let kk = mul(&k, &k);
+        let r = [0, 1, 2].map(|i| [0, 1, 2].map(|j| f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * kk[i][j]));
+        let d = [[1.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 9.0]];
+        let m = mul(&mul(&r, &d), &transpose(&r));
+        let (values, vectors) = symmetric_eigen3(m);
+        for (got, want) in values.iter().zip([1.0, 4.0, 9.0]) {
+            approx::assert_relative_eq!(*got, want, epsilon = 1e-12);
+        }
+        for i in 0..3 {
+            // Each eigenvector is ± the matching column of R.
+            let dot: f64 = (0..3).map(|a| vectors[a][i] * r[a][i]).sum();
+            approx::assert_relative_eq!(dot.abs(), 1.0, epsilon = 1e-12);
+        }
+    }
+
+    #[test]
+    fn collinear_points_have_no_normal() {
+        let line = (0..5).map(|i| [i as f32, 2.0 * i as f32, 0.0]);
+        assert!(pca_normal(line).is_none());
+        let two = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]].into_iter();
+        assert!(pca_normal(two).is_none());
+    }
+}

@@ -1,0 +1,162 @@
+//! Pass-through filter: keep the points whose coordinate on one axis lies in
+//! `[min, max]` (or outside it). The rope-shovel paper (§3.2, first step of
+//! the combined filtering process) uses it to strip the ground after the
+//! horizontal calibration of eqs. 11–12: a point with z below the height
+//! threshold is ground and is discarded, one with z at or above it is kept.
+//!
+//! Semantics of PCL 1.13's `pcl::PassThrough<PointT>::applyFilterIndices`
+//! (`filters/include/pcl/filters/impl/passthrough.hpp`):
+//! - a point with a non-finite coordinate is always removed;
+//! - the limits are stored as f32 (`setFilterLimits (const float&, const float&)`)
+//!   and compared with the f32 coordinate;
+//! - `keep_inside` (PCL's `!negative_`) keeps `min <= v <= max`: points on a
+//!   limit are kept;
+//! - `!keep_inside` keeps exactly the complement, `v < min || v > max`.
+//!
+//! PCL's `PassThrough<PCLPointCloud2>` (used by the `pcl_passthrough_filter`
+//! tool) differs in the negative mode only: it removes the open interval
+//! `min < v < max`, so it also keeps points lying exactly on a limit. We keep
+//! the complement of the positive mode, as `PassThrough<PointT>` does.
+//! Open3D has no pass-through; its `crop(AxisAlignedBoundingBox)` keeps the
+//! closed box too.
+
+use rayon::prelude::*;
+
+use super::neighbours::{bad, empty_input, emptied, is_finite};
+use crate::{Point, PointCloud, Result};
+
+const FILTER: &str = "pass-through";
+
+/// A coordinate axis.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Axis {
+    /// x.
+    X,
+    /// y.
+    Y,
+    /// z (up after the calibration of eqs. 11–12).
+    #[default]
+    Z,
+}
+
+impl Axis {
+    fn index(self) -> usize {
+        match self {
+            Axis::X => 0,
+            Axis::Y => 1,
+            Axis::Z => 2,
+        }
+    }
+}
+
+/// Parameters of [`pass_through`].
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct PassThroughParams {
+    /// The axis filtered on.
+    pub axis: Axis,
+    /// Lower limit [m], inclusive; may be `-inf`.
+    pub min_m: f64,
+    /// Upper limit [m], inclusive; may be `+inf`.
+    pub max_m: f64,
+    /// Keep the points inside `[min_m, max_m]` (true) or outside it (false).
+    pub keep_inside: bool,
+}
+
+impl Default for PassThroughParams {
+    /// The paper's ground removal, keep z ≥ threshold. The paper does not
+    /// give the threshold: 0.1 m (documented choice) clears a calibrated
+    /// floor with a few centimetres of range noise on a full-size machine.
+    fn default() -> Self {
+        Self::ground_removal(0.1)
+    }
+}
+
+impl PassThroughParams {
+    /// Ground removal as in the paper: keep `z >= threshold_m`.
+    pub fn ground_removal(threshold_m: f64) -> Self {
+        Self {
+            axis: Axis::Z,
+            min_m: threshold_m,
+            max_m: f64::INFINITY,
+            keep_inside: true,
+        }
+    }
+
+    /// The limits as PCL stores them (f32), validated.
+    fn limits(&self) -> Result<(f32, f32)> {
+        if self.min_m.is_nan() || self.max_m.is_nan() {
+            return Err(bad(
+                FILTER,
+                format!("limits must be numbers, got min_m = {}, max_m = {}", self.min_m, self.max_m),
+            ));
+        }
+        if self.min_m > self.max_m {
+            return Err(bad(
+                FILTER,
+                format!("min_m = {} is above max_m = {}", self.min_m, self.max_m),
+            ));
+        }
+        Ok((self.min_m as f32, self.max_m as f32))
+    }
+}
+
+/// Whether `p` passes, with the limits already in f32.
+#[inline]
+fn passes(p: &Point, axis: usize, lo: f32, hi: f32, keep_inside: bool) -> bool {
+    if !is_finite(p) {
+        return false;
+    }
+    let v = p[axis];
+    let inside = v >= lo && v <= hi;
+    inside == keep_inside
+}
+
+/// Indices of the points that pass, in input order.
+pub fn pass_through_indices(cloud: &PointCloud, params: &PassThroughParams) -> Result<Vec<usize>> {
+    let (lo, hi) = params.limits()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    let axis = params.axis.index();
+    let keep = params.keep_inside;
+    let kept: Vec<usize> = cloud
+        .points
+        .par_iter()
+        .enumerate()
+        .filter(|(_, p)| passes(p, axis, lo, hi, keep))
+        .map(|(i, _)| i)
+        .collect();
+    if kept.is_empty() {
+        return Err(emptied(FILTER, cloud.len(), HINT));
+    }
+    Ok(kept)
+}
+
+const HINT: &str = "widen [min_m, max_m], check the axis, or flip keep_inside";
+
+/// The points that pass, in input order.
+///
+/// ```
+/// use autoshovel_cloud::{filter, PointCloud};
+/// let cloud = PointCloud::new(vec![[0.0, 0.0, 0.05], [0.0, 0.0, 0.1], [0.0, 0.0, 2.0]]);
+/// let kept = filter::pass_through(&cloud, &filter::PassThroughParams::ground_removal(0.1)).unwrap();
+/// assert_eq!(kept.points, vec![[0.0, 0.0, 0.1], [0.0, 0.0, 2.0]]);
+/// ```
+pub fn pass_through(cloud: &PointCloud, params: &PassThroughParams) -> Result<PointCloud> {
+    let (lo, hi) = params.limits()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    let axis = params.axis.index();
+    let keep = params.keep_inside;
+    let points: Vec<Point> = cloud
+        .points
+        .par_iter()
+        .copied()
+        .filter(|p| passes(p, axis, lo, hi, keep))
+        .collect();
+    if points.is_empty() {
+        return Err(emptied(FILTER, cloud.len(), HINT));
+    }
+    Ok(PointCloud::new(points))
+}

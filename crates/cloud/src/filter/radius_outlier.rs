@@ -1,0 +1,131 @@
+//! Radius outlier removal (rope-shovel paper eq. 13): a point is kept when
+//! at least `min_neighbors` other points lie within the Euclidean distance
+//! `K_s` (`radius_m`) of it, d(p_i, p_j) ≤ K_s.
+//!
+//! Semantics of PCL 1.13.0's `pcl::RadiusOutlierRemoval<PointT>`, followed to
+//! the bit (`filters/include/pcl/filters/impl/radius_outlier_removal.hpp`,
+//! `applyFilterIndices`, the branch for dense clouds, which is the one PCL's
+//! `pcl_outlier_removal` tool takes after `removeNaNFromPointCloud`):
+//!
+//! ```text
+//! // Note: k includes the query point, so is always at least 1
+//! int mean_k = min_pts_radius_ + 1;
+//! double nn_dists_max = search_radius_ * search_radius_;
+//! int k = searcher_->nearestKSearch (index, mean_k, nn_indices, nn_dists);
+//! bool chk_neighbors = true;
+//! if (k == mean_k) { ... if (nn_dists_max < nn_dists[k-1]) chk_neighbors = false; }
+//! else chk_neighbors = false;
+//! ```
+//!
+//! So a point is kept when its `(min_neighbors + 1)`-th nearest point,
+//! counting itself (or a duplicate of itself) as the first, has a squared
+//! distance `d` with `(double) d <= radius * radius` (the radius squared in
+//! f64, as PCL does; `d` is FLANN's f32 squared distance, computed here in
+//! the same order, see `neighbours.rs`). Points at exactly the radius count.
+//! The non-dense branch (`radiusSearch`, `k <= min_pts_radius_` removed)
+//! counts the same neighbours. Non-finite points are dropped first, as the
+//! PCL tool does. `radius_m` must be positive (PCL refuses 0).
+//!
+//! The PCL 1.13 `pcl_outlier_removal -method radius -radius R -min_pts N`
+//! keeps exactly what `RadiusOutlierParams { radius_m: R, min_neighbors: N }`
+//! keeps (tests/filter_pcl_agreement.rs). Open3D's `remove_radius_outlier(nb_points,
+//! radius)` counts the point itself: its `nb_points = N + 1` is our `N`.
+
+use rayon::prelude::*;
+
+use super::kdtree::KdTree;
+use super::neighbours::{bad, empty_input, emptied, f32_at_most, gather, on_finite_points};
+use crate::{PointCloud, Result};
+
+const FILTER: &str = "radius outlier removal";
+
+/// Parameters of [`radius_outlier_removal`] (eq. 13).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct RadiusOutlierParams {
+    /// The search radius K_s [m], inclusive.
+    pub radius_m: f64,
+    /// The least number of other points within the radius for a point to be
+    /// kept (PCL's `min_pts_radius_`, `-min_pts`).
+    pub min_neighbors: usize,
+}
+
+impl Default for RadiusOutlierParams {
+    /// The paper gives no values: 5 neighbours within 5 cm (documented choice)
+    /// suits a full-size pile scanned at 1–3 cm spacing.
+    fn default() -> Self {
+        Self {
+            radius_m: 0.05,
+            min_neighbors: 5,
+        }
+    }
+}
+
+impl RadiusOutlierParams {
+    fn validate(&self) -> Result<()> {
+        if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
+            return Err(bad(
+                FILTER,
+                format!("radius_m must be positive and finite, got {}", self.radius_m),
+            ));
+        }
+        if self.min_neighbors >= u32::MAX as usize {
+            return Err(bad(
+                FILTER,
+                format!("min_neighbors = {} is beyond any cloud", self.min_neighbors),
+            ));
+        }
+        Ok(())
+    }
+}
+
+const HINT: &str = "lower min_neighbors or raise radius_m";
+
+/// Indices of the points kept by radius outlier removal, in input order.
+pub fn radius_outlier_removal_indices(
+    cloud: &PointCloud,
+    params: &RadiusOutlierParams,
+) -> Result<Vec<usize>> {
+    params.validate()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    let kept = on_finite_points(cloud, |points| Ok(kept_indices(points, params)))?;
+    if kept.is_empty() {
+        return Err(emptied(FILTER, cloud.len(), HINT));
+    }
+    Ok(kept)
+}
+
+/// The points kept by radius outlier removal (eq. 13), in input order.
+///
+/// ```
+/// use autoshovel_cloud::{filter, PointCloud};
+/// // Three points 1 m apart on a line, and a lone one.
+/// let cloud = PointCloud::new(vec![[0.0, 0.0, 0.0], [1.0, 0.0, 0.0], [2.0, 0.0, 0.0], [9.0, 0.0, 0.0]]);
+/// let params = filter::RadiusOutlierParams { radius_m: 1.0, min_neighbors: 1 };
+/// let kept = filter::radius_outlier_removal(&cloud, &params).unwrap();
+/// assert_eq!(kept.len(), 3); // neighbours at exactly the radius count
+/// let params = filter::RadiusOutlierParams { radius_m: 1.0, min_neighbors: 2 };
+/// assert_eq!(filter::radius_outlier_removal(&cloud, &params).unwrap().points, vec![[1.0, 0.0, 0.0]]);
+/// ```
+pub fn radius_outlier_removal(cloud: &PointCloud, params: &RadiusOutlierParams) -> Result<PointCloud> {
+    let kept = radius_outlier_removal_indices(cloud, params)?;
+    Ok(gather(cloud, &kept))
+}
+
+/// The kept indices of `points` (all finite, not empty).
+fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<usize> {
+    let wanted = params.min_neighbors + 1; // the point itself comes first
+    if params.min_neighbors == 0 {
+        return (0..points.len()).collect();
+    }
+    if wanted > points.len() {
+        return Vec::new();
+    }
+    let tree = KdTree::new(points);
+    let r2 = f32_at_most(params.radius_m * params.radius_m);
+    // The wanted-th nearest is within the radius exactly when at least
+    // `wanted` points are: count them, stopping at `wanted`.
+    let keep: Vec<bool> = tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted));
+    keep.par_iter().enumerate().filter(|(_, &k)| k).map(|(i, _)| i).collect()
+}

@@ -1,0 +1,162 @@
+//! Statistical outlier removal (rope-shovel paper eqs. 14–16): each point's
+//! mean distance d̄_i to its k nearest neighbours; their global mean d̄ and
+//! sample standard deviation δ (eq. 14, with n − 1); d̄_i ~ N(d̄, δ²) (eq. 15);
+//! a point is noise when d̄_i − d̄ > α·δ (eq. 16, one-sided as in PCL).
+//!
+//! Semantics of PCL 1.13.0's `pcl::StatisticalOutlierRemoval<PointT>`, followed
+//! to the bit (`filters/include/pcl/filters/impl/statistical_outlier_removal.hpp`,
+//! `applyFilterIndices`; the floating-point operations below were also read
+//! off the disassembly of Debian's `libpcl_filters.so.1.13.0`):
+//!
+//! ```text
+//! searcher_->nearestKSearch ((*indices_)[iii], mean_k_ + 1, nn_indices, nn_dists)
+//! double dist_sum = 0.0;
+//! for (int k = 1; k < mean_k_ + 1; ++k)  // k = 0 is the query point
+//!   dist_sum += sqrt (nn_dists[k]);      // sqrtsd of the f32 widened to f64
+//! distances[iii] = static_cast<float> (dist_sum / mean_k_);
+//! ...
+//! for (const float &distance : distances) { sum += distance; sq_sum += distance * distance; }
+//!                                          // f64 sums; distance * distance in f32
+//! double mean = sum / valid_distances;
+//! double variance = (sq_sum - sum * sum / valid_distances) / (valid_distances - 1);
+//! double stddev = sqrt (variance);
+//! double distance_threshold = mean + std_mul_ * stddev;
+//! if (distances[iii] > distance_threshold) → removed   // kept: d̄_i <= threshold
+//! ```
+//!
+//! The k neighbours exclude the first of the k + 1 nearest (the point itself,
+//! or an exact duplicate: both at distance 0); they are summed nearest first.
+//! The global sums run sequentially in input order (never in parallel, whose
+//! rounding would depend on the split). A negative variance from rounding
+//! gives a NaN threshold in PCL, which then keeps every point: so do we.
+//!
+//! The PCL 1.13 tool `pcl_outlier_removal -method statistical -mean_k K
+//! -std_dev_mul S` keeps exactly what `StatisticalOutlierParams { mean_k: K,
+//! std_mul: S }` keeps (tests/filter_pcl_agreement.rs). Open3D's
+//! `remove_statistical_outlier(nb_neighbors, std_ratio)` differs in details:
+//! its k neighbours include the point itself (so its mean is over k − 1 true
+//! neighbours), and it uses the population standard deviation (n).
+
+use super::kdtree::{KdTree, Nearest};
+use super::neighbours::{bad, empty_input, emptied, gather, on_finite_points};
+use crate::{Point, PointCloud, Result};
+
+const FILTER: &str = "statistical outlier removal";
+
+/// Parameters of [`statistical_outlier_removal`] (eqs. 14–16).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StatisticalOutlierParams {
+    /// The number k of neighbours (not counting the point) whose mean
+    /// distance d̄_i is taken (PCL's `mean_k_`, `-mean_k`).
+    pub mean_k: usize,
+    /// The threshold factor α of eq. 16 (PCL's `std_mul_`, `-std_dev_mul`).
+    pub std_mul: f64,
+}
+
+impl Default for StatisticalOutlierParams {
+    /// The paper gives no values: k = 50, α = 1 (PCL's tutorial values,
+    /// documented choice).
+    fn default() -> Self {
+        Self {
+            mean_k: 50,
+            std_mul: 1.0,
+        }
+    }
+}
+
+impl StatisticalOutlierParams {
+    fn validate(&self) -> Result<()> {
+        if self.mean_k == 0 || self.mean_k >= u32::MAX as usize {
+            return Err(bad(FILTER, format!("mean_k must be at least 1, got {}", self.mean_k)));
+        }
+        if !self.std_mul.is_finite() {
+            return Err(bad(FILTER, format!("std_mul must be finite, got {}", self.std_mul)));
+        }
+        Ok(())
+    }
+}
+
+/// Indices of the points kept by statistical outlier removal, in input order.
+pub fn statistical_outlier_removal_indices(
+    cloud: &PointCloud,
+    params: &StatisticalOutlierParams,
+) -> Result<Vec<usize>> {
+    params.validate()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    let kept = on_finite_points(cloud, |points| kept_indices(points, params))?;
+    if kept.is_empty() {
+        return Err(emptied(FILTER, cloud.len(), "raise std_mul"));
+    }
+    Ok(kept)
+}
+
+/// The points kept by statistical outlier removal (eqs. 14–16), in input order.
+///
+/// ```
+/// use autoshovel_cloud::{filter, PointCloud};
+/// // A 10 × 10 grid of 1 cm spacing and one point 1 m above it.
+/// let mut points: Vec<[f32; 3]> =
+///     (0..100).map(|i| [(i % 10) as f32 * 0.01, (i / 10) as f32 * 0.01, 0.0]).collect();
+/// points.push([0.05, 0.05, 1.0]);
+/// let cloud = PointCloud::new(points);
+/// let params = filter::StatisticalOutlierParams { mean_k: 8, std_mul: 1.0 };
+/// let kept = filter::statistical_outlier_removal(&cloud, &params).unwrap();
+/// assert!(kept.points.iter().all(|p| p[2] == 0.0));
+/// ```
+pub fn statistical_outlier_removal(
+    cloud: &PointCloud,
+    params: &StatisticalOutlierParams,
+) -> Result<PointCloud> {
+    let kept = statistical_outlier_removal_indices(cloud, params)?;
+    Ok(gather(cloud, &kept))
+}
+
+/// The mean distance d̄_i of every point to its k nearest neighbours, as PCL
+/// computes it (f64 sum of f64 square roots of f32 squared distances,
+/// nearest first, divided by k, stored as f32).
+pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f32> {
+    let tree = KdTree::new(points);
+    tree.map_points(
+        || Nearest::new(mean_k + 1),
+        |knn, _, p| {
+            tree.nearest(p, knn);
+            let sum = knn.distances()[1..].iter().fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
+            (sum / mean_k as f64) as f32
+        },
+    )
+}
+
+/// The kept indices of `points` (all finite, not empty).
+fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<Vec<usize>> {
+    if params.mean_k >= points.len() {
+        return Err(bad(
+            FILTER,
+            format!(
+                "mean_k = {} needs at least {} finite points, the cloud has {}",
+                params.mean_k,
+                params.mean_k + 1,
+                points.len()
+            ),
+        ));
+    }
+    let distances = mean_neighbour_distances(points, params.mean_k);
+    // Eq. 14 in PCL's arithmetic: sequential f64 sums, the square in f32.
+    let (mut sum, mut sq_sum) = (0.0_f64, 0.0_f64);
+    for &d in &distances {
+        sum += f64::from(d);
+        sq_sum += f64::from(d * d);
+    }
+    let n = distances.len() as f64;
+    let mean = sum / n;
+    let variance = (sq_sum - sum * sum / n) / (n - 1.0);
+    let threshold = mean + params.std_mul * variance.sqrt();
+    // Eq. 16: removed when d̄_i > threshold; a NaN threshold removes nothing.
+    Ok(distances
+        .iter()
+        .enumerate()
+        .filter(|(_, &d)| !(f64::from(d) > threshold))
+        .map(|(i, _)| i)
+        .collect())
+}

@@ -1,0 +1,455 @@
+//! LAS and LAZ (ASPRS LAS 1.0–1.4, LASzip compression) through the `las`
+//! crate, which returns x, y, z already scaled and offset.
+//!
+//! # The guard in front of `las`
+//! `las` (and `laz` under it) trust header fields when sizing buffers and
+//! loops, and a damaged or hostile file can make them allocate gigabytes or
+//! overflow. Before a file reaches them, [`check`] reads the public header
+//! and refuses:
+//! - a point count whose records (count × record length) do not fit in the
+//!   bytes after the point-data offset (LAS);
+//! - for LAZ, more than [`LAZ_MAX_POINTS_PER_BYTE`] points per byte of
+//!   compressed data. The most compressible data there is, 2 M identical
+//!   points, takes 13 557 bytes with the `las` writer (148 points a byte,
+//!   LAS 1.2; 100 a byte for 1.4's layered format), about 340 bytes per
+//!   50 000-point chunk. LASzip's adaptive models cap the probability of a
+//!   symbol, so even a crafted stream pays some bits per point; 2000 points
+//!   a byte is 13 times the best case measured and still turns a 1 kB file
+//!   claiming four billion points into an immediate error;
+//! - more variable-length records than fit between the header and the
+//!   points, an extended VLR longer than the rest of the file, a point-data
+//!   offset past the end;
+//! - a LASzip chunk table with more chunks than the compressed bytes could
+//!   hold (every chunk starts with one raw point, ≥ 20 bytes; we allow one
+//!   chunk per [`LAZ_MIN_CHUNK_BYTES`]), since `laz` reserves the table
+//!   from that count;
+//! - a layered (LAS 1.4, point formats 6–10) LASzip chunk with a layer
+//!   larger than the rest of the file, since `laz` zero-fills a buffer of
+//!   each announced layer size before reading it; every chunk header is
+//!   walked (a few seeks per 50 000 points) before decoding starts;
+//! - a LASzip record with no items (`laz` would panic).
+//!
+//! Points are then read one at a time (`read_point`, never `read_points`,
+//! which reserves the header's count) straight into the cloud's vector.
+
+use std::io::{Read, Seek, SeekFrom, Write};
+use std::path::Path;
+
+use super::input::Points;
+use crate::{CloudError, Point};
+
+/// Most LAZ points accepted per byte of compressed data (see the module
+/// docs for the measurement behind it).
+pub const LAZ_MAX_POINTS_PER_BYTE: u64 = 2000;
+/// Fewest bytes a LASzip chunk is assumed to take (a raw first point alone
+/// is 20 or more).
+pub const LAZ_MIN_CHUNK_BYTES: u64 = 8;
+/// Minimum size of a variable-length record header [bytes].
+const VLR_HEADER: u64 = 54;
+/// Size of an extended VLR header [bytes].
+const EVLR_HEADER: u64 = 60;
+/// Progress is reported every this many points.
+const PROGRESS_POINTS: u64 = 1 << 16;
+
+/// What the public header says, after checking.
+struct Checked {
+    compressed: bool,
+    count: u64,
+    minor: u8,
+    major: u8,
+    offset: u64,
+    record_len: u64,
+}
+
+fn le16(b: &[u8], at: usize) -> u64 {
+    u64::from(u16::from_le_bytes([b[at], b[at + 1]]))
+}
+fn le32(b: &[u8], at: usize) -> u64 {
+    u64::from(u32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]))
+}
+fn le64(b: &[u8], at: usize) -> u64 {
+    let mut a = [0u8; 8];
+    a.copy_from_slice(&b[at..at + 8]);
+    u64::from_le_bytes(a)
+}
+
+/// Reads as much of `buf` as the source has.
+fn read_up_to<R: Read>(src: &mut R, buf: &mut [u8]) -> std::io::Result<usize> {
+    let mut n = 0;
+    while n < buf.len() {
+        match src.read(&mut buf[n..]) {
+            Ok(0) => break,
+            Ok(k) => n += k,
+            Err(e) if e.kind() == std::io::ErrorKind::Interrupted => {}
+            Err(e) => return Err(e),
+        }
+    }
+    Ok(n)
+}
+
+fn read_at<R: Read + Seek>(src: &mut R, at: u64, buf: &mut [u8]) -> std::io::Result<bool> {
+    src.seek(SeekFrom::Start(at))?;
+    Ok(read_up_to(src, buf)? == buf.len())
+}
+
+/// Checks the header against the file size (see the module docs).
+fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
+    let io = |e: std::io::Error| format!("reading the header: {e}");
+    let mut h = [0u8; 255];
+    src.seek(SeekFrom::Start(0)).map_err(io)?;
+    let n = read_up_to(src, &mut h).map_err(io)?;
+    if n < 4 || &h[..4] != b"LASF" {
+        return Err("not a LAS file: it does not start with \"LASF\"".into());
+    }
+    if n < 227 {
+        return Err(format!(
+            "a LAS header takes at least 227 bytes, the file has {total}"
+        ));
+    }
+    let (major, minor) = (h[24], h[25]);
+    let is14 = major == 1 && minor == 4;
+    if is14 && n < 255 {
+        return Err(format!(
+            "a LAS 1.4 header takes at least 375 bytes, the file has {total}"
+        ));
+    }
+    let header_size = le16(&h, 94);
+    let offset = le32(&h, 96);
+    let n_vlrs = le32(&h, 100);
+    let format = h[104];
+    let record_len = le16(&h, 105);
+    let legacy = le32(&h, 107);
+    // As `las` does: the legacy count unless it is zero (LAS 1.4).
+    let count = if legacy > 0 {
+        legacy
+    } else if is14 {
+        le64(&h, 247)
+    } else {
+        0
+    };
+    let compressed = format & 0x80 != 0;
+    if offset > total {
+        return Err(format!(
+            "the point data offset {offset} lies past the end of the file ({total} bytes)"
+        ));
+    }
+    if n_vlrs.saturating_mul(VLR_HEADER) > offset.saturating_sub(header_size) {
+        return Err(format!(
+            "{n_vlrs} variable-length records cannot fit between the header ({header_size} bytes) and the point data at byte {offset}"
+        ));
+    }
+    let data_bytes = total - offset;
+    if !compressed {
+        let need = count.checked_mul(record_len);
+        if need.is_none_or(|need| need > data_bytes) {
+            return Err(format!(
+                "the header claims {count} points × {record_len} bytes, but only {data_bytes} bytes follow the point data offset {offset} (truncated file or a wrong point count)"
+            ));
+        }
+    } else if count > data_bytes.saturating_mul(LAZ_MAX_POINTS_PER_BYTE) {
+        return Err(format!(
+            "the header claims {count} points, more than {LAZ_MAX_POINTS_PER_BYTE} per byte of the {data_bytes} bytes of compressed data (truncated file or a wrong point count)"
+        ));
+    }
+    if is14 {
+        let evlr_start = le64(&h, 235);
+        let n_evlrs = le32(&h, 243);
+        if evlr_start > 0 && n_evlrs > 0 {
+            let mut e = [0u8; EVLR_HEADER as usize];
+            if evlr_start.saturating_add(EVLR_HEADER) > total
+                || !read_at(src, evlr_start, &mut e).map_err(io)?
+            {
+                return Err(format!("the extended VLR at byte {evlr_start} lies past the end of the file ({total} bytes)"));
+            }
+            let len = le64(&e, 20);
+            if len > total - evlr_start - EVLR_HEADER {
+                return Err(format!(
+                    "the extended VLR at byte {evlr_start} claims {len} bytes, more than the rest of the file"
+                ));
+            }
+        }
+    }
+    let c = Checked {
+        compressed,
+        count,
+        minor,
+        major,
+        offset,
+        record_len,
+    };
+    if compressed {
+        check_laz(src, total, header_size, n_vlrs, &c)?;
+    }
+    Ok(c)
+}
+
+/// The LASzip checks: items, chunk table, layer sizes.
+fn check_laz<R: Read + Seek>(
+    src: &mut R,
+    total: u64,
+    header_size: u64,
+    n_vlrs: u64,
+    c: &Checked,
+) -> Result<(), String> {
+    let io = |e: std::io::Error| format!("reading the LASzip records: {e}");
+    // Find the LASzip VLR ("laszip encoded", record 22204), as `las` does.
+    let mut pos = header_size;
+    let mut items: Option<Vec<(u16, u16, u16)>> = None;
+    for _ in 0..n_vlrs {
+        let mut v = [0u8; VLR_HEADER as usize];
+        if !read_at(src, pos, &mut v).map_err(io)? {
+            return Ok(()); // `las` reports the truncation
+        }
+        let len = le16(&v, 20);
+        if v[2..16] == *b"laszip encoded" && le16(&v, 18) == 22204 {
+            let mut d = vec![0u8; len as usize];
+            if !read_at(src, pos + VLR_HEADER, &mut d).map_err(io)? || d.len() < 34 {
+                return Ok(()); // `las`/`laz` report it
+            }
+            let n = le16(&d, 32) as usize;
+            if n == 0 {
+                return Err("the LASzip record lists no items".into());
+            }
+            if d.len() < 34 + 6 * n {
+                return Ok(());
+            }
+            items = Some(
+                (0..n)
+                    .map(|i| {
+                        let at = 34 + 6 * i;
+                        (
+                            le16(&d, at) as u16,
+                            le16(&d, at + 2) as u16,
+                            le16(&d, at + 4) as u16,
+                        )
+                    })
+                    .collect(),
+            );
+            break;
+        }
+        pos += VLR_HEADER + len;
+    }
+    let Some(items) = items else { return Ok(()) };
+    // Chunk table: its offset is the first 8 bytes of the point data, or
+    // the last 8 bytes of the file when the writer could not seek back.
+    let data_start = c.offset;
+    let mut b8 = [0u8; 8];
+    if !read_at(src, data_start, &mut b8).map_err(io)? {
+        return Ok(());
+    }
+    let mut table = i64::from_le_bytes(b8);
+    if table <= data_start as i64 && total >= 8 {
+        read_at(src, total - 8, &mut b8).map_err(io)?;
+        table = i64::from_le_bytes(b8);
+    }
+    let table = (table > data_start as i64).then_some(table as u64);
+    if let Some(table) = table {
+        if table.saturating_add(8) <= total && read_at(src, table, &mut b8).map_err(io)? {
+            let chunks = le32(&b8, 4);
+            let bound = (table - data_start) / LAZ_MIN_CHUNK_BYTES + 1;
+            if chunks > bound {
+                return Err(format!(
+                    "the LASzip chunk table at byte {table} claims {chunks} chunks; {} bytes of compressed points hold at most {bound}",
+                    table - data_start
+                ));
+            }
+        }
+    }
+    // Layered chunks (item version 3): walk the chunk headers.
+    if items.first().map(|i| i.2) != Some(3) {
+        return Ok(());
+    }
+    let mut first_point = 0u64;
+    let mut layers = 0u64;
+    for &(kind, size, _) in &items {
+        let (bytes, l) = match kind {
+            10 => (30, 9),                            // Point14
+            11 => (6, 1),                             // RGB14
+            12 => (8, 2),                             // RGBNIR14: RGB and NIR
+            13 => (29, 1),                            // WavePacket14
+            14 => (u64::from(size), u64::from(size)), // Byte14: a layer per byte
+            _ => return Ok(()),                       // `laz` refuses it
+        };
+        first_point += bytes;
+        layers += l;
+    }
+    let end = table.unwrap_or(total).min(total);
+    let mut pos = data_start + 8;
+    let mut seen = 0u64;
+    let mut sizes = vec![0u8; 4 + 4 * layers as usize];
+    while pos < end && seen < c.count {
+        let chunk = pos;
+        pos += first_point;
+        if pos + sizes.len() as u64 > total || !read_at(src, pos, &mut sizes).map_err(io)? {
+            return Ok(()); // `laz` reports the truncation
+        }
+        pos += sizes.len() as u64;
+        let mut sum = 0u64;
+        for k in 0..layers as usize {
+            let s = le32(&sizes, 4 + 4 * k);
+            if s > total - pos {
+                return Err(format!(
+                    "the LASzip chunk at byte {chunk} announces a layer of {s} bytes, more than the rest of the file"
+                ));
+            }
+            sum += s;
+        }
+        seen += le32(&sizes, 0).max(1);
+        pos = pos.saturating_add(sum);
+    }
+    Ok(())
+}
+
+fn las_err(path: &Path, e: las::Error) -> CloudError {
+    match e {
+        las::Error::Io(source) if source.kind() != std::io::ErrorKind::UnexpectedEof => {
+            CloudError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        }
+        e => CloudError::Format {
+            path: path.to_path_buf(),
+            what: format!("LAS: {e}"),
+        },
+    }
+}
+
+/// Reads a LAS or LAZ stream of `total` bytes into `out`.
+pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
+    mut src: R,
+    total: u64,
+    path: &Path,
+    progress: &mut dyn FnMut(u64, u64),
+    out: &mut Points,
+) -> crate::Result<&'static str> {
+    progress(0, total);
+    let c = check(&mut src, total).map_err(|what| CloudError::Format {
+        path: path.to_path_buf(),
+        what,
+    })?;
+    src.seek(SeekFrom::Start(0))
+        .map_err(|source| CloudError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let mut reader = las::Reader::new(src).map_err(|e| las_err(path, e))?;
+    if !c.compressed {
+        out.reserve_bounded(c.count, total - c.offset, c.record_len.max(1));
+    }
+    let mut i = 0u64;
+    while let Some(p) = reader.read_point().map_err(|e| las_err(path, e))? {
+        out.push([p.x as f32, p.y as f32, p.z as f32]);
+        i += 1;
+        if i.is_multiple_of(PROGRESS_POINTS) {
+            let done = if c.compressed {
+                (total as f64 * i as f64 / c.count.max(1) as f64) as u64
+            } else {
+                c.offset + i * c.record_len
+            };
+            progress(done.min(total), total);
+        }
+    }
+    progress(total, total);
+    Ok(match (c.compressed, c.major, c.minor) {
+        (false, 1, 0) => "las 1.0",
+        (false, 1, 1) => "las 1.1",
+        (false, 1, 2) => "las 1.2",
+        (false, 1, 3) => "las 1.3",
+        (false, 1, 4) => "las 1.4",
+        (false, _, _) => "las",
+        (true, 1, 0) => "laz 1.0",
+        (true, 1, 1) => "laz 1.1",
+        (true, 1, 2) => "laz 1.2",
+        (true, 1, 3) => "laz 1.3",
+        (true, 1, 4) => "laz 1.4",
+        (true, _, _) => "laz",
+    })
+}
+
+/// LAS version written.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum LasVersion {
+    /// LAS 1.2, point format 0: read by every LAS tool.
+    #[default]
+    V1_2,
+    /// LAS 1.4, point format 6.
+    V1_4,
+}
+
+/// Coordinate resolution written [m].
+pub const LAS_SCALE_M: f64 = 0.001;
+
+/// Scale and offset of one axis: the offset is the middle of the data
+/// rounded to a whole metre, the scale 1 mm unless the extent needs
+/// coarser steps to fit LAS's 32-bit integers (then 1 cm, 1 dm, ...; a
+/// cloud spanning more than ±2000 km is not a LiDAR scan).
+fn transform(lo: f64, hi: f64) -> las::Transform {
+    if lo > hi {
+        return las::Transform {
+            scale: LAS_SCALE_M,
+            offset: 0.0,
+        };
+    }
+    let offset = ((lo + hi) / 2.0).round();
+    let half = (hi - offset).abs().max((lo - offset).abs());
+    let mut scale = LAS_SCALE_M;
+    while half / scale > f64::from(i32::MAX - 1) {
+        scale *= 10.0;
+    }
+    las::Transform { scale, offset }
+}
+
+/// Writes `points` as LAS (or LAZ when `compressed`) into `w`.
+pub(crate) fn write<W: Write + Seek + Send + Sync + 'static>(
+    w: W,
+    points: &[Point],
+    compressed: bool,
+    version: LasVersion,
+) -> Result<W, String> {
+    let mut lo = [f64::INFINITY; 3];
+    let mut hi = [f64::NEG_INFINITY; 3];
+    for p in points {
+        for k in 0..3 {
+            let v = f64::from(p[k]);
+            if !v.is_finite() {
+                return Err(format!("LAS cannot store the non-finite coordinate {v}"));
+            }
+            lo[k] = lo[k].min(v);
+            hi[k] = hi[k].max(v);
+        }
+    }
+    let mut builder = match version {
+        LasVersion::V1_2 => las::Builder::from((1, 2)),
+        LasVersion::V1_4 => las::Builder::from((1, 4)),
+    };
+    builder.point_format = las::point::Format::new(match version {
+        LasVersion::V1_2 => 0,
+        LasVersion::V1_4 => 6,
+    })
+    .map_err(|e| e.to_string())?;
+    builder.point_format.is_compressed = compressed;
+    builder.generating_software = "autoshovel".into();
+    builder.transforms = las::Vector {
+        x: transform(lo[0], hi[0]),
+        y: transform(lo[1], hi[1]),
+        z: transform(lo[2], hi[2]),
+    };
+    let header = builder.into_header().map_err(|e| e.to_string())?;
+    let gps_time = (version == LasVersion::V1_4).then_some(0.0);
+    let mut writer = las::Writer::new(w, header).map_err(|e| e.to_string())?;
+    for p in points {
+        writer
+            .write_point(las::Point {
+                x: f64::from(p[0]),
+                y: f64::from(p[1]),
+                z: f64::from(p[2]),
+                return_number: 1,
+                number_of_returns: 1,
+                gps_time,
+                ..Default::default()
+            })
+            .map_err(|e| e.to_string())?;
+    }
+    writer.into_inner().map_err(|e| e.to_string())
+}

@@ -1,0 +1,145 @@
+//! Reading any supported file: dispatch on the extension (or a given
+//! [`Format`]), progress, and the report.
+
+use std::fmt;
+use std::fs::File;
+use std::io::{BufRead, BufReader, Cursor};
+use std::path::{Path, PathBuf};
+
+use super::input::{Input, Points};
+use super::{las, pcd, ply, xyz, Format};
+use crate::{CloudError, PointCloud};
+
+/// Buffer size of file readers [bytes].
+const BUFFER: usize = 1 << 20;
+
+/// What [`read`] found.
+#[derive(Debug, Clone, PartialEq)]
+pub struct ReadReport {
+    /// The finite points, in file order.
+    pub cloud: PointCloud,
+    /// Points dropped because a coordinate was NaN or infinite.
+    pub non_finite_dropped: usize,
+    /// The format and encoding read, e.g. `"pcd binary_compressed"`,
+    /// `"ply binary_big_endian"`, `"laz 1.4"`, `"csv"`.
+    pub format: &'static str,
+}
+
+impl ReadReport {
+    /// Whether no point was kept: valid to read, the caller decides
+    /// whether an empty cloud is an error.
+    pub fn is_empty(&self) -> bool {
+        self.cloud.is_empty()
+    }
+}
+
+impl fmt::Display for ReadReport {
+    /// E.g. `"12345 points (pcd binary), 3 non-finite dropped"` or
+    /// `"empty cloud (ply ascii)"`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        if self.cloud.is_empty() {
+            write!(f, "empty cloud ({})", self.format)?;
+        } else {
+            write!(f, "{} points ({})", self.cloud.len(), self.format)?;
+        }
+        if self.non_finite_dropped > 0 {
+            write!(f, ", {} non-finite dropped", self.non_finite_dropped)?;
+        }
+        Ok(())
+    }
+}
+
+/// Reads the point cloud in `path`, the format chosen by the extension
+/// (`.pcd .ply .las .laz .xyz .csv .txt`, any case).
+///
+/// `progress(bytes_done, bytes_total)` is called at the start, about every
+/// MiB, and at the end, so a caller can draw a bar. Non-finite points are
+/// dropped and counted. Every damaged or inconsistent file gives
+/// [`CloudError::Format`] naming the line or byte offset; nothing a header
+/// merely claims is allocated.
+pub fn read(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> crate::Result<ReadReport> {
+    let format = Format::from_path(path)?;
+    let io = |source| CloudError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = File::open(path).map_err(io)?;
+    let total = file.metadata().map_err(io)?.len();
+    let mut out = Points::default();
+    let name = match format {
+        Format::Las | Format::Laz => las::read(
+            BufReader::with_capacity(BUFFER, file),
+            total,
+            path,
+            progress,
+            &mut out,
+        )?,
+        _ => {
+            let mut input = Input::new(
+                BufReader::with_capacity(BUFFER, file),
+                total,
+                path,
+                progress,
+            );
+            read_text_or_binary(format, &mut input, &mut out)?
+        }
+    };
+    Ok(report(out, name))
+}
+
+/// Reads a cloud from memory, through the same readers as [`read`]
+/// (fuzzing, embedded test data, network buffers). Errors name the file
+/// as `<memory>.EXT`.
+pub fn read_from_bytes(format: Format, bytes: &[u8]) -> crate::Result<ReadReport> {
+    let path = PathBuf::from(format!("<memory>.{}", format.extension()));
+    let mut progress = |_: u64, _: u64| {};
+    let total = bytes.len() as u64;
+    let mut out = Points::default();
+    let name = match format {
+        // `las` wants an owned, seekable source.
+        Format::Las | Format::Laz => las::read(
+            Cursor::new(bytes.to_vec()),
+            total,
+            &path,
+            &mut progress,
+            &mut out,
+        )?,
+        _ => {
+            let mut input = Input::new(bytes, total, &path, &mut progress);
+            read_text_or_binary(format, &mut input, &mut out)?
+        }
+    };
+    Ok(report(out, name))
+}
+
+fn read_text_or_binary<R: BufRead>(
+    format: Format,
+    input: &mut Input<'_, R>,
+    out: &mut Points,
+) -> crate::Result<&'static str> {
+    let name = match format {
+        Format::Pcd => pcd::read(input, out)?,
+        Format::Ply => ply::read(input, out)?,
+        Format::Xyz | Format::Txt | Format::Csv => {
+            xyz::read(input, out)?;
+            match format {
+                Format::Csv => "csv",
+                Format::Txt => "txt",
+                _ => "xyz",
+            }
+        }
+        Format::Las | Format::Laz => unreachable!("handled by the callers"),
+    };
+    input.finish();
+    Ok(name)
+}
+
+fn report(out: Points, format: &'static str) -> ReadReport {
+    let mut points = out.points;
+    points.shrink_to_fit();
+    ReadReport {
+        cloud: PointCloud { points },
+        non_finite_dropped: out.non_finite,
+        format,
+    }
+}

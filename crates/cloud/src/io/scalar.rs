@@ -1,0 +1,175 @@
+//! Scalar types shared by the PCD and PLY layouts: their sizes and how one
+//! value is turned into an `f32` coordinate.
+
+/// One numeric type of a PCD field or a PLY property.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(crate) enum Scalar {
+    I8,
+    U8,
+    I16,
+    U16,
+    I32,
+    U32,
+    I64,
+    U64,
+    F32,
+    F64,
+}
+
+impl Scalar {
+    /// Size of one value [bytes].
+    pub(crate) fn size(self) -> usize {
+        match self {
+            Scalar::I8 | Scalar::U8 => 1,
+            Scalar::I16 | Scalar::U16 => 2,
+            Scalar::I32 | Scalar::U32 | Scalar::F32 => 4,
+            Scalar::I64 | Scalar::U64 | Scalar::F64 => 8,
+        }
+    }
+
+    /// Whether the type is an integer (PLY list counts must be).
+    pub(crate) fn is_integer(self) -> bool {
+        !matches!(self, Scalar::F32 | Scalar::F64)
+    }
+
+    /// The PCD type from its TYPE letter and SIZE.
+    pub(crate) fn from_pcd(kind: char, size: usize) -> Option<Scalar> {
+        Some(match (kind, size) {
+            ('I', 1) => Scalar::I8,
+            ('U', 1) => Scalar::U8,
+            ('I', 2) => Scalar::I16,
+            ('U', 2) => Scalar::U16,
+            ('I', 4) => Scalar::I32,
+            ('U', 4) => Scalar::U32,
+            ('I', 8) => Scalar::I64,
+            ('U', 8) => Scalar::U64,
+            ('F', 4) => Scalar::F32,
+            ('F', 8) => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    /// The PLY type from its name (both the classic and the sized spellings).
+    pub(crate) fn from_ply(name: &str) -> Option<Scalar> {
+        Some(match name {
+            "char" | "int8" => Scalar::I8,
+            "uchar" | "uint8" => Scalar::U8,
+            "short" | "int16" => Scalar::I16,
+            "ushort" | "uint16" => Scalar::U16,
+            "int" | "int32" => Scalar::I32,
+            "uint" | "uint32" => Scalar::U32,
+            "float" | "float32" => Scalar::F32,
+            "double" | "float64" => Scalar::F64,
+            _ => return None,
+        })
+    }
+
+    /// The value at the start of `b` (at least `self.size()` bytes) as an
+    /// `f32`, rounded once (integers and doubles are converted directly).
+    #[inline]
+    pub(crate) fn to_f32(self, b: &[u8], big_endian: bool) -> f32 {
+        macro_rules! get {
+            ($t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                if big_endian {
+                    <$t>::from_be_bytes(a)
+                } else {
+                    <$t>::from_le_bytes(a)
+                }
+            }};
+        }
+        match self {
+            Scalar::I8 => b[0] as i8 as f32,
+            Scalar::U8 => b[0] as f32,
+            Scalar::I16 => get!(i16, 2) as f32,
+            Scalar::U16 => get!(u16, 2) as f32,
+            Scalar::I32 => get!(i32, 4) as f32,
+            Scalar::U32 => get!(u32, 4) as f32,
+            Scalar::I64 => get!(i64, 8) as f32,
+            Scalar::U64 => get!(u64, 8) as f32,
+            Scalar::F32 => get!(f32, 4),
+            Scalar::F64 => get!(f64, 8) as f32,
+        }
+    }
+
+    /// The value at the start of `b` as an unsigned count (PLY list
+    /// lengths); `None` for a negative value or a float type.
+    pub(crate) fn to_count(self, b: &[u8], big_endian: bool) -> Option<u64> {
+        if !self.is_integer() {
+            return None;
+        }
+        let v = self.to_i128(b, big_endian);
+        u64::try_from(v).ok()
+    }
+
+    fn to_i128(self, b: &[u8], big_endian: bool) -> i128 {
+        let n = self.size();
+        let mut a = [0u8; 8];
+        let signed = matches!(self, Scalar::I8 | Scalar::I16 | Scalar::I32 | Scalar::I64);
+        if big_endian {
+            a[8 - n..].copy_from_slice(&b[..n]);
+            let raw = u64::from_be_bytes(a);
+            sign_extend(raw, n, signed)
+        } else {
+            a[..n].copy_from_slice(&b[..n]);
+            let raw = u64::from_le_bytes(a);
+            sign_extend(raw, n, signed)
+        }
+    }
+
+    /// A text value of this type as an `f32` (one rounding step).
+    pub(crate) fn parse_f32(self, s: &str) -> Option<f32> {
+        match self {
+            Scalar::F32 => s.parse::<f32>().ok(),
+            Scalar::F64 => s.parse::<f64>().ok().map(|v| v as f32),
+            // Integer fields written by sloppy tools as "3.0" are accepted.
+            _ => s
+                .parse::<i64>()
+                .map(|v| v as f32)
+                .or_else(|_| s.parse::<u64>().map(|v| v as f32))
+                .ok()
+                .or_else(|| s.parse::<f64>().ok().map(|v| v as f32)),
+        }
+    }
+
+    /// A text list count.
+    pub(crate) fn parse_count(self, s: &str) -> Option<u64> {
+        if !self.is_integer() {
+            return None;
+        }
+        s.parse::<u64>().ok()
+    }
+}
+
+fn sign_extend(raw: u64, n: usize, signed: bool) -> i128 {
+    let bits = 8 * n as u32;
+    if signed && bits < 64 && raw & (1 << (bits - 1)) != 0 {
+        i128::from(raw) - (1i128 << bits)
+    } else if signed && bits == 64 {
+        i128::from(raw as i64)
+    } else {
+        i128::from(raw)
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn decodes_each_type_in_both_byte_orders() {
+        assert_eq!(Scalar::I8.to_f32(&[0xff], false), -1.0);
+        assert_eq!(Scalar::U8.to_f32(&[0xff], true), 255.0);
+        assert_eq!(Scalar::I16.to_f32(&(-300i16).to_be_bytes(), true), -300.0);
+        assert_eq!(Scalar::U16.to_f32(&60000u16.to_le_bytes(), false), 60000.0);
+        assert_eq!(Scalar::I32.to_f32(&(-7i32).to_le_bytes(), false), -7.0);
+        assert_eq!(Scalar::U32.to_f32(&7u32.to_be_bytes(), true), 7.0);
+        assert_eq!(Scalar::F64.to_f32(&0.5f64.to_be_bytes(), true), 0.5);
+        assert_eq!(Scalar::F32.to_f32(&1.25f32.to_le_bytes(), false), 1.25);
+        assert_eq!(Scalar::I16.to_count(&(-1i16).to_le_bytes(), false), None);
+        assert_eq!(Scalar::U8.to_count(&[200], false), Some(200));
+        assert_eq!(Scalar::I32.to_count(&5i32.to_be_bytes(), true), Some(5));
+        assert_eq!(Scalar::F32.to_count(&[0, 0, 0, 0], true), None);
+    }
+}

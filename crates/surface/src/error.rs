@@ -1,0 +1,81 @@
+//! Errors of calibration, floor estimation, surface fitting and pile generation.
+
+/// Everything that can go wrong in this crate. Each variant names the value at
+/// fault and, where there is one, what to change.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum SurfaceError {
+    /// A parameter out of its valid range.
+    #[error("{name} = {value}: expected {expected}")]
+    BadParameter {
+        /// The parameter, as `Struct.field`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The valid range, in words.
+        expected: &'static str,
+    },
+    /// Too few points for a stage to work with.
+    #[error("{stage}: {points} points, at least {required} needed{hint}")]
+    TooFewPoints {
+        /// The stage ("floor RANSAC", "surface fit", ...).
+        stage: &'static str,
+        /// Points available.
+        points: usize,
+        /// Points needed.
+        required: usize,
+        /// What to change (may be empty; starts with "; " otherwise).
+        hint: &'static str,
+    },
+    /// RANSAC found no plane within the allowed tilt that holds enough of the
+    /// lowest points to be the floor.
+    #[error(
+        "no floor: the best plane within {max_tilt_deg:.1} deg of horizontal holds {inliers} of \
+         {candidates} low points (at least {required} needed); raise TiltParams.floor_fraction, \
+         TiltParams.inlier_threshold_m or TiltParams.max_tilt_rad"
+    )]
+    NoFloor {
+        /// Inliers of the best plane found.
+        inliers: usize,
+        /// Low points searched.
+        candidates: usize,
+        /// Inliers required.
+        required: usize,
+        /// The largest accepted tilt of the floor [deg].
+        max_tilt_deg: f64,
+    },
+    /// The 8 × 8 samples do not determine even a plane (e.g. all on one line).
+    #[error(
+        "degenerate samples: {samples} grid samples have rank {rank} for the {terms} terms of a \
+         degree-{degree} polynomial; the cloud must span an area in x and y"
+    )]
+    DegenerateSamples {
+        /// Grid samples taken.
+        samples: usize,
+        /// Numerical rank of the design matrix.
+        rank: usize,
+        /// Polynomial terms.
+        terms: usize,
+        /// Polynomial total degree.
+        degree: usize,
+    },
+    /// The fitted surface explains too little of the samples' height variance
+    /// (rope-shovel paper §3.2 asks R² > 0.95).
+    #[error(
+        "poor surface fit: R² = {r2:.4} <= threshold {threshold} (degree {degree}, {samples} \
+         samples); clean the cloud first or lower/disable FitParams.r2_threshold"
+    )]
+    PoorFit {
+        /// Coefficient of determination on the grid samples.
+        r2: f64,
+        /// The threshold it had to exceed.
+        threshold: f64,
+        /// Total degree of the best polynomial.
+        degree: usize,
+        /// Grid samples used.
+        samples: usize,
+    },
+}
+
+/// Result alias of this crate.
+pub type Result<T> = std::result::Result<T, SurfaceError>;
