@@ -179,6 +179,8 @@ fn demo_writes_index_and_summary() {
     assert_eq!(
         keys,
         [
+            "perceive convex-concave pile",
+            "perceive typical pile",
             "plan-path curve apf",
             "plan-path curve improved-apf",
             "plan-path curve-reverse improved-apf",

@@ -14,7 +14,13 @@ use proptest::prelude::*;
 type Sample = (String, Format, Vec<u8>, bool);
 
 fn samples() -> Vec<Sample> {
-    let dir = std::env::temp_dir().join(format!("autoshovel-io-damaged-{}", std::process::id()));
+    use std::sync::atomic::{AtomicU64, Ordering};
+    static CALL: AtomicU64 = AtomicU64::new(0);
+    let dir = std::env::temp_dir().join(format!(
+        "autoshovel-io-damaged-{}-{}",
+        std::process::id(),
+        CALL.fetch_add(1, Ordering::Relaxed)
+    ));
     std::fs::create_dir_all(&dir).unwrap();
     let cloud = PointCloud::new(
         (0..40)
@@ -292,4 +298,14 @@ fn fuzz_regressions() {
     // the end of the names.
     let b = std::fs::read(data.join("fuzz_pcd_fields_twice.pcd")).unwrap();
     assert!(check("fields twice", Format::Pcd, &b).is_err());
+    // A LAS 1.4 header_size of 256 (below the 375 of the version): `las`
+    // still reads the VLRs after byte 375, the guard looked at byte 256,
+    // missed the LASzip record, and `laz` zero-filled a 2 GiB layer.
+    let b = std::fs::read(data.join("fuzz_laz_layer_size_short_header.laz")).unwrap();
+    let what = check("short header", Format::Laz, &b).unwrap_err();
+    assert!(what.contains("layers"), "{what}");
+    // Variable-size LASzip chunks whose table holds fewer points than the
+    // header claims: `laz` indexed its chunk table past the end (a panic).
+    let b = std::fs::read(data.join("fuzz_laz_chunk_table_too_short.laz")).unwrap();
+    assert!(check("short table", Format::Laz, &b).is_err());
 }

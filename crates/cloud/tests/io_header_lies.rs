@@ -229,7 +229,7 @@ fn laz_lies() {
     let data = get_u32(&b, 96) as usize;
     // 8 bytes of table offset, a raw 30-byte first point, the point count.
     put_u32(&mut b, data + 8 + 30 + 4, 0xFFFF_FFF0);
-    refuses("layer", Format::Laz, &b, "layer of");
+    refuses("layer", Format::Laz, &b, "bytes of layers");
     // A LASzip record listing no items (laz would panic).
     let mut b = las_bytes(true, LasVersion::V1_2, 10);
     let pos = b.windows(14).position(|w| w == b"laszip encoded").unwrap() - 2;

@@ -7,7 +7,7 @@
 //! machine (PCL 1.13 needs 10.7 s for the whole statistical filter), mostly
 //! because its pruning bound `rd + (new_off − old_off)²` is much weaker than
 //! the exact `rd − old_off² + new_off²`. This tree uses the exact bound, splits
-//! at the median of the widest axis, stores the points in tree order, and
+//! at the median of the axis of largest variance, stores the points in tree order, and
 //! the filters query the points in that order, so that consecutive queries
 //! touch the same memory.
 //!
@@ -31,6 +31,9 @@ const LEAF: usize = 16;
 /// Above this many points a subtree is built in parallel.
 const PARALLEL_BUILD: usize = 32 * 1024;
 
+/// How many previous points bound the next k-nearest search.
+const HISTORY: usize = 16;
+
 /// Relative slack of the pruning test (see the module docs).
 const SLACK: f64 = 1.0 + 1e-6;
 
@@ -51,6 +54,9 @@ pub(crate) struct KdTree {
     splits: Vec<(u8, f32)>,
     /// Number of inner levels.
     depth: u32,
+    /// Tight bounding box (lo, hi) of the points of every node, inner and
+    /// leaf, in the same heap order.
+    boxes: Vec<(Point, Point)>,
     /// The points in tree order.
     points: Vec<Point>,
     /// For each point in tree order, its index in the input.
@@ -74,13 +80,52 @@ impl KdTree {
         for (node, split) in found {
             splits[node] = split;
         }
-        let (points, ids) = entries.into_iter().unzip();
+        let (points, ids): (Vec<Point>, Vec<u32>) = entries.into_iter().unzip();
+        let empty = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        let mut boxes = vec![empty; 2 * inner + 1];
+        // Leaves from their points, then every inner node from its children.
+        let mut ranges = Vec::with_capacity(inner + 1);
+        leaf_ranges(0, n, depth, &mut ranges);
+        for (leaf, &(start, len)) in ranges.iter().enumerate() {
+            let b = &mut boxes[inner + leaf];
+            for p in &points[start..start + len] {
+                for a in 0..3 {
+                    b.0[a] = b.0[a].min(p[a]);
+                    b.1[a] = b.1[a].max(p[a]);
+                }
+            }
+        }
+        for node in (0..inner).rev() {
+            let (l, r) = (boxes[2 * node + 1], boxes[2 * node + 2]);
+            boxes[node] = ([0, 1, 2].map(|a| l.0[a].min(r.0[a])), [0, 1, 2].map(|a| l.1[a].max(r.1[a])));
+        }
         Self {
             splits,
             depth,
+            boxes,
             points,
             ids,
         }
+    }
+
+    /// Squared distance (f64, exact up to its last bit) from `q` to the box
+    /// of `node`: a lower bound of the distance to any of its points.
+    #[inline]
+    fn box_distance(&self, node: usize, q: &Point) -> f64 {
+        let (lo, hi) = &self.boxes[node];
+        let mut d2 = 0.0;
+        for a in 0..3 {
+            let (x, l, h) = (f64::from(q[a]), f64::from(lo[a]), f64::from(hi[a]));
+            let d = if x < l {
+                l - x
+            } else if x > h {
+                x - h
+            } else {
+                0.0
+            };
+            d2 += d * d;
+        }
+        d2
     }
 
     /// Number of points.
@@ -122,7 +167,7 @@ impl KdTree {
     /// The k nearest points to `q` (as tree positions with their squared
     /// distances), nearest first, into `knn`.
     pub(crate) fn nearest(&self, q: &Point, knn: &mut Nearest) {
-        knn.clear();
+        knn.reset(f32::INFINITY);
         let mut off = [0.0f64; 3];
         self.nearest_in(0, 0, self.len(), self.depth, q, &mut off, 0.0, knn);
     }
@@ -224,74 +269,128 @@ impl KdTree {
     /// (inclusive, `q` itself included), in tree order, into `out`.
     pub(crate) fn within(&self, q: &Point, r2: f32, out: &mut Vec<u32>) {
         out.clear();
-        let mut off = [0.0f64; 3];
-        self.within_in(0, 0, self.len(), self.depth, q, &mut off, 0.0, r2, out);
+        self.for_each_within(q, r2, |_, pos| out.push(pos));
     }
 
-    #[allow(clippy::too_many_arguments)]
-    fn within_in(
-        &self,
-        node: usize,
-        start: usize,
-        len: usize,
-        levels: u32,
-        q: &Point,
-        off: &mut [f64; 3],
-        rd: f64,
-        r2: f32,
-        out: &mut Vec<u32>,
-    ) {
-        if levels == 0 {
-            for (i, p) in self.points[start..start + len].iter().enumerate() {
-                if squared_distance(q, p) <= r2 {
-                    out.push((start + i) as u32);
-                }
-            }
-            return;
-        }
-        let (axis, split) = self.splits[node];
-        let a = axis as usize;
-        let half = len / 2;
-        let diff = f64::from(q[a]) - f64::from(split);
-        let old = off[a];
-        let far_rd = rd - old * old + diff * diff;
-        let visit_far = far_rd <= f64::from(r2) * SLACK;
-        // Left before right, so that the output is in tree order.
-        let left = (2 * node + 1, start, half, diff < 0.0 || visit_far);
-        let right = (2 * node + 2, start + half, len - half, diff >= 0.0 || visit_far);
-        for (child, s, l, visit) in [left, right] {
-            if !visit {
+    /// Calls `sink(d², position)` for every point within squared distance
+    /// `r2` of `q` (inclusive), in tree order. Nodes are pruned by their
+    /// tight bounding boxes.
+    fn for_each_within<F: FnMut(f32, u32)>(&self, q: &Point, r2: f32, mut sink: F) {
+        let limit = f64::from(r2) * SLACK;
+        let first_leaf = (1usize << self.depth) - 1;
+        // Depth-first, left before right: (node, start, len).
+        let mut stack = [(0usize, 0usize, 0usize); 66];
+        stack[0] = (0, 0, self.len());
+        let mut top = 1;
+        while top > 0 {
+            top -= 1;
+            let (node, start, len) = stack[top];
+            if self.box_distance(node, q) > limit {
                 continue;
             }
-            let is_far = (child == 2 * node + 1) != (diff < 0.0);
-            if is_far {
-                off[a] = diff.abs();
-                self.within_in(child, s, l, levels - 1, q, off, far_rd, r2, out);
-                off[a] = old;
-            } else {
-                self.within_in(child, s, l, levels - 1, q, off, rd, r2, out);
+            if node >= first_leaf {
+                for (i, p) in self.points[start..start + len].iter().enumerate() {
+                    let d = squared_distance(q, p);
+                    if d <= r2 {
+                        sink(d, (start + i) as u32);
+                    }
+                }
+                continue;
             }
+            let half = len / 2;
+            stack[top] = (2 * node + 2, start + half, len - half);
+            stack[top + 1] = (2 * node + 1, start, half);
+            top += 2;
         }
     }
+
+    /// For every point of the tree, `f` of the squared distances to its k
+    /// nearest points (itself included), nearest first; results in input
+    /// order. Exactly the distances [`KdTree::nearest`] finds, faster: the
+    /// points are visited in tree order, and each of the last 16 points q'
+    /// of the same task, whose k-th nearest lies at r', bounds the k nearest
+    /// of the next point q within r' + ‖q − q'‖ (triangle inequality; the
+    /// smallest such bound is taken and widened by a relative 1e-5 for the
+    /// f32 rounding). The search then only collects the points within that
+    /// cap, with no pruning bound to update, and keeps the k smallest.
+    pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
+    where
+        T: Send + Clone + Default,
+        F: Fn(&[f32]) -> T + Sync + Send,
+    {
+        assert!(k >= 1 && k <= self.len(), "1 <= k <= number of points");
+        let in_tree_order: Vec<T> = (0..self.len())
+            .into_par_iter()
+            .map_init(
+                || (Nearest::new(k), Vec::<f32>::new(), Vec::<u32>::new(), Vec::<(Point, f64)>::with_capacity(HISTORY)),
+                |(knn, dist, bits, history), pos| {
+                    let q = &self.points[pos];
+                    // The tightest bound among the last few points of the task.
+                    let reach = history
+                        .iter()
+                        .map(|(p, r)| r + (0..3).map(|a| (f64::from(q[a]) - f64::from(p[a])).powi(2)).sum::<f64>().sqrt())
+                        .fold(f64::INFINITY, f64::min);
+                    // Squared distances are ≥ +0, whose f32 bit patterns sort
+                    // as the numbers do: select and sort them as integers.
+                    bits.clear();
+                    if reach < f64::INFINITY {
+                        self.for_each_within(q, widen(reach), |d, _| bits.push(d.to_bits()));
+                    }
+                    if bits.len() >= k {
+                        let (smaller, _, _) = bits.select_nth_unstable(k - 1);
+                        smaller.sort_unstable();
+                        dist.clear();
+                        dist.extend(bits[..k].iter().map(|&b| f32::from_bits(b)));
+                    } else {
+                        // First point of the task (a cap too small cannot happen).
+                        self.nearest(q, knn);
+                        dist.clear();
+                        dist.extend_from_slice(knn.distances());
+                    }
+                    if history.len() == HISTORY {
+                        history.remove(0);
+                    }
+                    history.push((*q, f64::from(dist[k - 1]).sqrt()));
+                    f(&dist[..k])
+                },
+            )
+            .collect();
+        let mut out = vec![T::default(); self.len()];
+        for (pos, value) in in_tree_order.into_iter().enumerate() {
+            out[self.ids[pos] as usize] = value;
+        }
+        out
+    }
+}
+
+/// The (start, length) of every leaf, left to right.
+fn leaf_ranges(start: usize, len: usize, levels: u32, out: &mut Vec<(usize, usize)>) {
+    if levels == 0 {
+        out.push((start, len));
+    } else {
+        let half = len / 2;
+        leaf_ranges(start, half, levels - 1, out);
+        leaf_ranges(start + half, len - half, levels - 1, out);
+    }
+}
+
+/// The squared distance `r²` widened by a relative 1e-5 (far above the f32
+/// rounding of a squared distance), as f32: a cap that surely holds every
+/// point whose true distance is at most `r`.
+fn widen(r: f64) -> f32 {
+    (r * r * (1.0 + 1e-5)) as f32
 }
 
 /// Builds the subtree of `node` over `entries`, pushing (node, split) pairs.
 fn build(entries: &mut [(Point, u32)], node: usize, levels: u32, found: &mut Vec<(usize, (u8, f32))>) {
+    let axis = axis_of_largest_variance(entries);
     if levels == 0 {
+        // A leaf is sorted along its own longest direction, so that
+        // consecutive points (consecutive queries) are close.
+        entries.sort_unstable_by(|x, y| x.0[axis].total_cmp(&y.0[axis]).then(x.1.cmp(&y.1)));
         return;
     }
-    // Split the widest axis of the points' bounding box at the median.
-    let mut lo = [f32::INFINITY; 3];
-    let mut hi = [f32::NEG_INFINITY; 3];
-    for (p, _) in entries.iter() {
-        for a in 0..3 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
-    let axis = (0..3)
-        .max_by(|&a, &b| (hi[a] - lo[a]).total_cmp(&(hi[b] - lo[b])).then(b.cmp(&a)))
-        .expect("three axes");
+    // Split at the median.
     let half = entries.len() / 2;
     // Ties broken by input index, so the tree does not depend on the
     // selection algorithm's choices.
@@ -311,9 +410,35 @@ fn build(entries: &mut [(Point, u32)], node: usize, levels: u32, found: &mut Vec
     }
 }
 
+/// The axis along which `entries` vary most. (Not the widest extent: on a
+/// scanned floor, range noise makes z the widest axis of a small cell, and
+/// cutting it yields flat leaves metres wide.)
+fn axis_of_largest_variance(entries: &[(Point, u32)]) -> usize {
+    let count = entries.len().max(1) as f64;
+    let mut mean = [0.0f64; 3];
+    for (p, _) in entries {
+        for a in 0..3 {
+            mean[a] += f64::from(p[a]);
+        }
+    }
+    let mean = mean.map(|m| m / count);
+    let mut var = [0.0f64; 3];
+    for (p, _) in entries {
+        for a in 0..3 {
+            let d = f64::from(p[a]) - mean[a];
+            var[a] += d * d;
+        }
+    }
+    (0..3)
+        .max_by(|&a, &b| var[a].total_cmp(&var[b]).then(b.cmp(&a)))
+        .expect("three axes")
+}
+
 /// A bounded list of the k nearest found so far, nearest first.
 pub(crate) struct Nearest {
     k: usize,
+    len: usize,
+    cap: f32,
     dist: Vec<f32>,
     pos: Vec<u32>,
 }
@@ -323,53 +448,63 @@ impl Nearest {
     pub(crate) fn new(k: usize) -> Self {
         Self {
             k,
-            dist: Vec::with_capacity(k + 1),
-            pos: Vec::with_capacity(k + 1),
+            len: 0,
+            cap: f32::INFINITY,
+            dist: vec![0.0; k],
+            pos: vec![0; k],
         }
     }
 
-    fn clear(&mut self) {
-        self.dist.clear();
-        self.pos.clear();
+    /// Empties the list; until it is full, only points with squared
+    /// distance `<= cap` enter.
+    fn reset(&mut self, cap: f32) {
+        self.len = 0;
+        self.cap = cap;
     }
 
-    /// The squared distance a point must beat (or tie) to enter.
+    /// The squared distance a point must not exceed to enter.
     #[inline]
     fn worst(&self) -> f32 {
-        if self.dist.len() < self.k {
-            f32::INFINITY
-        } else {
+        if self.len == self.k {
             self.dist[self.k - 1]
+        } else {
+            self.cap
         }
     }
 
     #[inline]
     fn offer(&mut self, d: f32, pos: u32) {
-        let full = self.dist.len() == self.k;
-        if full && d >= self.dist[self.k - 1] {
-            return;
-        }
+        let mut i = if self.len == self.k {
+            // Full: only a strictly nearer point enters (as in FLANN).
+            if d >= self.dist[self.k - 1] {
+                return;
+            }
+            self.k - 1
+        } else {
+            if d > self.cap {
+                return;
+            }
+            self.len += 1;
+            self.len - 1
+        };
         // Insertion keeps equal distances in arrival order.
-        let mut i = self.dist.len();
         while i > 0 && self.dist[i - 1] > d {
+            self.dist[i] = self.dist[i - 1];
+            self.pos[i] = self.pos[i - 1];
             i -= 1;
         }
-        self.dist.insert(i, d);
-        self.pos.insert(i, pos);
-        if full {
-            self.dist.pop();
-            self.pos.pop();
-        }
+        self.dist[i] = d;
+        self.pos[i] = pos;
     }
 
     /// Squared distances, nearest first.
     pub(crate) fn distances(&self) -> &[f32] {
-        &self.dist
+        &self.dist[..self.len]
     }
 
     /// Tree positions, nearest first.
     pub(crate) fn positions(&self) -> &[u32] {
-        &self.pos
+        &self.pos[..self.len]
     }
 }
 
@@ -398,14 +533,19 @@ mod tests {
             let tree = KdTree::new(&pts);
             let mut knn = Nearest::new(7.min(n));
             let mut out = Vec::new();
+            // All k nearest at once, leaf by leaf: the same distances.
+            let k = 7.min(n);
+            let batched = tree.map_k_nearest_distances(k, |d| d.to_vec());
+            for (i, q) in pts.iter().enumerate() {
+                let mut all: Vec<f32> = pts.iter().map(|p| squared_distance(q, p)).collect();
+                all.sort_by(f32::total_cmp);
+                assert_eq!(batched[i], &all[..k], "point {i}");
+            }
             for q in pts.iter().step_by(3).chain([[0.5, 0.5, 0.5]].iter()) {
                 let mut all: Vec<f32> = pts.iter().map(|p| squared_distance(q, p)).collect();
                 all.sort_by(f32::total_cmp);
                 tree.nearest(q, &mut knn);
                 assert_eq!(knn.distances(), &all[..7.min(n)]);
-                for (d, &pos) in knn.distances().iter().zip(knn.positions()) {
-                    assert_eq!(*d, squared_distance(q, &tree.points()[pos as usize]));
-                }
                 let r2 = all[(n / 3).min(n - 1)];
                 let inside = all.iter().filter(|&&d| d <= r2).count();
                 tree.within(q, r2, &mut out);

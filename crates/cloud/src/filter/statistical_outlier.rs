@@ -37,7 +37,7 @@
 //! its k neighbours include the point itself (so its mean is over k − 1 true
 //! neighbours), and it uses the population standard deviation (n).
 
-use super::kdtree::{KdTree, Nearest};
+use super::kdtree::KdTree;
 use super::neighbours::{bad, empty_input, emptied, gather, on_finite_points};
 use crate::{Point, PointCloud, Result};
 
@@ -118,14 +118,10 @@ pub fn statistical_outlier_removal(
 /// nearest first, divided by k, stored as f32).
 pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f32> {
     let tree = KdTree::new(points);
-    tree.map_points(
-        || Nearest::new(mean_k + 1),
-        |knn, _, p| {
-            tree.nearest(p, knn);
-            let sum = knn.distances()[1..].iter().fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
-            (sum / mean_k as f64) as f32
-        },
-    )
+    tree.map_k_nearest_distances(mean_k + 1, |nearest| {
+        let sum = nearest[1..].iter().fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
+        (sum / mean_k as f64) as f32
+    })
 }
 
 /// The kept indices of `points` (all finite, not empty).

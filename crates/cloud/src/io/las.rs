@@ -23,11 +23,15 @@
 //!   hold (every chunk starts with one raw point, ≥ 20 bytes; we allow one
 //!   chunk per [`LAZ_MIN_CHUNK_BYTES`]), since `laz` reserves the table
 //!   from that count;
-//! - a layered (LAS 1.4, point formats 6–10) LASzip chunk with a layer
-//!   larger than the rest of the file, since `laz` zero-fills a buffer of
-//!   each announced layer size before reading it; every chunk header is
-//!   walked (a few seeks per 50 000 points) before decoding starts;
-//! - a LASzip record with no items (`laz` would panic).
+//! - a layered (LAS 1.4, point formats 6–10) LASzip chunk whose layers add
+//!   up to more than the rest of the file, since `laz` zero-fills a buffer
+//!   of each announced layer size before reading it; every chunk header is
+//!   walked (a few seeks per 50 000 points) before decoding starts, and a
+//!   layered file whose chunk table cannot be read is refused (`laz` would
+//!   decode from wherever the failed attempt left the stream);
+//! - a LASzip record with no items, or variable-size chunks whose table
+//!   holds fewer points than the header's count (`laz` would panic: it
+//!   indexes the table past its end).
 //!
 //! Points are then read one at a time (`read_point`, never `read_points`,
 //! which reserves the header's count) straight into the cloud's vector.
@@ -133,9 +137,18 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
             "the point data offset {offset} lies past the end of the file ({total} bytes)"
         ));
     }
-    if n_vlrs.saturating_mul(VLR_HEADER) > offset.saturating_sub(header_size) {
+    // `las` reads the fixed fields of the version, then pads up to
+    // `header_size` if that is larger, then the VLRs.
+    let (fields, nominal) = match (major, minor) {
+        (1, 4) => (375, 375),
+        (1, 3) => (235, 235),
+        (1, 0..=2) => (227, 227),
+        _ => (227, 375),
+    };
+    let vlr_start = fields + header_size.saturating_sub(nominal);
+    if n_vlrs.saturating_mul(VLR_HEADER) > offset.saturating_sub(vlr_start) {
         return Err(format!(
-            "{n_vlrs} variable-length records cannot fit between the header ({header_size} bytes) and the point data at byte {offset}"
+            "{n_vlrs} variable-length records cannot fit between byte {vlr_start} and the point data at byte {offset}"
         ));
     }
     let data_bytes = total - offset;
@@ -178,126 +191,151 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
         record_len,
     };
     if compressed {
-        check_laz(src, total, header_size, n_vlrs, &c)?;
+        check_laz(src, total, vlr_start, n_vlrs, &c)?;
     }
     Ok(c)
 }
 
-/// The LASzip checks: items, chunk table, layer sizes.
-fn check_laz<R: Read + Seek>(
-    src: &mut R,
-    total: u64,
-    header_size: u64,
-    n_vlrs: u64,
-    c: &Checked,
-) -> Result<(), String> {
+/// The LASzip checks: items, chunk table, layer sizes. They follow what
+/// `las` and `laz` do step by step: where the VLRs start, which VLR is the
+/// LASzip one, where decoding starts.
+#[cfg(feature = "laz")]
+fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u64, c: &Checked) -> Result<(), String> {
     let io = |e: std::io::Error| format!("reading the LASzip records: {e}");
-    // Find the LASzip VLR ("laszip encoded", record 22204), as `las` does.
-    let mut pos = header_size;
-    let mut items: Option<Vec<(u16, u16, u16)>> = None;
+    let mut pos = vlr_start;
+    let mut found = None;
     for _ in 0..n_vlrs {
         let mut v = [0u8; VLR_HEADER as usize];
         if !read_at(src, pos, &mut v).map_err(io)? {
             return Ok(()); // `las` reports the truncation
         }
         let len = le16(&v, 20);
-        if v[2..16] == *b"laszip encoded" && le16(&v, 18) == 22204 {
-            let mut d = vec![0u8; len as usize];
-            if !read_at(src, pos + VLR_HEADER, &mut d).map_err(io)? || d.len() < 34 {
-                return Ok(()); // `las`/`laz` report it
-            }
-            let n = le16(&d, 32) as usize;
-            if n == 0 {
-                return Err("the LASzip record lists no items".into());
-            }
-            if d.len() < 34 + 6 * n {
-                return Ok(());
-            }
-            items = Some(
-                (0..n)
-                    .map(|i| {
-                        let at = 34 + 6 * i;
-                        (
-                            le16(&d, at) as u16,
-                            le16(&d, at + 2) as u16,
-                            le16(&d, at + 4) as u16,
-                        )
-                    })
-                    .collect(),
-            );
+        // The user id up to its first NUL, as `las` compares it.
+        let id_end = v[2..18].iter().position(|&b| b == 0).map_or(18, |i| i + 2);
+        if &v[2..id_end] == b"laszip encoded" && le16(&v, 18) == 22204 {
+            found = Some((pos + VLR_HEADER, len));
             break;
         }
         pos += VLR_HEADER + len;
     }
-    let Some(items) = items else { return Ok(()) };
-    // Chunk table: its offset is the first 8 bytes of the point data, or
-    // the last 8 bytes of the file when the writer could not seek back.
-    let data_start = c.offset;
-    let mut b8 = [0u8; 8];
-    if !read_at(src, data_start, &mut b8).map_err(io)? {
+    let Some((at, len)) = found else { return Ok(()) };
+    let mut d = vec![0u8; len as usize];
+    if !read_at(src, at, &mut d).map_err(io)? {
         return Ok(());
     }
-    let mut table = i64::from_le_bytes(b8);
-    if table <= data_start as i64 && total >= 8 {
-        read_at(src, total - 8, &mut b8).map_err(io)?;
-        table = i64::from_le_bytes(b8);
+    let Ok(vlr) = laz::LazVlr::from_buffer(&d) else {
+        return Ok(()); // `las` refuses it the same way
+    };
+    if vlr.items().is_empty() {
+        return Err("the LASzip record lists no items".into());
     }
-    let table = (table > data_start as i64).then_some(table as u64);
-    if let Some(table) = table {
-        if table.saturating_add(8) <= total && read_at(src, table, &mut b8).map_err(io)? {
-            let chunks = le32(&b8, 4);
-            let bound = (table - data_start) / LAZ_MIN_CHUNK_BYTES + 1;
-            if chunks > bound {
-                return Err(format!(
-                    "the LASzip chunk table at byte {table} claims {chunks} chunks; {} bytes of compressed points hold at most {bound}",
-                    table - data_start
-                ));
+    let compressor = le16(&d, 0);
+    let layered = matches!(vlr.items()[0].version(), 3 | 4);
+    let data_start = c.offset;
+    if compressor != 1 {
+        // Chunk table: its offset is the first 8 bytes of the point data,
+        // or the last 8 bytes of the file when the writer could not seek.
+        let mut b8 = [0u8; 8];
+        if !read_at(src, data_start, &mut b8).map_err(io)? {
+            return Ok(());
+        }
+        let mut table = i64::from_le_bytes(b8);
+        if table <= data_start as i64 && total >= 8 {
+            read_at(src, total - 8, &mut b8).map_err(io)?;
+            table = i64::from_le_bytes(b8);
+        }
+        if table > data_start as i64 {
+            let table = table as u64;
+            if table.saturating_add(8) <= total && read_at(src, table, &mut b8).map_err(io)? {
+                let chunks = le32(&b8, 4);
+                let bound = (table - data_start) / LAZ_MIN_CHUNK_BYTES + 1;
+                if chunks > bound {
+                    return Err(format!(
+                        "the LASzip chunk table at byte {table} claims {chunks} chunks; {} bytes of compressed points hold at most {bound}",
+                        table - data_start
+                    ));
+                }
+            }
+        }
+        let variable = vlr.uses_variable_size_chunks();
+        if layered || variable {
+            src.seek(SeekFrom::Start(data_start)).map_err(io)?;
+            match laz::laszip::ChunkTable::read_from(&mut *src, &vlr) {
+                // When the table cannot be read, `laz` goes on decoding from
+                // wherever the attempt left the stream: refuse that for
+                // layered data, whose chunks announce buffer sizes.
+                Err(_) if layered => {
+                    return Err("the LASzip chunk table cannot be read (damaged or truncated file)".into())
+                }
+                Err(_) => {}
+                // With variable-size chunks `laz` indexes the table by chunk
+                // number and panics past its end: the chunks must hold the
+                // header's point count.
+                Ok(table) if variable => {
+                    let mut left = c.count;
+                    for entry in table.as_ref() {
+                        if entry.point_count == 0 || left <= entry.point_count {
+                            left = 0;
+                            break;
+                        }
+                        left -= entry.point_count;
+                    }
+                    if left > 0 {
+                        return Err(format!(
+                            "the LASzip chunk table's {} chunks hold fewer than the header's {} points",
+                            table.len(),
+                            c.count
+                        ));
+                    }
+                }
+                Ok(_) => {}
             }
         }
     }
-    // Layered chunks (item version 3): walk the chunk headers.
-    if items.first().map(|i| i.2) != Some(3) {
+    if !layered {
         return Ok(());
     }
+    // Layered chunks: [first point, raw][u32 count][u32 size per layer]
+    // [layers]; `laz` zero-fills a buffer of each size before reading it.
     let mut first_point = 0u64;
     let mut layers = 0u64;
-    for &(kind, size, _) in &items {
-        let (bytes, l) = match kind {
-            10 => (30, 9),                            // Point14
-            11 => (6, 1),                             // RGB14
-            12 => (8, 2),                             // RGBNIR14: RGB and NIR
-            13 => (29, 1),                            // WavePacket14
-            14 => (u64::from(size), u64::from(size)), // Byte14: a layer per byte
-            _ => return Ok(()),                       // `laz` refuses it
+    for item in vlr.items() {
+        let (bytes, l) = match item.item_type() {
+            laz::LazItemType::Point14 => (30, 9),
+            laz::LazItemType::RGB14 => (6, 1),
+            laz::LazItemType::RGBNIR14 => (8, 2),
+            laz::LazItemType::WavePacket14 => (29, 1),
+            laz::LazItemType::Byte14(n) => (u64::from(n), u64::from(n)),
+            _ => return Ok(()), // `laz` refuses it
         };
         first_point += bytes;
         layers += l;
     }
-    let end = table.unwrap_or(total).min(total);
-    let mut pos = data_start + 8;
-    let mut seen = 0u64;
+    let mut pos = if compressor == 1 { data_start } else { data_start + 8 };
     let mut sizes = vec![0u8; 4 + 4 * layers as usize];
-    while pos < end && seen < c.count {
+    // Until the file ends: a header count larger than the chunks hold makes
+    // `laz` read "chunks" out of whatever follows.
+    loop {
         let chunk = pos;
         pos += first_point;
         if pos + sizes.len() as u64 > total || !read_at(src, pos, &mut sizes).map_err(io)? {
-            return Ok(()); // `laz` reports the truncation
+            return Ok(()); // `laz` stops with an end-of-file error here
         }
         pos += sizes.len() as u64;
-        let mut sum = 0u64;
-        for k in 0..layers as usize {
-            let s = le32(&sizes, 4 + 4 * k);
-            if s > total - pos {
-                return Err(format!(
-                    "the LASzip chunk at byte {chunk} announces a layer of {s} bytes, more than the rest of the file"
-                ));
-            }
-            sum += s;
+        let sum: u64 = (0..layers as usize).map(|k| le32(&sizes, 4 + 4 * k)).sum();
+        if sum > total - pos {
+            return Err(format!(
+                "the LASzip chunk at byte {chunk} announces {sum} bytes of layers, more than the rest of the file ({} bytes)",
+                total - pos
+            ));
         }
-        seen += le32(&sizes, 0).max(1);
-        pos = pos.saturating_add(sum);
+        pos += sum;
     }
-    Ok(())
+}
+
+#[cfg(not(feature = "laz"))]
+fn check_laz<R: Read + Seek>(_: &mut R, _: u64, _: u64, _: u64, _: &Checked) -> Result<(), String> {
+    Ok(()) // `las` refuses compressed data without the feature
 }
 
 fn las_err(path: &Path, e: las::Error) -> CloudError {

@@ -1,0 +1,189 @@
+//! `autoshovel generate-pile` and `autoshovel perceive`: every shape and
+//! format round trip through the pipeline, and bad input.
+
+mod common;
+
+use common::*;
+
+#[test]
+fn every_shape_and_format_recovers_the_tilt_and_fits() {
+    let dir = TempDir::new("piles");
+    let shapes = ["typical", "convex", "concave", "convex-concave"];
+    let formats = ["pcd", "ply", "las", "laz", "xyz"];
+    for (i, shape) in shapes.iter().enumerate() {
+        // Each shape once per format would be 20 runs: rotate the formats over the shapes
+        // and give the first shape every format.
+        let fmts: Vec<&str> = if i == 0 {
+            formats.to_vec()
+        } else {
+            vec![formats[i % formats.len()]]
+        };
+        for ext in fmts {
+            let file = dir.path().join(format!("{shape}.{ext}"));
+            let g = run(&[
+                "generate-pile".as_ref(),
+                "--shape".as_ref(),
+                shape.as_ref(),
+                "--points".as_ref(),
+                "60000".as_ref(),
+                "--seed".as_ref(),
+                "3".as_ref(),
+                "--roll".as_ref(),
+                "2.5".as_ref(),
+                "--pitch".as_ref(),
+                "-1.5".as_ref(),
+                "--out".as_ref(),
+                file.as_os_str(),
+                "--json".as_ref(),
+            ])
+            .ok()
+            .json();
+            assert_eq!(g["points"], 60000);
+            let s = run(&[
+                "perceive".as_ref(),
+                "--input".as_ref(),
+                file.as_os_str(),
+                "--json".as_ref(),
+            ])
+            .ok()
+            .json();
+            for key in [
+                "input_points",
+                "output_points",
+                "stage_points",
+                "roll_deg",
+                "pitch_deg",
+                "r2",
+                "timings_ms",
+            ] {
+                assert!(!s[key].is_null(), "{shape}.{ext}: {key} missing");
+            }
+            assert_eq!(s["input_points"], 60000, "{shape}.{ext}");
+            let roll = f64_field(&s, "roll_deg");
+            let pitch = f64_field(&s, "pitch_deg");
+            assert!(
+                (roll - 2.5).abs() < 0.2 && (pitch + 1.5).abs() < 0.2,
+                "{shape}.{ext}: roll {roll}, pitch {pitch}"
+            );
+            assert!(f64_field(&s, "r2") > 0.95, "{shape}.{ext}: {s:#}");
+        }
+    }
+}
+
+#[test]
+fn perceive_writes_the_cleaned_cloud_surface_and_plots() {
+    let dir = TempDir::new("perceive-out");
+    let file = dir.path().join("scan.ply");
+    run(&[
+        "generate-pile".as_ref(),
+        "--points".as_ref(),
+        "40000".as_ref(),
+        "--out".as_ref(),
+        file.as_os_str(),
+    ])
+    .ok();
+    let out = dir.path().join("out");
+    let s = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        file.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    for f in [
+        "summary.json",
+        "cleaned.pcd",
+        "surface_grid.csv",
+        "fit_samples.csv",
+        "height_map.svg",
+        "height_map.png",
+        "residuals.svg",
+        "profile.svg",
+    ] {
+        assert!(out.join(f).exists(), "{f} missing");
+    }
+    // The cleaned cloud holds the count the summary gives (its PCD header says so).
+    let bytes = std::fs::read(out.join("cleaned.pcd")).unwrap();
+    let head = String::from_utf8_lossy(&bytes[..bytes.len().min(400)]).to_string();
+    let points: usize = head
+        .lines()
+        .find_map(|l| l.strip_prefix("POINTS "))
+        .unwrap()
+        .trim()
+        .parse()
+        .unwrap();
+    assert_eq!(serde_json::json!(points), s["output_points"]);
+}
+
+#[test]
+fn bad_scans_and_settings_are_refused_clearly() {
+    let dir = TempDir::new("perceive-bad");
+    let missing = dir.path().join("nope.pcd");
+    let r = run(&["perceive".as_ref(), "--input".as_ref(), missing.as_os_str()]).fails();
+    assert!(
+        r.error_message().contains("nope.pcd"),
+        "{}",
+        r.error_message()
+    );
+    let unknown = dir.write("scan.e57", "whatever");
+    let r = run(&["perceive".as_ref(), "--input".as_ref(), unknown.as_os_str()]).fails();
+    assert!(r.error_message().contains("e57"), "{}", r.error_message());
+    let empty = dir.write("empty.xyz", "");
+    let r = run(&["perceive".as_ref(), "--input".as_ref(), empty.as_os_str()]).fails();
+    assert!(
+        r.error_message().contains("empty.xyz"),
+        "{}",
+        r.error_message()
+    );
+    let lies = dir.write("lies.pcd", "VERSION .7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 4000000000\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS 4000000000\nDATA binary\n\u{0}\u{0}\u{0}\u{0}");
+    let r = run(&["perceive".as_ref(), "--input".as_ref(), lies.as_os_str()]).fails();
+    assert!(
+        r.error_message().contains("lies.pcd"),
+        "{}",
+        r.error_message()
+    );
+    // Settings: a leaf of zero, an unknown key.
+    let scan = dir.path().join("scan.pcd");
+    run(&[
+        "generate-pile".as_ref(),
+        "--points".as_ref(),
+        "20000".as_ref(),
+        "--out".as_ref(),
+        scan.as_os_str(),
+    ])
+    .ok();
+    let cfg = dir.write("zero.toml", "[voxel]\nleaf_spacings = 0.0\n");
+    let r = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        scan.as_os_str(),
+        "--config".as_ref(),
+        cfg.as_os_str(),
+    ])
+    .fails();
+    assert!(
+        r.error_message().to_lowercase().contains("leaf"),
+        "{}",
+        r.error_message()
+    );
+    let cfg = dir.write("typo.toml", "[voxel]\nleaf = 0.1\n");
+    let r = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        scan.as_os_str(),
+        "--config".as_ref(),
+        cfg.as_os_str(),
+    ])
+    .fails();
+    assert!(
+        r.error_message().contains("typo.toml:2") && r.error_message().contains("leaf"),
+        "{}",
+        r.error_message()
+    );
+    let r = run(&["generate-pile", "--shape", "pyramid", "--out", "x.pcd"]);
+    assert_ne!(r.code(), Some(0));
+    r.no_panic();
+}
