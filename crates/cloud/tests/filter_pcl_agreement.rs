@@ -15,7 +15,9 @@ use autoshovel_cloud::filter::{self, Axis};
 use autoshovel_cloud::{Point, PointCloud};
 
 fn data(name: &str) -> PathBuf {
-    PathBuf::from(env!("CARGO_MANIFEST_DIR")).join("tests/data/filters").join(name)
+    PathBuf::from(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/data/filters")
+        .join(name)
 }
 
 /// x, y, z of an ascii or binary PCD whose fields are x y z, 4-byte floats.
@@ -25,8 +27,15 @@ fn read_pcd(name: &str) -> Vec<Point> {
     let mut points = 0usize;
     let mut fields = String::new();
     let kind = loop {
-        let end = pos + bytes[pos..].iter().position(|&b| b == b'\n').expect("header line");
-        let line = std::str::from_utf8(&bytes[pos..end]).expect("ascii header").trim().to_string();
+        let end = pos
+            + bytes[pos..]
+                .iter()
+                .position(|&b| b == b'\n')
+                .expect("header line");
+        let line = std::str::from_utf8(&bytes[pos..end])
+            .expect("ascii header")
+            .trim()
+            .to_string();
         pos = end + 1;
         let mut words = line.split_whitespace();
         match words.next() {
@@ -40,12 +49,17 @@ fn read_pcd(name: &str) -> Vec<Point> {
     let out: Vec<Point> = match kind.as_str() {
         "ascii" => {
             let text = std::str::from_utf8(&bytes[pos..]).expect("ascii data");
-            let v: Vec<f32> = text.split_whitespace().map(|w| w.parse().expect("float")).collect();
+            let v: Vec<f32> = text
+                .split_whitespace()
+                .map(|w| w.parse().expect("float"))
+                .collect();
             v.chunks_exact(3).map(|c| [c[0], c[1], c[2]]).collect()
         }
         "binary" => bytes[pos..pos + 12 * points]
             .chunks_exact(12)
-            .map(|c| [0, 4, 8].map(|o| f32::from_le_bytes(c[o..o + 4].try_into().expect("4 bytes"))))
+            .map(|c| {
+                [0, 4, 8].map(|o| f32::from_le_bytes(c[o..o + 4].try_into().expect("4 bytes")))
+            })
             .collect(),
         other => panic!("{name}: DATA {other} not handled"),
     };
@@ -60,14 +74,27 @@ fn cloud(name: &str) -> PointCloud {
 /// Our kept points equal PCL's, bit for bit and in order.
 fn assert_same_points(ours: &PointCloud, reference: &str) {
     let pcl = read_pcd(&format!("{reference}.pcl.pcd"));
-    assert_eq!(ours.len(), pcl.len(), "{reference}: {} kept here, {} by PCL", ours.len(), pcl.len());
+    assert_eq!(
+        ours.len(),
+        pcl.len(),
+        "{reference}: {} kept here, {} by PCL",
+        ours.len(),
+        pcl.len()
+    );
     for (i, (a, b)) in ours.points.iter().zip(&pcl).enumerate() {
-        assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits), "{reference}: point {i}: {a:?} here, {b:?} in PCL");
+        assert_eq!(
+            a.map(f32::to_bits),
+            b.map(f32::to_bits),
+            "{reference}: point {i}: {a:?} here, {b:?} in PCL"
+        );
     }
 }
 
 fn radius(input: &str, radius_m: f64, min_neighbors: usize, reference: &str) {
-    let params = filter::RadiusOutlierParams { radius_m, min_neighbors };
+    let params = filter::RadiusOutlierParams {
+        radius_m,
+        min_neighbors,
+    };
     let ours = filter::radius_outlier_removal(&cloud(input), &params).expect("filter");
     assert_same_points(&ours, reference);
 }
@@ -107,12 +134,23 @@ fn statistical_outlier_removal_keeps_what_pcl_keeps() {
 fn pass_through_keeps_what_pcl_keeps() {
     let pile = cloud("pile");
     let run = |axis, min_m, max_m, keep_inside, reference| {
-        let params = filter::PassThroughParams { axis, min_m, max_m, keep_inside };
-        assert_same_points(&filter::pass_through(&pile, &params).expect("filter"), reference);
+        let params = filter::PassThroughParams {
+            axis,
+            min_m,
+            max_m,
+            keep_inside,
+        };
+        assert_same_points(
+            &filter::pass_through(&pile, &params).expect("filter"),
+            reference,
+        );
         // The indices variant agrees with the points variant.
         let idx = filter::pass_through_indices(&pile, &params).expect("filter");
         let gathered: Vec<Point> = idx.iter().map(|&i| pile.points[i]).collect();
-        assert_eq!(gathered, filter::pass_through(&pile, &params).expect("filter").points);
+        assert_eq!(
+            gathered,
+            filter::pass_through(&pile, &params).expect("filter").points
+        );
     };
     // The paper's ground removal, with points at and next to z = 0.1.
     run(Axis::Z, 0.1, 1e30, true, "pile_passthrough_z0.1");
@@ -123,13 +161,23 @@ fn pass_through_keeps_what_pcl_keeps() {
 }
 
 fn voxel(input: &str, leaf_m: [f64; 3], reference: &str) {
-    let ours = filter::voxel_grid(&cloud(input), &filter::VoxelGridParams { leaf_m }).expect("filter");
+    let ours =
+        filter::voxel_grid(&cloud(input), &filter::VoxelGridParams { leaf_m }).expect("filter");
     let pcl = read_pcd(&format!("{reference}.pcl.pcd"));
-    assert_eq!(ours.len(), pcl.len(), "{reference}: {} voxels here, {} in PCL", ours.len(), pcl.len());
+    assert_eq!(
+        ours.len(),
+        pcl.len(),
+        "{reference}: {} voxels here, {} in PCL",
+        ours.len(),
+        pcl.len()
+    );
     // Same order too (PCL sorts by linear voxel index, x fastest).
     for (i, (a, b)) in ours.points.iter().zip(&pcl).enumerate() {
         for k in 0..3 {
-            assert!((a[k] - b[k]).abs() <= 1e-5, "{reference}: centroid {i}: {a:?} here, {b:?} in PCL");
+            assert!(
+                (a[k] - b[k]).abs() <= 1e-5,
+                "{reference}: centroid {i}: {a:?} here, {b:?} in PCL"
+            );
         }
     }
 }

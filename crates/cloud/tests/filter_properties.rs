@@ -13,9 +13,13 @@ use proptest::prelude::*;
 /// A seeded LCG cloud: `n` points in a `size` cube, a quarter of them in a
 /// tight clump so that neighbourhoods vary.
 fn lcg_cloud(n: usize, size: f32, seed: u64) -> PointCloud {
-    let mut s = seed.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+    let mut s = seed
+        .wrapping_mul(6364136223846793005)
+        .wrapping_add(1442695040888963407);
     let mut next = move || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 40) as f32 / (1u64 << 24) as f32
     };
     PointCloud::new(
@@ -45,7 +49,8 @@ fn brute_radius(points: &[Point], radius_m: f64, min_neighbors: usize) -> Vec<us
     (0..points.len())
         .filter(|&i| {
             let d = sorted_d2(points, &points[i]);
-            d.get(min_neighbors).is_some_and(|&x| f64::from(x) <= radius_m * radius_m)
+            d.get(min_neighbors)
+                .is_some_and(|&x| f64::from(x) <= radius_m * radius_m)
         })
         .collect()
 }
@@ -55,7 +60,9 @@ fn brute_statistical(points: &[Point], k: usize, std_mul: f64) -> Vec<usize> {
         .iter()
         .map(|p| {
             let d = sorted_d2(points, p);
-            let sum = d[1..=k].iter().fold(0.0_f64, |s, &x| s + f64::from(x).sqrt());
+            let sum = d[1..=k]
+                .iter()
+                .fold(0.0_f64, |s, &x| s + f64::from(x).sqrt());
             (sum / k as f64) as f32
         })
         .collect();
@@ -66,7 +73,9 @@ fn brute_statistical(points: &[Point], k: usize, std_mul: f64) -> Vec<usize> {
     }
     let n = dist.len() as f64;
     let thr = sum / n + std_mul * ((sq - sum * sum / n) / (n - 1.0)).sqrt();
-    (0..dist.len()).filter(|&i| !(f64::from(dist[i]) > thr)).collect()
+    (0..dist.len())
+        .filter(|&i| f64::from(dist[i]) <= thr || thr.is_nan())
+        .collect()
 }
 
 proptest! {
@@ -105,7 +114,7 @@ proptest! {
         for p in &cloud.points {
             let c = [2, 1, 0].map(|a| (p[a] * inv).floor() as i64);
             let e = voxels.entry(c).or_insert(([0.0; 3], 0.0));
-            for a in 0..3 { e.0[a] += f64::from(p[a]); }
+            for (sum, c) in e.0.iter_mut().zip(p) { *sum += f64::from(*c); }
             e.1 += 1.0;
         }
         let got = filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(leaf)).unwrap();
@@ -137,16 +146,30 @@ fn results_do_not_depend_on_the_number_of_threads() {
     let cloud = lcg_cloud(5000, 1.0, 7);
     let run = || {
         (
-            filter::radius_outlier_removal_indices(&cloud, &filter::RadiusOutlierParams { radius_m: 0.05, min_neighbors: 3 })
-                .unwrap(),
+            filter::radius_outlier_removal_indices(
+                &cloud,
+                &filter::RadiusOutlierParams {
+                    radius_m: 0.05,
+                    min_neighbors: 3,
+                },
+            )
+            .unwrap(),
             filter::statistical_outlier_removal_indices(&cloud, &Default::default()).unwrap(),
             filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(0.03)).unwrap(),
             filter::estimate_normals(&cloud, &Default::default()).unwrap(),
             filter::bilateral_normal_smoothing(&cloud, &Default::default()).unwrap(),
         )
     };
-    let one = rayon::ThreadPoolBuilder::new().num_threads(1).build().unwrap().install(run);
-    let three = rayon::ThreadPoolBuilder::new().num_threads(3).build().unwrap().install(run);
+    let one = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap()
+        .install(run);
+    let three = rayon::ThreadPoolBuilder::new()
+        .num_threads(3)
+        .build()
+        .unwrap()
+        .install(run);
     assert_eq!(one.0, three.0);
     assert_eq!(one.1, three.1);
     assert_eq!(one.2, three.2);
@@ -162,20 +185,34 @@ fn non_finite_points_are_dropped() {
     dirty.points.insert(100, [f32::NAN, 0.0, 0.0]);
     dirty.points.insert(0, [0.0, f32::INFINITY, 0.0]);
     dirty.points.push([0.0, 0.0, f32::NEG_INFINITY]);
-    let radius = filter::RadiusOutlierParams { radius_m: 0.1, min_neighbors: 2 };
+    let radius = filter::RadiusOutlierParams {
+        radius_m: 0.1,
+        min_neighbors: 2,
+    };
     assert_eq!(
         filter::radius_outlier_removal(&dirty, &radius).unwrap(),
         filter::radius_outlier_removal(&clean, &radius).unwrap()
     );
-    let stat = filter::StatisticalOutlierParams { mean_k: 8, std_mul: 1.0 };
+    let stat = filter::StatisticalOutlierParams {
+        mean_k: 8,
+        std_mul: 1.0,
+    };
     assert_eq!(
         filter::statistical_outlier_removal(&dirty, &stat).unwrap(),
         filter::statistical_outlier_removal(&clean, &stat).unwrap()
     );
-    let pass = filter::PassThroughParams { axis: Axis::X, min_m: f64::NEG_INFINITY, max_m: f64::INFINITY, keep_inside: true };
+    let pass = filter::PassThroughParams {
+        axis: Axis::X,
+        min_m: f64::NEG_INFINITY,
+        max_m: f64::INFINITY,
+        keep_inside: true,
+    };
     assert_eq!(filter::pass_through(&dirty, &pass).unwrap(), clean);
     let vox = filter::VoxelGridParams::cube(0.1);
-    assert_eq!(filter::voxel_grid(&dirty, &vox).unwrap(), filter::voxel_grid(&clean, &vox).unwrap());
+    assert_eq!(
+        filter::voxel_grid(&dirty, &vox).unwrap(),
+        filter::voxel_grid(&clean, &vox).unwrap()
+    );
     let normals = filter::estimate_normals(&dirty, &Default::default()).unwrap();
     assert_eq!(normals.len(), dirty.len());
     assert!(normals[0].is_none() && normals[101].is_none() && normals[502].is_none());
@@ -195,51 +232,149 @@ fn what(e: CloudError) -> String {
 #[test]
 fn bad_parameters_name_the_value() {
     let cloud = lcg_cloud(100, 1.0, 1);
-    let e = filter::radius_outlier_removal(&cloud, &filter::RadiusOutlierParams { radius_m: 0.0, min_neighbors: 1 });
+    let e = filter::radius_outlier_removal(
+        &cloud,
+        &filter::RadiusOutlierParams {
+            radius_m: 0.0,
+            min_neighbors: 1,
+        },
+    );
     assert!(what(e.unwrap_err()).contains("radius_m must be positive and finite, got 0"));
-    let e = filter::radius_outlier_removal(&cloud, &filter::RadiusOutlierParams { radius_m: f64::NAN, min_neighbors: 1 });
+    let e = filter::radius_outlier_removal(
+        &cloud,
+        &filter::RadiusOutlierParams {
+            radius_m: f64::NAN,
+            min_neighbors: 1,
+        },
+    );
     assert!(what(e.unwrap_err()).contains("NaN"));
-    let e = filter::statistical_outlier_removal(&cloud, &filter::StatisticalOutlierParams { mean_k: 0, std_mul: 1.0 });
+    let e = filter::statistical_outlier_removal(
+        &cloud,
+        &filter::StatisticalOutlierParams {
+            mean_k: 0,
+            std_mul: 1.0,
+        },
+    );
     assert!(what(e.unwrap_err()).contains("mean_k must be at least 1, got 0"));
-    let e = filter::statistical_outlier_removal(&cloud, &filter::StatisticalOutlierParams { mean_k: 100, std_mul: 1.0 });
-    assert!(what(e.unwrap_err()).contains("mean_k = 100 needs at least 101 finite points, the cloud has 100"));
-    let e = filter::statistical_outlier_removal(&cloud, &filter::StatisticalOutlierParams { mean_k: 5, std_mul: f64::INFINITY });
+    let e = filter::statistical_outlier_removal(
+        &cloud,
+        &filter::StatisticalOutlierParams {
+            mean_k: 100,
+            std_mul: 1.0,
+        },
+    );
+    assert!(what(e.unwrap_err())
+        .contains("mean_k = 100 needs at least 101 finite points, the cloud has 100"));
+    let e = filter::statistical_outlier_removal(
+        &cloud,
+        &filter::StatisticalOutlierParams {
+            mean_k: 5,
+            std_mul: f64::INFINITY,
+        },
+    );
     assert!(what(e.unwrap_err()).contains("std_mul must be finite, got inf"));
     for leaf in [0.0, -0.05, f64::NAN, f64::INFINITY, 1e-300, 1e300] {
-        let e = filter::voxel_grid(&cloud, &filter::VoxelGridParams { leaf_m: [0.05, leaf, 0.05] });
-        assert!(what(e.unwrap_err()).contains(&format!("leaf_m[1] must be positive and finite in f32, got {leaf}")));
+        let e = filter::voxel_grid(
+            &cloud,
+            &filter::VoxelGridParams {
+                leaf_m: [0.05, leaf, 0.05],
+            },
+        );
+        assert!(what(e.unwrap_err()).contains(&format!(
+            "leaf_m[1] must be positive and finite in f32, got {leaf}"
+        )));
     }
-    let e = filter::pass_through(&cloud, &filter::PassThroughParams { min_m: 1.0, max_m: 0.5, ..Default::default() });
+    let e = filter::pass_through(
+        &cloud,
+        &filter::PassThroughParams {
+            min_m: 1.0,
+            max_m: 0.5,
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("min_m = 1 is above max_m = 0.5"));
-    let e = filter::pass_through(&cloud, &filter::PassThroughParams { min_m: f64::NAN, ..Default::default() });
+    let e = filter::pass_through(
+        &cloud,
+        &filter::PassThroughParams {
+            min_m: f64::NAN,
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("limits must be numbers"));
-    let e = filter::estimate_normals(&cloud, &filter::NormalParams { neighbourhood: filter::Neighbourhood::Nearest(2), ..Default::default() });
+    let e = filter::estimate_normals(
+        &cloud,
+        &filter::NormalParams {
+            neighbourhood: filter::Neighbourhood::Nearest(2),
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("Nearest(k) needs k >= 3"));
-    let e = filter::estimate_normals(&cloud, &filter::NormalParams { neighbourhood: filter::Neighbourhood::Radius(-1.0), ..Default::default() });
+    let e = filter::estimate_normals(
+        &cloud,
+        &filter::NormalParams {
+            neighbourhood: filter::Neighbourhood::Radius(-1.0),
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("Radius(r) must be positive and finite, got -1"));
-    let e = filter::bilateral_normal_smoothing(&cloud, &filter::BilateralParams { sigma_n_m: 0.0, ..Default::default() });
+    let e = filter::bilateral_normal_smoothing(
+        &cloud,
+        &filter::BilateralParams {
+            sigma_n_m: 0.0,
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("sigma_n_m must be positive and finite, got 0"));
-    let e = filter::bilateral_normal_smoothing(&cloud, &filter::BilateralParams { iterations: 0, ..Default::default() });
+    let e = filter::bilateral_normal_smoothing(
+        &cloud,
+        &filter::BilateralParams {
+            iterations: 0,
+            ..Default::default()
+        },
+    );
     assert!(what(e.unwrap_err()).contains("iterations must be at least 1"));
 }
 
 #[test]
 fn empty_input_and_emptied_output_are_errors_with_a_hint() {
     let empty = PointCloud::default();
-    let is_empty_input = |r: Result<(), CloudError>| matches!(r, Err(CloudError::Emptied { input: 0, .. }));
-    assert!(is_empty_input(filter::pass_through(&empty, &Default::default()).map(drop)));
-    assert!(is_empty_input(filter::radius_outlier_removal(&empty, &Default::default()).map(drop)));
-    assert!(is_empty_input(filter::statistical_outlier_removal(&empty, &Default::default()).map(drop)));
-    assert!(is_empty_input(filter::voxel_grid(&empty, &Default::default()).map(drop)));
-    assert!(is_empty_input(filter::estimate_normals(&empty, &Default::default()).map(drop)));
-    assert!(is_empty_input(filter::bilateral_normal_smoothing(&empty, &Default::default()).map(drop)));
+    let is_empty_input =
+        |r: Result<(), CloudError>| matches!(r, Err(CloudError::Emptied { input: 0, .. }));
+    assert!(is_empty_input(
+        filter::pass_through(&empty, &Default::default()).map(drop)
+    ));
+    assert!(is_empty_input(
+        filter::radius_outlier_removal(&empty, &Default::default()).map(drop)
+    ));
+    assert!(is_empty_input(
+        filter::statistical_outlier_removal(&empty, &Default::default()).map(drop)
+    ));
+    assert!(is_empty_input(
+        filter::voxel_grid(&empty, &Default::default()).map(drop)
+    ));
+    assert!(is_empty_input(
+        filter::estimate_normals(&empty, &Default::default()).map(drop)
+    ));
+    assert!(is_empty_input(
+        filter::bilateral_normal_smoothing(&empty, &Default::default()).map(drop)
+    ));
 
     // Sparse points: nobody has 5 neighbours within 1 mm.
     let cloud = lcg_cloud(100, 1.0, 2);
-    let err = filter::radius_outlier_removal(&cloud, &filter::RadiusOutlierParams { radius_m: 0.001, min_neighbors: 5 })
-        .unwrap_err();
+    let err = filter::radius_outlier_removal(
+        &cloud,
+        &filter::RadiusOutlierParams {
+            radius_m: 0.001,
+            min_neighbors: 5,
+        },
+    )
+    .unwrap_err();
     match &err {
-        CloudError::Emptied { filter, input, hint } => {
+        CloudError::Emptied {
+            filter,
+            input,
+            hint,
+        } => {
             assert_eq!((*filter, *input), ("radius outlier removal", 100));
             assert!(hint.contains("lower min_neighbors or raise radius_m"));
         }
@@ -249,10 +384,17 @@ fn empty_input_and_emptied_output_are_errors_with_a_hint() {
         err.to_string(),
         "radius outlier removal removed every point (100 in, 0 out): lower min_neighbors or raise radius_m"
     );
-    let e = filter::pass_through(&cloud, &filter::PassThroughParams::ground_removal(5.0)).unwrap_err();
+    let e =
+        filter::pass_through(&cloud, &filter::PassThroughParams::ground_removal(5.0)).unwrap_err();
     assert!(matches!(e, CloudError::Emptied { input: 100, .. }), "{e}");
-    let e = filter::statistical_outlier_removal(&cloud, &filter::StatisticalOutlierParams { mean_k: 5, std_mul: -100.0 })
-        .unwrap_err();
+    let e = filter::statistical_outlier_removal(
+        &cloud,
+        &filter::StatisticalOutlierParams {
+            mean_k: 5,
+            std_mul: -100.0,
+        },
+    )
+    .unwrap_err();
     assert!(e.to_string().contains("raise std_mul"), "{e}");
 }
 
@@ -268,41 +410,92 @@ fn voxel_grid_never_overflows_its_index() {
         [-1.0e4, 0.0, 0.0],
     ]);
     let down = filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(1e-6)).unwrap();
-    assert_eq!(down.points, vec![[0.0, 1.0e4, -1.0e4], [-1.0e4, 0.0, 0.0], [1.0e4, 0.0, 0.0]]);
+    assert_eq!(
+        down.points,
+        vec![[0.0, 1.0e4, -1.0e4], [-1.0e4, 0.0, 0.0], [1.0e4, 0.0, 0.0]]
+    );
     // 1 mm voxels over 2 km: beyond i32, within u64.
-    let cloud = PointCloud::new(vec![[1000.0, 1000.0, 1000.0], [-1000.0, -1000.0, -1000.0], [0.0005, 0.0, 0.0], [0.0, 0.0, 0.0]]);
+    let cloud = PointCloud::new(vec![
+        [1000.0, 1000.0, 1000.0],
+        [-1000.0, -1000.0, -1000.0],
+        [0.0005, 0.0, 0.0],
+        [0.0, 0.0, 0.0],
+    ]);
     let down = filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(0.001)).unwrap();
-    assert_eq!(down.points, vec![[-1000.0, -1000.0, -1000.0], [0.00025, 0.0, 0.0], [1000.0, 1000.0, 1000.0]]);
+    assert_eq!(
+        down.points,
+        vec![
+            [-1000.0, -1000.0, -1000.0],
+            [0.00025, 0.0, 0.0],
+            [1000.0, 1000.0, 1000.0]
+        ]
+    );
 }
 
 /// A flat grid z = 0 of `n` × `n` points at 1 cm.
 fn flat_grid(n: usize) -> Vec<Point> {
-    (0..n * n).map(|i| [(i % n) as f32 * 0.01, (i / n) as f32 * 0.01, 0.0]).collect()
+    (0..n * n)
+        .map(|i| [(i % n) as f32 * 0.01, (i / n) as f32 * 0.01, 0.0])
+        .collect()
 }
 
 #[test]
 fn normals_of_a_plane_point_where_asked() {
     let cloud = PointCloud::new(flat_grid(10));
-    let up = filter::estimate_normals(&cloud, &filter::NormalParams { neighbourhood: filter::Neighbourhood::Radius(0.015), orientation: filter::Orientation::PositiveZ })
-        .unwrap();
-    let down = filter::estimate_normals(&cloud, &filter::NormalParams { neighbourhood: filter::Neighbourhood::Nearest(9), orientation: filter::Orientation::Viewpoint([0.05, 0.05, -3.0]) })
-        .unwrap();
+    let up = filter::estimate_normals(
+        &cloud,
+        &filter::NormalParams {
+            neighbourhood: filter::Neighbourhood::Radius(0.015),
+            orientation: filter::Orientation::PositiveZ,
+        },
+    )
+    .unwrap();
+    let down = filter::estimate_normals(
+        &cloud,
+        &filter::NormalParams {
+            neighbourhood: filter::Neighbourhood::Nearest(9),
+            orientation: filter::Orientation::Viewpoint([0.05, 0.05, -3.0]),
+        },
+    )
+    .unwrap();
     for (u, d) in up.iter().zip(&down) {
         let (u, d) = (u.unwrap(), d.unwrap());
         approx::assert_relative_eq!(u[2], 1.0, epsilon = 1e-9);
         approx::assert_relative_eq!(d[2], -1.0, epsilon = 1e-9);
     }
     // A lone point has no normal.
-    let lone = PointCloud::new(vec![[0.0, 0.0, 0.0], [5.0, 0.0, 0.0], [5.01, 0.0, 0.0], [5.0, 0.01, 0.0]]);
-    let n = filter::estimate_normals(&lone, &filter::NormalParams { neighbourhood: filter::Neighbourhood::Radius(0.1), ..Default::default() }).unwrap();
+    let lone = PointCloud::new(vec![
+        [0.0, 0.0, 0.0],
+        [5.0, 0.0, 0.0],
+        [5.01, 0.0, 0.0],
+        [5.0, 0.01, 0.0],
+    ]);
+    let n = filter::estimate_normals(
+        &lone,
+        &filter::NormalParams {
+            neighbourhood: filter::Neighbourhood::Radius(0.1),
+            ..Default::default()
+        },
+    )
+    .unwrap();
     assert!(n[0].is_none() && n[1].is_some());
 }
 
 #[test]
 fn bilateral_smoothing_leaves_a_plane_alone_and_flattens_noise() {
     // Eq. 20 on a plane: every offset ⟨n, q − P⟩ is 0, so δ = 0.
-    let plane = PointCloud::new(flat_grid(15).into_iter().map(|p| [p[0], p[1], 0.25 * p[0] + 0.1]).collect());
-    let params = filter::BilateralParams { radius_m: 0.025, sigma_d_m: 0.0125, sigma_n_m: 0.005, iterations: 3 };
+    let plane = PointCloud::new(
+        flat_grid(15)
+            .into_iter()
+            .map(|p| [p[0], p[1], 0.25 * p[0] + 0.1])
+            .collect(),
+    );
+    let params = filter::BilateralParams {
+        radius_m: 0.025,
+        sigma_d_m: 0.0125,
+        sigma_n_m: 0.005,
+        iterations: 3,
+    };
     let out = filter::bilateral_normal_smoothing(&plane, &params).unwrap();
     for (a, b) in out.points.iter().zip(&plane.points) {
         for k in 0..3 {
@@ -315,16 +508,34 @@ fn bilateral_smoothing_leaves_a_plane_alone_and_flattens_noise() {
     let noisy: Vec<Point> = flat_grid(30)
         .into_iter()
         .map(|p| {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
-            [p[0], p[1], ((s >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.002]
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            [
+                p[0],
+                p[1],
+                ((s >> 40) as f32 / (1u64 << 24) as f32 - 0.5) * 0.002,
+            ]
         })
         .collect();
-    let rms = |c: &PointCloud| (c.points.iter().map(|p| f64::from(p[2]).powi(2)).sum::<f64>() / c.len() as f64).sqrt();
+    let rms = |c: &PointCloud| {
+        (c.points
+            .iter()
+            .map(|p| f64::from(p[2]).powi(2))
+            .sum::<f64>()
+            / c.len() as f64)
+            .sqrt()
+    };
     let noisy = PointCloud::new(noisy);
     let initial = rms(&noisy);
     let mut last = initial;
     for iterations in 1..=3 {
-        let params = filter::BilateralParams { radius_m: 0.025, sigma_d_m: 0.0125, sigma_n_m: 0.005, iterations };
+        let params = filter::BilateralParams {
+            radius_m: 0.025,
+            sigma_d_m: 0.0125,
+            sigma_n_m: 0.005,
+            iterations,
+        };
         let now = rms(&filter::bilateral_normal_smoothing(&noisy, &params).unwrap());
         assert!(now < last, "pass {iterations}: rms {now} after {last}");
         if iterations == 1 {

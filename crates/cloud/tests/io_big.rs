@@ -33,7 +33,7 @@ fn two_million_points_in_every_binary_format() {
         ("laz", Encoding::Binary, LasVersion::V1_4),
     ];
     println!(
-        "{:<34} {:>10} {:>9} {:>9}",
+        "{:<46} {:>10} {:>9} {:>9}",
         "format", "MB", "write s", "read s"
     );
     for (ext, enc, ver) in cases {
@@ -66,7 +66,7 @@ fn two_million_points_in_every_binary_format() {
             assert!(r.cloud.points == cloud.points);
         }
         println!(
-            "{:<34} {mb:>10.1} {tw:>9.3} {tr:>9.3}",
+            "{:<46} {mb:>10.1} {tw:>9.3} {tr:>9.3}",
             format!("{} ({enc}, {ver:?})", r.format)
         );
     }

@@ -252,7 +252,7 @@ fn unknown_fields_types_and_disagreements_are_errors() {
 }
 
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 400, ..ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: 1500, ..ProptestConfig::default() })]
 
     #[test]
     fn flipped_bytes_never_panic(
@@ -308,4 +308,9 @@ fn fuzz_regressions() {
     // header claims: `laz` indexed its chunk table past the end (a panic).
     let b = std::fs::read(data.join("fuzz_laz_chunk_table_too_short.laz")).unwrap();
     assert!(check("short table", Format::Laz, &b).is_err());
+    // A malformed chunk table on which `laz`'s arithmetic decoder indexes
+    // past its table (a panic inside `laz`): caught, reported as an error.
+    let b = std::fs::read(data.join("fuzz_laz_decoder_index_panic.laz")).unwrap();
+    let what = check("decoder panic", Format::Laz, &b).unwrap_err();
+    assert!(what.contains("malformed"), "{what}");
 }

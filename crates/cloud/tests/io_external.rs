@@ -163,3 +163,23 @@ fn las_and_laz_from_laspy() {
         assert_eq!(bits(&r.cloud.points), bits(&expect), "{file}");
     }
 }
+
+#[test]
+fn old_pcd_headers_and_crlf_ply_headers() {
+    use autoshovel_cloud::io::{read_from_bytes, Format};
+    // PCD .5 style: COLUMNS, no SIZE/TYPE/COUNT (4-byte floats, as PCL
+    // assumes), no POINTS (WIDTH × HEIGHT), no VIEWPOINT.
+    let old = b"# .PCD v.5 - Point Cloud Data file format\nVERSION .5\nCOLUMNS x y z\nWIDTH 2\nHEIGHT 1\nDATA ascii\n1 2 3\n4 5 6\n";
+    let r = read_from_bytes(Format::Pcd, old).unwrap();
+    assert_eq!(r.cloud.points, vec![[1.0, 2.0, 3.0], [4.0, 5.0, 6.0]]);
+    let v6 = b"VERSION .6\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nWIDTH 1\nHEIGHT 1\nDATA binary\n\0\0\x80\x3f\0\0\0\x40\0\0\x40\x40";
+    let r = read_from_bytes(Format::Pcd, v6).unwrap();
+    assert_eq!(r.cloud.points, vec![[1.0, 2.0, 3.0]]);
+    // A PLY header with Windows line ends, binary data right after it.
+    let mut ply = b"ply\r\nformat binary_big_endian 1.0\r\nelement vertex 1\r\nproperty float x\r\nproperty float y\r\nproperty float z\r\nend_header\r\n".to_vec();
+    for v in [1.0f32, 2.0, 3.0] {
+        ply.extend_from_slice(&v.to_be_bytes());
+    }
+    let r = read_from_bytes(Format::Ply, &ply).unwrap();
+    assert_eq!(r.cloud.points, vec![[1.0, 2.0, 3.0]]);
+}

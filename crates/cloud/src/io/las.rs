@@ -33,6 +33,11 @@
 //!   holds fewer points than the header's count (`laz` would panic: it
 //!   indexes the table past its end).
 //!
+//! `laz` also panics on some malformed streams (fuzzing found an index out
+//! of bounds in its arithmetic decoder); the decoding runs under
+//! `catch_unwind`, so such a file is a format error (with the default
+//! `panic = "unwind"`).
+//!
 //! Points are then read one at a time (`read_point`, never `read_points`,
 //! which reserves the header's count) straight into the cloud's vector.
 
@@ -200,7 +205,13 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
 /// `las` and `laz` do step by step: where the VLRs start, which VLR is the
 /// LASzip one, where decoding starts.
 #[cfg(feature = "laz")]
-fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u64, c: &Checked) -> Result<(), String> {
+fn check_laz<R: Read + Seek>(
+    src: &mut R,
+    total: u64,
+    vlr_start: u64,
+    n_vlrs: u64,
+    c: &Checked,
+) -> Result<(), String> {
     let io = |e: std::io::Error| format!("reading the LASzip records: {e}");
     let mut pos = vlr_start;
     let mut found = None;
@@ -218,7 +229,9 @@ fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u6
         }
         pos += VLR_HEADER + len;
     }
-    let Some((at, len)) = found else { return Ok(()) };
+    let Some((at, len)) = found else {
+        return Ok(());
+    };
     let mut d = vec![0u8; len as usize];
     if !read_at(src, at, &mut d).map_err(io)? {
         return Ok(());
@@ -260,12 +273,23 @@ fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u6
         let variable = vlr.uses_variable_size_chunks();
         if layered || variable {
             src.seek(SeekFrom::Start(data_start)).map_err(io)?;
-            match laz::laszip::ChunkTable::read_from(&mut *src, &vlr) {
+            let table = std::panic::catch_unwind(std::panic::AssertUnwindSafe(|| {
+                laz::laszip::ChunkTable::read_from(&mut *src, &vlr)
+            }));
+            let table = match table {
+                Ok(t) => t,
+                Err(_) => {
+                    return Err("the LASzip chunk table is malformed (the decoder failed)".into())
+                }
+            };
+            match table {
                 // When the table cannot be read, `laz` goes on decoding from
                 // wherever the attempt left the stream: refuse that for
                 // layered data, whose chunks announce buffer sizes.
                 Err(_) if layered => {
-                    return Err("the LASzip chunk table cannot be read (damaged or truncated file)".into())
+                    return Err(
+                        "the LASzip chunk table cannot be read (damaged or truncated file)".into(),
+                    )
                 }
                 Err(_) => {}
                 // With variable-size chunks `laz` indexes the table by chunk
@@ -311,7 +335,11 @@ fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u6
         first_point += bytes;
         layers += l;
     }
-    let mut pos = if compressor == 1 { data_start } else { data_start + 8 };
+    let mut pos = if compressor == 1 {
+        data_start
+    } else {
+        data_start + 8
+    };
     let mut sizes = vec![0u8; 4 + 4 * layers as usize];
     // Until the file ends: a header count larger than the chunks hold makes
     // `laz` read "chunks" out of whatever follows.
@@ -336,6 +364,23 @@ fn check_laz<R: Read + Seek>(src: &mut R, total: u64, vlr_start: u64, n_vlrs: u6
 #[cfg(not(feature = "laz"))]
 fn check_laz<R: Read + Seek>(_: &mut R, _: u64, _: u64, _: u64, _: &Checked) -> Result<(), String> {
     Ok(()) // `las` refuses compressed data without the feature
+}
+
+/// Runs `f`, turning a panic (in `las` or `laz`) into a format error.
+/// Needs the default `panic = "unwind"`; the panic message still goes to
+/// the panic hook (stderr by default).
+fn without_panics<T>(path: &Path, f: impl FnOnce() -> crate::Result<T>) -> crate::Result<T> {
+    std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
+        let msg = payload
+            .downcast_ref::<&str>()
+            .map(|s| s.to_string())
+            .or_else(|| payload.downcast_ref::<String>().cloned())
+            .unwrap_or_default();
+        Err(CloudError::Format {
+            path: path.to_path_buf(),
+            what: format!("LAS/LAZ decoder failed on malformed data: {msg}"),
+        })
+    })
 }
 
 fn las_err(path: &Path, e: las::Error) -> CloudError {
@@ -371,23 +416,29 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             path: path.to_path_buf(),
             source,
         })?;
-    let mut reader = las::Reader::new(src).map_err(|e| las_err(path, e))?;
-    if !c.compressed {
-        out.reserve_bounded(c.count, total - c.offset, c.record_len.max(1));
-    }
-    let mut i = 0u64;
-    while let Some(p) = reader.read_point().map_err(|e| las_err(path, e))? {
-        out.push([p.x as f32, p.y as f32, p.z as f32]);
-        i += 1;
-        if i.is_multiple_of(PROGRESS_POINTS) {
-            let done = if c.compressed {
-                (total as f64 * i as f64 / c.count.max(1) as f64) as u64
-            } else {
-                c.offset + i * c.record_len
-            };
-            progress(done.min(total), total);
+    // `laz` 0.12 panics on some malformed streams (an index out of bounds
+    // in its arithmetic decoder, found by fuzzing): decoding runs under
+    // catch_unwind so that such a file is a format error, not a crash.
+    without_panics(path, || {
+        let mut reader = las::Reader::new(src).map_err(|e| las_err(path, e))?;
+        if !c.compressed {
+            out.reserve_bounded(c.count, total - c.offset, c.record_len.max(1));
         }
-    }
+        let mut i = 0u64;
+        while let Some(p) = reader.read_point().map_err(|e| las_err(path, e))? {
+            out.push([p.x as f32, p.y as f32, p.z as f32]);
+            i += 1;
+            if i.is_multiple_of(PROGRESS_POINTS) {
+                let done = if c.compressed {
+                    (total as f64 * i as f64 / c.count.max(1) as f64) as u64
+                } else {
+                    c.offset + i * c.record_len
+                };
+                progress(done.min(total), total);
+            }
+        }
+        Ok(())
+    })?;
     progress(total, total);
     Ok(match (c.compressed, c.major, c.minor) {
         (false, 1, 0) => "las 1.0",

@@ -603,6 +603,11 @@ impl Column {
 }
 
 /// Writes `points` as PCD (fields x y z, F4) in the given encoding.
+///
+/// binary_compressed builds the column-major buffer (12 bytes a point) and
+/// its LZF image in memory, as PCL does: the sizes precede the data, and
+/// LZF compresses one block. Use binary for clouds near the format's
+/// 4 GiB uncompressed limit.
 pub(crate) fn write<W: Write>(
     w: &mut W,
     points: &[Point],
