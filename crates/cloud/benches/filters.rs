@@ -10,13 +10,20 @@
 //! and every peer sees the same cloud.
 //!
 //! `FILTER_BENCH_WRITE=DIR cargo bench -p autoshovel-cloud --bench filters`
-//! writes the two clouds as binary PCD (`DIR/pile_100k.pcd`,
-//! `DIR/pile_1m.pcd`) and exits, for `peer/bench_peers.py`, which runs PCL and
-//! Open3D on them.
+//! does not run criterion: it writes the two clouds as binary PCD
+//! (`DIR/pile_100k.pcd`, `DIR/pile_1m.pcd`), runs each filter once to warm
+//! up and then `FILTER_BENCH_RUNS` (default 3) times or for half a second,
+//! whichever is longer, prints the median time as
+//! `ours NAME SIZE MS ms N points`, and writes each output
+//! (`DIR/ours_NAME_SIZE.pcd`), for `peer/bench_peers.py`, which runs PCL and
+//! Open3D on the same clouds and compares. `FILTER_BENCH_ONLY=NAME:SIZE`
+//! (e.g. `statistical:1m`) runs one filter on one cloud, `clouds` none.
 
 use std::io::Write;
 
-use autoshovel_cloud::filter::{self, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams, VoxelGridParams};
+use autoshovel_cloud::filter::{
+    self, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams, VoxelGridParams,
+};
 use autoshovel_cloud::{Point, PointCloud};
 use criterion::{BenchmarkId, Criterion};
 
@@ -24,7 +31,9 @@ use criterion::{BenchmarkId, Criterion};
 pub fn pile(n: usize, seed: u64) -> PointCloud {
     let mut s = seed;
     let mut uniform = move || {
-        s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
         (s >> 11) as f64 / (1u64 << 53) as f64
     };
     let tan40 = 40f64.to_radians().tan();
@@ -74,41 +83,100 @@ fn write_binary_pcd(path: &std::path::Path, cloud: &PointCloud) -> std::io::Resu
 
 const SIZES: [(usize, &str); 2] = [(100_000, "100k"), (1_000_000, "1m")];
 
+/// The filters as benchmarked, by name.
+type Run = fn(&PointCloud) -> PointCloud;
+const FILTERS: [(&str, Run); 4] = [
+    ("pass_through", |c| {
+        filter::pass_through(c, &PassThroughParams::ground_removal(0.1)).unwrap()
+    }),
+    ("voxel_grid", |c| {
+        filter::voxel_grid(c, &VoxelGridParams::cube(0.05)).unwrap()
+    }),
+    ("radius", |c| {
+        filter::radius_outlier_removal(
+            c,
+            &RadiusOutlierParams {
+                radius_m: 0.05,
+                min_neighbors: 5,
+            },
+        )
+        .unwrap()
+    }),
+    ("statistical", |c| {
+        filter::statistical_outlier_removal(
+            c,
+            &StatisticalOutlierParams {
+                mean_k: 50,
+                std_mul: 1.0,
+            },
+        )
+        .unwrap()
+    }),
+];
+
 fn benches(c: &mut Criterion) {
-    for (n, name) in SIZES {
+    for (n, size) in SIZES {
         let cloud = pile(n, 4);
-        let mut group = c.benchmark_group(format!("filters_{name}"));
+        let mut group = c.benchmark_group(format!("filters_{size}"));
         group.sample_size(10);
         if n >= 1_000_000 {
             group.measurement_time(std::time::Duration::from_secs(20));
         }
-        group.bench_with_input(BenchmarkId::new("pass_through_z0.1", n), &cloud, |b, cloud| {
-            b.iter(|| filter::pass_through(cloud, &PassThroughParams::ground_removal(0.1)).unwrap())
-        });
-        group.bench_with_input(BenchmarkId::new("voxel_grid_0.05", n), &cloud, |b, cloud| {
-            b.iter(|| filter::voxel_grid(cloud, &VoxelGridParams::cube(0.05)).unwrap())
-        });
-        group.bench_with_input(BenchmarkId::new("radius_r0.05_min5", n), &cloud, |b, cloud| {
-            let params = RadiusOutlierParams { radius_m: 0.05, min_neighbors: 5 };
-            b.iter(|| filter::radius_outlier_removal(cloud, &params).unwrap())
-        });
-        group.bench_with_input(BenchmarkId::new("statistical_k50_s1", n), &cloud, |b, cloud| {
-            let params = StatisticalOutlierParams { mean_k: 50, std_mul: 1.0 };
-            b.iter(|| filter::statistical_outlier_removal(cloud, &params).unwrap())
-        });
+        for (name, run) in FILTERS {
+            group.bench_with_input(BenchmarkId::new(name, n), &cloud, |b, cloud| {
+                b.iter(|| run(cloud))
+            });
+        }
         group.finish();
+    }
+}
+
+/// The peer mode: clouds, outputs and median timings for `peer/bench_peers.py`.
+fn write_for_peers(dir: &std::path::Path) {
+    std::fs::create_dir_all(dir).expect("create FILTER_BENCH_WRITE");
+    let runs: usize = std::env::var("FILTER_BENCH_RUNS")
+        .ok()
+        .and_then(|r| r.parse().ok())
+        .unwrap_or(3)
+        .max(1);
+    let only = std::env::var("FILTER_BENCH_ONLY").ok();
+    for (n, size) in SIZES {
+        let cloud = pile(n, 4);
+        if only.is_none() || only.as_deref() == Some("clouds") {
+            write_binary_pcd(&dir.join(format!("pile_{size}.pcd")), &cloud)
+                .expect("write the bench cloud");
+        }
+        for (name, run) in FILTERS {
+            if only
+                .as_ref()
+                .is_some_and(|o| *o != format!("{name}:{size}"))
+            {
+                continue;
+            }
+            let out = run(&cloud);
+            // At least `runs` runs and half a second, as criterion warms up.
+            let started = std::time::Instant::now();
+            let mut ms = Vec::new();
+            while ms.len() < runs || started.elapsed().as_secs_f64() < 0.5 {
+                let t = std::time::Instant::now();
+                criterion::black_box(run(&cloud));
+                ms.push(t.elapsed().as_secs_f64() * 1e3);
+            }
+            ms.sort_by(f64::total_cmp);
+            println!(
+                "ours {name} {size} {:.3} ms {} points",
+                ms[ms.len() / 2],
+                out.len()
+            );
+            write_binary_pcd(&dir.join(format!("ours_{name}_{size}.pcd")), &out)
+                .expect("write an output");
+        }
     }
 }
 
 fn main() {
     if let Ok(dir) = std::env::var("FILTER_BENCH_WRITE") {
-        let dir = std::path::PathBuf::from(dir);
-        std::fs::create_dir_all(&dir).expect("create FILTER_BENCH_WRITE");
-        for (n, name) in SIZES {
-            let path = dir.join(format!("pile_{name}.pcd"));
-            write_binary_pcd(&path, &pile(n, 4)).expect("write the bench cloud");
-            println!("wrote {}", path.display());
-        }
+        write_for_peers(std::path::Path::new(&dir));
         return;
     }
     let mut c = Criterion::default().configure_from_args();

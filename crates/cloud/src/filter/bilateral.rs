@@ -26,8 +26,8 @@
 //! closed forms instead (a plane stays put, a single raised point returns to
 //! its plane, noise on a plane shrinks).
 
+use super::common::{bad, empty_input, f32_at_most, is_finite};
 use super::kdtree::KdTree;
-use super::neighbours::{bad, empty_input, f32_at_most, is_finite};
 use super::normals::pca_normal;
 use crate::{Point, PointCloud, Result};
 
@@ -68,7 +68,10 @@ impl BilateralParams {
             ("sigma_n_m", self.sigma_n_m),
         ] {
             if !(v.is_finite() && v > 0.0) {
-                return Err(bad(FILTER, format!("{name} must be positive and finite, got {v}")));
+                return Err(bad(
+                    FILTER,
+                    format!("{name} must be positive and finite, got {v}"),
+                ));
             }
         }
         if self.iterations == 0 {
@@ -93,14 +96,17 @@ impl BilateralParams {
 /// let smoothed = filter::bilateral_normal_smoothing(&PointCloud::new(points), &params).unwrap();
 /// assert!(smoothed.points[60][2].abs() < 1e-6);
 /// ```
-pub fn bilateral_normal_smoothing(cloud: &PointCloud, params: &BilateralParams) -> Result<PointCloud> {
+pub fn bilateral_normal_smoothing(
+    cloud: &PointCloud,
+    params: &BilateralParams,
+) -> Result<PointCloud> {
     params.validate()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
     let mut points: Vec<Point> = cloud.points.iter().copied().filter(is_finite).collect();
     if points.is_empty() {
-        return Err(super::neighbours::emptied(
+        return Err(super::common::emptied(
             FILTER,
             cloud.len(),
             "every point has a non-finite coordinate",

@@ -4,12 +4,15 @@
 //!
 //! Why not `kiddo`: on the 1 M-point pile of `benches/filters.rs`, kiddo 5.3's
 //! `ImmutableKdTree::nearest_n(51)` for every point took 25 s on this 2-core
-//! machine (PCL 1.13 needs 10.7 s for the whole statistical filter), mostly
-//! because its pruning bound `rd + (new_off − old_off)²` is much weaker than
-//! the exact `rd − old_off² + new_off²`. This tree uses the exact bound, splits
-//! at the median of the axis of largest variance, stores the points in tree order, and
-//! the filters query the points in that order, so that consecutive queries
-//! touch the same memory.
+//! machine (its mutable `KdTree` too; PCL 1.13 needs 10.7 s for the whole
+//! statistical filter). Two likely causes, both fixed here: kiddo prunes with
+//! `rd + (new_off − old_off)²`, much weaker than the exact
+//! `rd − old_off² + new_off²`, and it cycles the split axis, which on a
+//! noisy floor cuts z (the noise) as often as x and y and makes leaves long
+//! and flat. This tree splits at the median of the axis of largest variance,
+//! stores the points in tree order, each leaf sorted along its own main
+//! axis, and the filters query the points in that order, so that
+//! consecutive queries are close and touch the same memory.
 //!
 //! Arithmetic, so that results agree with PCL bit for bit: a squared
 //! distance is computed in f32 as `(dx·dx + dy·dy) + dz·dz` (which equals
@@ -34,6 +37,10 @@ const PARALLEL_BUILD: usize = 32 * 1024;
 /// How many previous points bound the next k-nearest search.
 const HISTORY: usize = 16;
 
+/// The first guess of a k-nearest search: this times the k-th distance of
+/// the nearest recent point.
+const GUESS: f64 = 1.1;
+
 /// Relative slack of the pruning test (see the module docs).
 const SLACK: f64 = 1.0 + 1e-6;
 
@@ -54,9 +61,6 @@ pub(crate) struct KdTree {
     splits: Vec<(u8, f32)>,
     /// Number of inner levels.
     depth: u32,
-    /// Tight bounding box (lo, hi) of the points of every node, inner and
-    /// leaf, in the same heap order.
-    boxes: Vec<(Point, Point)>,
     /// The points in tree order.
     points: Vec<Point>,
     /// For each point in tree order, its index in the input.
@@ -67,65 +71,33 @@ impl KdTree {
     /// Builds the tree over `points` (finite, at most u32::MAX of them).
     pub(crate) fn new(points: &[Point]) -> Self {
         let n = points.len();
-        assert!(u32::try_from(n).is_ok(), "a k-d tree holds at most 2^32 - 1 points");
+        assert!(
+            u32::try_from(n).is_ok(),
+            "a k-d tree holds at most 2^32 - 1 points"
+        );
         let mut depth = 0u32;
         while (n >> depth) > LEAF {
             depth += 1;
         }
         let inner = (1usize << depth) - 1;
-        let mut entries: Vec<(Point, u32)> = points.iter().enumerate().map(|(i, p)| (*p, i as u32)).collect();
+        let mut entries: Vec<(Point, u32)> = points
+            .iter()
+            .enumerate()
+            .map(|(i, p)| (*p, i as u32))
+            .collect();
         let mut splits = vec![(0u8, 0.0f32); inner];
         let mut found = Vec::with_capacity(inner);
         build(&mut entries, 0, depth, &mut found);
         for (node, split) in found {
             splits[node] = split;
         }
-        let (points, ids): (Vec<Point>, Vec<u32>) = entries.into_iter().unzip();
-        let empty = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        let mut boxes = vec![empty; 2 * inner + 1];
-        // Leaves from their points, then every inner node from its children.
-        let mut ranges = Vec::with_capacity(inner + 1);
-        leaf_ranges(0, n, depth, &mut ranges);
-        for (leaf, &(start, len)) in ranges.iter().enumerate() {
-            let b = &mut boxes[inner + leaf];
-            for p in &points[start..start + len] {
-                for a in 0..3 {
-                    b.0[a] = b.0[a].min(p[a]);
-                    b.1[a] = b.1[a].max(p[a]);
-                }
-            }
-        }
-        for node in (0..inner).rev() {
-            let (l, r) = (boxes[2 * node + 1], boxes[2 * node + 2]);
-            boxes[node] = ([0, 1, 2].map(|a| l.0[a].min(r.0[a])), [0, 1, 2].map(|a| l.1[a].max(r.1[a])));
-        }
+        let (points, ids) = entries.into_iter().unzip();
         Self {
             splits,
             depth,
-            boxes,
             points,
             ids,
         }
-    }
-
-    /// Squared distance (f64, exact up to its last bit) from `q` to the box
-    /// of `node`: a lower bound of the distance to any of its points.
-    #[inline]
-    fn box_distance(&self, node: usize, q: &Point) -> f64 {
-        let (lo, hi) = &self.boxes[node];
-        let mut d2 = 0.0;
-        for a in 0..3 {
-            let (x, l, h) = (f64::from(q[a]), f64::from(lo[a]), f64::from(hi[a]));
-            let d = if x < l {
-                l - x
-            } else if x > h {
-                x - h
-            } else {
-                0.0
-            };
-            d2 += d * d;
-        }
-        d2
     }
 
     /// Number of points.
@@ -139,7 +111,7 @@ impl KdTree {
     }
 
     /// The input index of the point at tree position `pos`.
-    #[inline]
+    #[cfg(test)]
     pub(crate) fn id(&self, pos: usize) -> usize {
         self.ids[pos] as usize
     }
@@ -195,9 +167,15 @@ impl KdTree {
         let half = len / 2;
         let diff = f64::from(q[a]) - f64::from(split);
         let (near, far) = if diff < 0.0 {
-            ((2 * node + 1, start, half), (2 * node + 2, start + half, len - half))
+            (
+                (2 * node + 1, start, half),
+                (2 * node + 2, start + half, len - half),
+            )
         } else {
-            ((2 * node + 2, start + half, len - half), (2 * node + 1, start, half))
+            (
+                (2 * node + 2, start + half, len - half),
+                (2 * node + 1, start, half),
+            )
         };
         self.nearest_in(near.0, near.1, near.2, levels - 1, q, off, rd, knn);
         let old = off[a];
@@ -214,7 +192,18 @@ impl KdTree {
     pub(crate) fn has_within(&self, q: &Point, r2: f32, wanted: usize) -> bool {
         let mut count = 0;
         let mut off = [0.0f64; 3];
-        self.count_in(0, 0, self.len(), self.depth, q, &mut off, 0.0, r2, wanted, &mut count);
+        self.count_in(
+            0,
+            0,
+            self.len(),
+            self.depth,
+            q,
+            &mut off,
+            0.0,
+            r2,
+            wanted,
+            &mut count,
+        );
         count >= wanted
     }
 
@@ -248,11 +237,28 @@ impl KdTree {
         let half = len / 2;
         let diff = f64::from(q[a]) - f64::from(split);
         let (near, far) = if diff < 0.0 {
-            ((2 * node + 1, start, half), (2 * node + 2, start + half, len - half))
+            (
+                (2 * node + 1, start, half),
+                (2 * node + 2, start + half, len - half),
+            )
         } else {
-            ((2 * node + 2, start + half, len - half), (2 * node + 1, start, half))
+            (
+                (2 * node + 2, start + half, len - half),
+                (2 * node + 1, start, half),
+            )
         };
-        self.count_in(near.0, near.1, near.2, levels - 1, q, off, rd, r2, wanted, count);
+        self.count_in(
+            near.0,
+            near.1,
+            near.2,
+            levels - 1,
+            q,
+            off,
+            rd,
+            r2,
+            wanted,
+            count,
+        );
         if *count >= wanted {
             return;
         }
@@ -260,7 +266,18 @@ impl KdTree {
         let far_rd = rd - old * old + diff * diff;
         if far_rd <= f64::from(r2) * SLACK {
             off[a] = diff.abs();
-            self.count_in(far.0, far.1, far.2, levels - 1, q, off, far_rd, r2, wanted, count);
+            self.count_in(
+                far.0,
+                far.1,
+                far.2,
+                levels - 1,
+                q,
+                off,
+                far_rd,
+                r2,
+                wanted,
+                count,
+            );
             off[a] = old;
         }
     }
@@ -269,50 +286,110 @@ impl KdTree {
     /// (inclusive, `q` itself included), in tree order, into `out`.
     pub(crate) fn within(&self, q: &Point, r2: f32, out: &mut Vec<u32>) {
         out.clear();
-        self.for_each_within(q, r2, |_, pos| out.push(pos));
+        let mut off = [0.0f64; 3];
+        self.within_in(
+            0,
+            0,
+            self.len(),
+            self.depth,
+            q,
+            &mut off,
+            0.0,
+            r2,
+            &mut |_, pos| out.push(pos),
+        );
     }
 
-    /// Calls `sink(d², position)` for every point within squared distance
-    /// `r2` of `q` (inclusive), in tree order. Nodes are pruned by their
-    /// tight bounding boxes.
-    fn for_each_within<F: FnMut(f32, u32)>(&self, q: &Point, r2: f32, mut sink: F) {
-        let limit = f64::from(r2) * SLACK;
-        let first_leaf = (1usize << self.depth) - 1;
-        // Depth-first, left before right: (node, start, len).
-        let mut stack = [(0usize, 0usize, 0usize); 66];
-        stack[0] = (0, 0, self.len());
-        let mut top = 1;
-        while top > 0 {
-            top -= 1;
-            let (node, start, len) = stack[top];
-            if self.box_distance(node, q) > limit {
-                continue;
-            }
-            if node >= first_leaf {
-                for (i, p) in self.points[start..start + len].iter().enumerate() {
-                    let d = squared_distance(q, p);
-                    if d <= r2 {
-                        sink(d, (start + i) as u32);
-                    }
+    #[allow(clippy::too_many_arguments)]
+    fn within_in<F: FnMut(f32, u32)>(
+        &self,
+        node: usize,
+        start: usize,
+        len: usize,
+        levels: u32,
+        q: &Point,
+        off: &mut [f64; 3],
+        rd: f64,
+        r2: f32,
+        sink: &mut F,
+    ) {
+        if levels == 0 {
+            for (i, p) in self.points[start..start + len].iter().enumerate() {
+                let d = squared_distance(q, p);
+                if d <= r2 {
+                    sink(d, (start + i) as u32);
                 }
-                continue;
             }
-            let half = len / 2;
-            stack[top] = (2 * node + 2, start + half, len - half);
-            stack[top + 1] = (2 * node + 1, start, half);
-            top += 2;
+            return;
+        }
+        let (axis, split) = self.splits[node];
+        let a = axis as usize;
+        let half = len / 2;
+        let diff = f64::from(q[a]) - f64::from(split);
+        let old = off[a];
+        let far_rd = rd - old * old + diff * diff;
+        let visit_far = far_rd <= f64::from(r2) * SLACK;
+        // Left before right, so that the output is in tree order.
+        if diff < 0.0 {
+            self.within_in(2 * node + 1, start, half, levels - 1, q, off, rd, r2, sink);
+            if visit_far {
+                off[a] = -diff;
+                self.within_in(
+                    2 * node + 2,
+                    start + half,
+                    len - half,
+                    levels - 1,
+                    q,
+                    off,
+                    far_rd,
+                    r2,
+                    sink,
+                );
+                off[a] = old;
+            }
+        } else {
+            if visit_far {
+                off[a] = diff;
+                self.within_in(
+                    2 * node + 1,
+                    start,
+                    half,
+                    levels - 1,
+                    q,
+                    off,
+                    far_rd,
+                    r2,
+                    sink,
+                );
+                off[a] = old;
+            }
+            self.within_in(
+                2 * node + 2,
+                start + half,
+                len - half,
+                levels - 1,
+                q,
+                off,
+                rd,
+                r2,
+                sink,
+            );
         }
     }
 
     /// For every point of the tree, `f` of the squared distances to its k
     /// nearest points (itself included), nearest first; results in input
-    /// order. Exactly the distances [`KdTree::nearest`] finds, faster: the
+    /// order. Exactly the distances [`KdTree::nearest`] finds, faster. The
     /// points are visited in tree order, and each of the last 16 points q'
     /// of the same task, whose k-th nearest lies at r', bounds the k nearest
-    /// of the next point q within r' + ‖q − q'‖ (triangle inequality; the
-    /// smallest such bound is taken and widened by a relative 1e-5 for the
-    /// f32 rounding). The search then only collects the points within that
-    /// cap, with no pruning bound to update, and keeps the k smallest.
+    /// of the next point q within r' + ‖q − q'‖ (triangle inequality). A
+    /// first search collects the points within 1.1 r' of the nearest q'
+    /// (a guess); if there are k of them, they hold q's k nearest, whatever
+    /// the guess was. Otherwise a second search collects those within the
+    /// smallest bound, which holds k points for sure. Every cap is widened
+    /// by a relative 1e-5 for the f32 rounding. Collecting within a fixed
+    /// cap needs no pruning bound to update; the k smallest are then
+    /// selected and sorted.
     pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
     where
         T: Send + Clone + Default,
@@ -322,19 +399,67 @@ impl KdTree {
         let in_tree_order: Vec<T> = (0..self.len())
             .into_par_iter()
             .map_init(
-                || (Nearest::new(k), Vec::<f32>::new(), Vec::<u32>::new(), Vec::<(Point, f64)>::with_capacity(HISTORY)),
+                || {
+                    (
+                        Nearest::new(k),
+                        Vec::<f32>::new(),
+                        Vec::<u32>::new(),
+                        Vec::<(Point, f64)>::with_capacity(HISTORY),
+                    )
+                },
                 |(knn, dist, bits, history), pos| {
+                    // `history` is a ring of the last HISTORY points and r'.
                     let q = &self.points[pos];
-                    // The tightest bound among the last few points of the task.
-                    let reach = history
-                        .iter()
-                        .map(|(p, r)| r + (0..3).map(|a| (f64::from(q[a]) - f64::from(p[a])).powi(2)).sum::<f64>().sqrt())
-                        .fold(f64::INFINITY, f64::min);
+                    // The tightest bound among the last few points of the
+                    // task, and the k-th distance of the nearest of them.
+                    let (mut reach, mut guess, mut nearest_gap) =
+                        (f64::INFINITY, f64::INFINITY, f64::INFINITY);
+                    for (p, r) in history.iter() {
+                        let gap = (0..3)
+                            .map(|a| (f64::from(q[a]) - f64::from(p[a])).powi(2))
+                            .sum::<f64>()
+                            .sqrt();
+                        reach = reach.min(r + gap);
+                        if gap < nearest_gap {
+                            nearest_gap = gap;
+                            guess = *r;
+                        }
+                    }
                     // Squared distances are ≥ +0, whose f32 bit patterns sort
                     // as the numbers do: select and sort them as integers.
                     bits.clear();
                     if reach < f64::INFINITY {
-                        self.for_each_within(q, widen(reach), |d, _| bits.push(d.to_bits()));
+                        // First a guess: the k-th distance of a close point,
+                        // a little more. If k points lie within it, they
+                        // include q's k nearest; otherwise use the bound.
+                        let guess = (guess * GUESS).min(reach);
+                        let mut off = [0.0f64; 3];
+                        self.within_in(
+                            0,
+                            0,
+                            self.len(),
+                            self.depth,
+                            q,
+                            &mut off,
+                            0.0,
+                            widen(guess),
+                            &mut |d, _| bits.push(d.to_bits()),
+                        );
+                        if bits.len() < k && guess < reach {
+                            bits.clear();
+                            let mut off = [0.0f64; 3];
+                            self.within_in(
+                                0,
+                                0,
+                                self.len(),
+                                self.depth,
+                                q,
+                                &mut off,
+                                0.0,
+                                widen(reach),
+                                &mut |d, _| bits.push(d.to_bits()),
+                            );
+                        }
                     }
                     if bits.len() >= k {
                         let (smaller, _, _) = bits.select_nth_unstable(k - 1);
@@ -347,10 +472,12 @@ impl KdTree {
                         dist.clear();
                         dist.extend_from_slice(knn.distances());
                     }
-                    if history.len() == HISTORY {
-                        history.remove(0);
+                    let latest = (*q, f64::from(dist[k - 1]).sqrt());
+                    if history.len() < HISTORY {
+                        history.push(latest);
+                    } else {
+                        history[pos % HISTORY] = latest;
                     }
-                    history.push((*q, f64::from(dist[k - 1]).sqrt()));
                     f(&dist[..k])
                 },
             )
@@ -363,17 +490,6 @@ impl KdTree {
     }
 }
 
-/// The (start, length) of every leaf, left to right.
-fn leaf_ranges(start: usize, len: usize, levels: u32, out: &mut Vec<(usize, usize)>) {
-    if levels == 0 {
-        out.push((start, len));
-    } else {
-        let half = len / 2;
-        leaf_ranges(start, half, levels - 1, out);
-        leaf_ranges(start + half, len - half, levels - 1, out);
-    }
-}
-
 /// The squared distance `r²` widened by a relative 1e-5 (far above the f32
 /// rounding of a squared distance), as f32: a cap that surely holds every
 /// point whose true distance is at most `r`.
@@ -382,7 +498,12 @@ fn widen(r: f64) -> f32 {
 }
 
 /// Builds the subtree of `node` over `entries`, pushing (node, split) pairs.
-fn build(entries: &mut [(Point, u32)], node: usize, levels: u32, found: &mut Vec<(usize, (u8, f32))>) {
+fn build(
+    entries: &mut [(Point, u32)],
+    node: usize,
+    levels: u32,
+    found: &mut Vec<(usize, (u8, f32))>,
+) {
     let axis = axis_of_largest_variance(entries);
     if levels == 0 {
         // A leaf is sorted along its own longest direction, so that
@@ -394,7 +515,9 @@ fn build(entries: &mut [(Point, u32)], node: usize, levels: u32, found: &mut Vec
     let half = entries.len() / 2;
     // Ties broken by input index, so the tree does not depend on the
     // selection algorithm's choices.
-    entries.select_nth_unstable_by(half, |x, y| x.0[axis].total_cmp(&y.0[axis]).then(x.1.cmp(&y.1)));
+    entries.select_nth_unstable_by(half, |x, y| {
+        x.0[axis].total_cmp(&y.0[axis]).then(x.1.cmp(&y.1))
+    });
     found.push((node, (axis as u8, entries[half].0[axis])));
     let (left, right) = entries.split_at_mut(half);
     if left.len() + right.len() > PARALLEL_BUILD {
@@ -515,7 +638,9 @@ mod tests {
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
         let mut s = seed;
         let mut u = move || {
-            s = s.wrapping_mul(6364136223846793005).wrapping_add(1442695040888963407);
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
             (s >> 40) as f32 / (1u64 << 24) as f32
         };
         // A thin slab with duplicates, to stress ties and flat cells.

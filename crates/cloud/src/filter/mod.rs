@@ -23,8 +23,8 @@
 //! tree order; results never depend on the number of threads.
 
 mod bilateral;
+mod common;
 mod kdtree;
-mod neighbours;
 mod normals;
 mod pass_through;
 mod radius_outlier;
@@ -34,7 +34,9 @@ mod voxel_grid;
 pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
 pub use pass_through::{pass_through, pass_through_indices, Axis, PassThroughParams};
-pub use radius_outlier::{radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams};
+pub use radius_outlier::{
+    radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams,
+};
 pub use statistical_outlier::{
     statistical_outlier_removal, statistical_outlier_removal_indices, StatisticalOutlierParams,
 };

@@ -13,8 +13,8 @@
 //! whose points are collinear (the smallest eigenvalue not unique), has no
 //! normal: `None` (PCL writes NaN).
 
+use super::common::{bad, empty_input, f32_at_most};
 use super::kdtree::{KdTree, Nearest};
-use super::neighbours::{bad, empty_input, f32_at_most};
 use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "normal estimation";
@@ -63,16 +63,25 @@ impl NormalParams {
     fn validate(&self) -> Result<()> {
         match self.neighbourhood {
             Neighbourhood::Nearest(k) if k < 3 => {
-                return Err(bad(FILTER, format!("Nearest(k) needs k >= 3 points for a plane, got {k}")))
+                return Err(bad(
+                    FILTER,
+                    format!("Nearest(k) needs k >= 3 points for a plane, got {k}"),
+                ))
             }
             Neighbourhood::Radius(r) if !(r.is_finite() && r > 0.0) => {
-                return Err(bad(FILTER, format!("Radius(r) must be positive and finite, got {r}")))
+                return Err(bad(
+                    FILTER,
+                    format!("Radius(r) must be positive and finite, got {r}"),
+                ))
             }
             _ => {}
         }
         if let Orientation::Viewpoint(v) = self.orientation {
             if !v.iter().all(|c| c.is_finite()) {
-                return Err(bad(FILTER, format!("the viewpoint must be finite, got {v:?}")));
+                return Err(bad(
+                    FILTER,
+                    format!("the viewpoint must be finite, got {v:?}"),
+                ));
             }
         }
         Ok(())
@@ -94,14 +103,17 @@ impl NormalParams {
 /// let s = 1.25_f64.sqrt();
 /// assert!((n[0] + 0.5 / s).abs() < 1e-6 && n[1].abs() < 1e-6 && (n[2] - 1.0 / s).abs() < 1e-6);
 /// ```
-pub fn estimate_normals(cloud: &PointCloud, params: &NormalParams) -> Result<Vec<Option<[f64; 3]>>> {
+pub fn estimate_normals(
+    cloud: &PointCloud,
+    params: &NormalParams,
+) -> Result<Vec<Option<[f64; 3]>>> {
     params.validate()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
     // Search among the finite points only.
     let finite: Vec<usize> = (0..cloud.len())
-        .filter(|&i| super::neighbours::is_finite(&cloud.points[i]))
+        .filter(|&i| super::common::is_finite(&cloud.points[i]))
         .collect();
     let points: Vec<Point> = finite.iter().map(|&i| cloud.points[i]).collect();
     let tree = KdTree::new(&points);
@@ -198,7 +210,8 @@ pub(crate) fn pca_normal(points: impl Iterator<Item = Point> + Clone) -> Option<
     }
     let (values, vectors) = symmetric_eigen3(cov);
     // Collinear (or coincident) points: the two smallest eigenvalues vanish.
-    if !(values[1] > 1e-12 * values[2]) {
+    let plane_defined = values[1] > 1e-12 * values[2];
+    if !plane_defined {
         return None;
     }
     let n = [vectors[0][0], vectors[1][0], vectors[2][0]];
@@ -267,9 +280,15 @@ mod tests {
         // R diag(1, 4, 9) Rᵀ for a rotation R about an oblique axis.
         let (ax, ang) = ([1.0_f64, 2.0, 2.0].map(|c| c / 3.0), 0.7_f64);
         let (s, c) = ang.sin_cos();
-        let k = [[0.0, -ax[2], ax[1]], [ax[2], 0.0, -ax[0]], [-ax[1], ax[0], 0.0]];
+        let k = [
+            [0.0, -ax[2], ax[1]],
+            [ax[2], 0.0, -ax[0]],
+            [-ax[1], ax[0], 0.0],
+        ];
         let kk = mul(&k, &k);
-        let r = [0, 1, 2].map(|i| [0, 1, 2].map(|j| f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * kk[i][j]));
+        let r = [0, 1, 2].map(|i| {
+            [0, 1, 2].map(|j| f64::from(u8::from(i == j)) + s * k[i][j] + (1.0 - c) * kk[i][j])
+        });
         let d = [[1.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 9.0]];
         let m = mul(&mul(&r, &d), &transpose(&r));
         let (values, vectors) = symmetric_eigen3(m);

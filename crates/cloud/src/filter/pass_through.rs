@@ -22,7 +22,7 @@
 
 use rayon::prelude::*;
 
-use super::neighbours::{bad, empty_input, emptied, is_finite};
+use super::common::{bad, emptied, empty_input, is_finite};
 use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "pass-through";
@@ -87,7 +87,10 @@ impl PassThroughParams {
         if self.min_m.is_nan() || self.max_m.is_nan() {
             return Err(bad(
                 FILTER,
-                format!("limits must be numbers, got min_m = {}, max_m = {}", self.min_m, self.max_m),
+                format!(
+                    "limits must be numbers, got min_m = {}, max_m = {}",
+                    self.min_m, self.max_m
+                ),
             ));
         }
         if self.min_m > self.max_m {
@@ -119,13 +122,7 @@ pub fn pass_through_indices(cloud: &PointCloud, params: &PassThroughParams) -> R
     }
     let axis = params.axis.index();
     let keep = params.keep_inside;
-    let kept: Vec<usize> = cloud
-        .points
-        .par_iter()
-        .enumerate()
-        .filter(|(_, p)| passes(p, axis, lo, hi, keep))
-        .map(|(i, _)| i)
-        .collect();
+    let kept = compact(&cloud.points, |p| passes(p, axis, lo, hi, keep), |i, _| i);
     if kept.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }
@@ -149,14 +146,45 @@ pub fn pass_through(cloud: &PointCloud, params: &PassThroughParams) -> Result<Po
     }
     let axis = params.axis.index();
     let keep = params.keep_inside;
-    let points: Vec<Point> = cloud
-        .points
-        .par_iter()
-        .copied()
-        .filter(|p| passes(p, axis, lo, hi, keep))
-        .collect();
+    let points = compact(&cloud.points, |p| passes(p, axis, lo, hi, keep), |_, p| *p);
     if points.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }
     Ok(PointCloud::new(points))
+}
+
+/// Points per task of [`compact`].
+const CHUNK: usize = 1 << 15;
+
+/// `out(i, p)` for the points `p` (at index `i`) that pass `keep`, in input
+/// order. Each task writes its chunk's survivors, branch-free, to the start
+/// of the chunk's own range of the output; the ranges are then closed up in
+/// order.
+fn compact<T, K, O>(points: &[Point], keep: K, out: O) -> Vec<T>
+where
+    T: Copy + Default + Send + Sync,
+    K: Fn(&Point) -> bool + Sync,
+    O: Fn(usize, &Point) -> T + Sync,
+{
+    let mut result = vec![T::default(); points.len()];
+    let counts: Vec<usize> = result
+        .par_chunks_mut(CHUNK)
+        .zip(points.par_chunks(CHUNK))
+        .enumerate()
+        .map(|(chunk, (dst, src))| {
+            let mut n = 0;
+            for (j, p) in src.iter().enumerate() {
+                dst[n] = out(chunk * CHUNK + j, p);
+                n += usize::from(keep(p));
+            }
+            n
+        })
+        .collect();
+    let mut kept = 0;
+    for (chunk, &count) in counts.iter().enumerate() {
+        result.copy_within(chunk * CHUNK..chunk * CHUNK + count, kept);
+        kept += count;
+    }
+    result.truncate(kept);
+    result
 }

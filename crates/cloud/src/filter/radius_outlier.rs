@@ -21,20 +21,24 @@
 //! counting itself (or a duplicate of itself) as the first, has a squared
 //! distance `d` with `(double) d <= radius * radius` (the radius squared in
 //! f64, as PCL does; `d` is FLANN's f32 squared distance, computed here in
-//! the same order, see `neighbours.rs`). Points at exactly the radius count.
+//! the same order, see `kdtree.rs`). Points at exactly the radius count.
 //! The non-dense branch (`radiusSearch`, `k <= min_pts_radius_` removed)
 //! counts the same neighbours. Non-finite points are dropped first, as the
 //! PCL tool does. `radius_m` must be positive (PCL refuses 0).
 //!
 //! The PCL 1.13 `pcl_outlier_removal -method radius -radius R -min_pts N`
 //! keeps exactly what `RadiusOutlierParams { radius_m: R, min_neighbors: N }`
-//! keeps (tests/filter_pcl_agreement.rs). Open3D's `remove_radius_outlier(nb_points,
-//! radius)` counts the point itself: its `nb_points = N + 1` is our `N`.
+//! keeps (tests/filter_pcl_agreement.rs). Open3D 0.20's
+//! `remove_radius_outlier(nb_points = N, radius)` keeps a point when its
+//! radius search (which counts the point itself) finds more than N points,
+//! the same rule as ours with `min_neighbors = N`, but in f64 and without
+//! the points at exactly the radius (on `tests/data/filters/grid.pcd`,
+//! r = 0.25, N = 6 it keeps 400 points where PCL and we keep 620).
 
 use rayon::prelude::*;
 
+use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_points};
 use super::kdtree::KdTree;
-use super::neighbours::{bad, empty_input, emptied, f32_at_most, gather, on_finite_points};
 use crate::{PointCloud, Result};
 
 const FILTER: &str = "radius outlier removal";
@@ -65,7 +69,10 @@ impl RadiusOutlierParams {
         if !(self.radius_m.is_finite() && self.radius_m > 0.0) {
             return Err(bad(
                 FILTER,
-                format!("radius_m must be positive and finite, got {}", self.radius_m),
+                format!(
+                    "radius_m must be positive and finite, got {}",
+                    self.radius_m
+                ),
             ));
         }
         if self.min_neighbors >= u32::MAX as usize {
@@ -108,7 +115,10 @@ pub fn radius_outlier_removal_indices(
 /// let params = filter::RadiusOutlierParams { radius_m: 1.0, min_neighbors: 2 };
 /// assert_eq!(filter::radius_outlier_removal(&cloud, &params).unwrap().points, vec![[1.0, 0.0, 0.0]]);
 /// ```
-pub fn radius_outlier_removal(cloud: &PointCloud, params: &RadiusOutlierParams) -> Result<PointCloud> {
+pub fn radius_outlier_removal(
+    cloud: &PointCloud,
+    params: &RadiusOutlierParams,
+) -> Result<PointCloud> {
     let kept = radius_outlier_removal_indices(cloud, params)?;
     Ok(gather(cloud, &kept))
 }
@@ -127,5 +137,9 @@ fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<us
     // The wanted-th nearest is within the radius exactly when at least
     // `wanted` points are: count them, stopping at `wanted`.
     let keep: Vec<bool> = tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted));
-    keep.par_iter().enumerate().filter(|(_, &k)| k).map(|(i, _)| i).collect()
+    keep.par_iter()
+        .enumerate()
+        .filter(|(_, &k)| k)
+        .map(|(i, _)| i)
+        .collect()
 }

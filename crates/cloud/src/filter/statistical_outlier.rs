@@ -32,13 +32,16 @@
 //!
 //! The PCL 1.13 tool `pcl_outlier_removal -method statistical -mean_k K
 //! -std_dev_mul S` keeps exactly what `StatisticalOutlierParams { mean_k: K,
-//! std_mul: S }` keeps (tests/filter_pcl_agreement.rs). Open3D's
-//! `remove_statistical_outlier(nb_neighbors, std_ratio)` differs in details:
-//! its k neighbours include the point itself (so its mean is over k − 1 true
-//! neighbours), and it uses the population standard deviation (n).
+//! std_mul: S }` keeps (tests/filter_pcl_agreement.rs). Open3D 0.20's
+//! `remove_statistical_outlier(nb_neighbors, std_ratio)` differs in
+//! details: its nb_neighbors nearest include the point itself (so
+//! `nb_neighbors = k + 1` averages our k distances and a zero, which scales
+//! every mean by k/(k + 1) and the threshold with it), it computes in f64,
+//! and it keeps `0 < d̄_i < threshold` (strict); like PCL it uses the
+//! sample standard deviation.
 
+use super::common::{bad, emptied, empty_input, gather, on_finite_points};
 use super::kdtree::KdTree;
-use super::neighbours::{bad, empty_input, emptied, gather, on_finite_points};
 use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "statistical outlier removal";
@@ -67,10 +70,16 @@ impl Default for StatisticalOutlierParams {
 impl StatisticalOutlierParams {
     fn validate(&self) -> Result<()> {
         if self.mean_k == 0 || self.mean_k >= u32::MAX as usize {
-            return Err(bad(FILTER, format!("mean_k must be at least 1, got {}", self.mean_k)));
+            return Err(bad(
+                FILTER,
+                format!("mean_k must be at least 1, got {}", self.mean_k),
+            ));
         }
         if !self.std_mul.is_finite() {
-            return Err(bad(FILTER, format!("std_mul must be finite, got {}", self.std_mul)));
+            return Err(bad(
+                FILTER,
+                format!("std_mul must be finite, got {}", self.std_mul),
+            ));
         }
         Ok(())
     }
@@ -119,7 +128,9 @@ pub fn statistical_outlier_removal(
 pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f32> {
     let tree = KdTree::new(points);
     tree.map_k_nearest_distances(mean_k + 1, |nearest| {
-        let sum = nearest[1..].iter().fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
+        let sum = nearest[1..]
+            .iter()
+            .fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
         (sum / mean_k as f64) as f32
     })
 }
@@ -152,7 +163,7 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
     Ok(distances
         .iter()
         .enumerate()
-        .filter(|(_, &d)| !(f64::from(d) > threshold))
+        .filter(|(_, &d)| f64::from(d) <= threshold || threshold.is_nan())
         .map(|(i, _)| i)
         .collect())
 }

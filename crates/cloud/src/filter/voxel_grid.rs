@@ -16,16 +16,18 @@
 //! refuses a leaf whose linear voxel index would overflow an `int32`
 //! ("Leaf size is too small for the input dataset. Integer indices would
 //! overflow.") and returns the input unchanged; here voxel coordinates are
-//! i64 triplets, sorted through a u64 linear index when the occupied box has
-//! fewer than 2⁶⁴ voxels and lexicographically (z, y, x) otherwise, so any
-//! leaf whose products stay finite in f32 works.
+//! i64, and the points are sorted by voxel through one u64 holding the
+//! linear voxel index and the point index when the occupied box has at most
+//! 2³² voxels (an LSD radix sort on the voxel bits), through (u64 linear
+//! index, point index) pairs below 2⁶⁴ voxels, and through (z, y, x) i64
+//! triplets beyond, so any leaf whose products stay finite in f32 works.
 //!
 //! Open3D's `voxel_down_sample` anchors its grid at `min_bound − leaf/2`
 //! and computes in f64, so its voxels differ from PCL's.
 
 use rayon::prelude::*;
 
-use super::neighbours::{bad, empty_input, is_finite};
+use super::common::{bad, empty_input, is_finite};
 use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "voxel grid";
@@ -59,7 +61,12 @@ impl VoxelGridParams {
         for (a, (&leaf, inv)) in self.leaf_m.iter().zip(inv.iter_mut()).enumerate() {
             let leaf32 = leaf as f32;
             *inv = 1.0 / leaf32;
-            if !(leaf.is_finite() && leaf > 0.0 && leaf32 > 0.0 && leaf32.is_finite() && inv.is_finite()) {
+            if !(leaf.is_finite()
+                && leaf > 0.0
+                && leaf32 > 0.0
+                && leaf32.is_finite()
+                && inv.is_finite())
+            {
                 return Err(bad(
                     FILTER,
                     format!(
@@ -91,99 +98,144 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
-    // Voxel of each finite point (eq. 18 per point).
-    let cells: Vec<Option<[i64; 3]>> = cloud
-        .points
-        .par_iter()
-        .map(|p| {
-            if !is_finite(p) {
-                return Ok(None);
+    let points = &cloud.points;
+    // The voxel of a finite point (eq. 18 per point), checked.
+    let cell = |p: &Point| -> Result<[i64; 3]> {
+        let mut c = [0_i64; 3];
+        for a in 0..3 {
+            let v = (p[a] * inv[a]).floor();
+            if !v.is_finite() || v.abs() >= MAX_CELL {
+                return Err(bad(
+                    FILTER,
+                    format!(
+                        "leaf_m[{a}] = {} is too small for the coordinate {} (voxel index beyond 4e18)",
+                        params.leaf_m[a], p[a]
+                    ),
+                ));
             }
-            let mut c = [0_i64; 3];
-            for a in 0..3 {
-                let v = (p[a] * inv[a]).floor();
-                if !(v.abs() < MAX_CELL) {
-                    return Err(bad(
-                        FILTER,
-                        format!(
-                            "leaf_m[{a}] = {} is too small for the coordinate {} (voxel index beyond 4e18)",
-                            params.leaf_m[a], p[a]
-                        ),
-                    ));
+            c[a] = v as i64;
+        }
+        Ok(c)
+    };
+    // Bounds in voxels (eq. 17), in one parallel pass.
+    let none = || ([i64::MAX; 3], [i64::MIN; 3]);
+    let (lo, hi) = points
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+            for p in chunk.iter().filter(|p| is_finite(p)) {
+                let c = cell(p)?;
+                for a in 0..3 {
+                    lo[a] = lo[a].min(c[a]);
+                    hi[a] = hi[a].max(c[a]);
                 }
-                c[a] = v as i64;
             }
-            Ok(Some(c))
+            Ok((lo, hi))
         })
-        .collect::<Result<_>>()?;
-    // Bounds in voxels (eq. 17).
-    let bounds = cells.par_iter().flatten().fold(
-        || ([i64::MAX; 3], [i64::MIN; 3]),
-        |(mut lo, mut hi), c| {
-            for a in 0..3 {
-                lo[a] = lo[a].min(c[a]);
-                hi[a] = hi[a].max(c[a]);
-            }
-            (lo, hi)
-        },
-    );
-    let (lo, hi) = bounds.reduce(
-        || ([i64::MAX; 3], [i64::MIN; 3]),
-        |(l1, h1), (l2, h2)| {
-            (
-                [l1[0].min(l2[0]), l1[1].min(l2[1]), l1[2].min(l2[2])],
-                [h1[0].max(h2[0]), h1[1].max(h2[1]), h1[2].max(h2[2])],
-            )
-        },
-    );
+        .try_reduce(none, |(l1, h1), (l2, h2)| {
+            Ok((
+                [0, 1, 2].map(|a| l1[a].min(l2[a])),
+                [0, 1, 2].map(|a| h1[a].max(h2[a])),
+            ))
+        })?;
     if lo[0] > hi[0] {
-        // No finite point at all.
-        return Err(super::neighbours::emptied(
+        return Err(super::common::emptied(
             FILTER,
             cloud.len(),
             "every point has a non-finite coordinate",
         ));
     }
     let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]) as u128 + 1);
-    let centroids = if extent[0] * extent[1] * extent[2] <= u128::from(u64::MAX) {
-        // One u64 linear index, PCL's order: x fastest, z slowest.
-        let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
-        let keys: Vec<(u64, usize)> = cells
+    let voxels = extent[0] * extent[1] * extent[2];
+    // The linear index, PCL's order: x fastest, z slowest (the cell is
+    // valid: the bounds pass checked every finite point).
+    let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
+    let linear = |p: &Point| {
+        let c = [0, 1, 2].map(|a| ((p[a] * inv[a]).floor() as i64 - lo[a]) as u64);
+        c[0] + c[1] * ex + c[2] * exy
+    };
+    let centroids = if voxels <= 1 << 32 && points.len() <= 1 << 32 {
+        // Usual case: voxel index and point index packed in one u64, sorted
+        // by an LSD radix sort on the voxel bits (stable, so each voxel's
+        // points stay in input order).
+        let mut keys: Vec<u64> = points
             .par_iter()
             .enumerate()
-            .filter_map(|(i, c)| {
-                c.map(|c| {
-                    let d = [0, 1, 2].map(|a| (c[a] - lo[a]) as u64);
-                    (d[0] + d[1] * ex + d[2] * exy, i)
-                })
-            })
+            .filter(|(_, p)| is_finite(p))
+            .map(|(i, p)| (linear(p) << 32) | i as u64)
             .collect();
-        centroids_of_runs(&cloud.points, keys)
+        radix_sort_high(&mut keys, (128 - (voxels - 1).leading_zeros()) as usize);
+        centroids_of_runs(points, &keys, |k| k >> 32, |k| (k & 0xffff_ffff) as usize)
+    } else if voxels <= u128::from(u64::MAX) {
+        let mut keys: Vec<(u64, usize)> = points
+            .par_iter()
+            .enumerate()
+            .filter(|(_, p)| is_finite(p))
+            .map(|(i, p)| (linear(p), i))
+            .collect();
+        keys.par_sort_unstable();
+        centroids_of_runs(points, &keys, |k| k.0, |k| k.1)
     } else {
         // A box of 2⁶⁴ voxels or more: sort (z, y, x) triplets, same order.
-        let keys: Vec<([i64; 3], usize)> = cells
+        let mut keys: Vec<([i64; 3], usize)> = points
             .par_iter()
             .enumerate()
-            .filter_map(|(i, c)| c.map(|c| ([c[2], c[1], c[0]], i)))
+            .filter(|(_, p)| is_finite(p))
+            .map(|(i, p)| {
+                let c = [0, 1, 2].map(|a| (p[a] * inv[a]).floor() as i64);
+                ([c[2], c[1], c[0]], i)
+            })
             .collect();
-        centroids_of_runs(&cloud.points, keys)
+        keys.par_sort_unstable();
+        centroids_of_runs(points, &keys, |k| k.0, |k| k.1)
     };
     Ok(PointCloud::new(centroids))
 }
 
-/// Sorts (voxel key, point index) pairs and returns the centroid of each run
-/// of equal keys, in key order. Pairs are unique, so the order (and with it
-/// the f64 summation order inside a voxel: ascending point index) does not
-/// depend on the sort or on the number of threads.
-fn centroids_of_runs<K: Ord + Copy + Send + Sync>(points: &[Point], mut keys: Vec<(K, usize)>) -> Vec<Point> {
-    keys.par_sort_unstable();
-    // Cut the sorted pairs into chunks at run starts, one chunk per task.
+/// Sorts `keys` by their top `bits` bits above bit 32 (the voxel index),
+/// stably, by least-significant-digit radix passes of 11 bits.
+fn radix_sort_high(keys: &mut Vec<u64>, bits: usize) {
+    const DIGIT: usize = 11;
+    let mut other = vec![0u64; keys.len()];
+    let mut shift = 32;
+    while shift < 32 + bits {
+        let mut count = vec![0usize; 1 << DIGIT];
+        for &k in keys.iter() {
+            count[((k >> shift) as usize) & ((1 << DIGIT) - 1)] += 1;
+        }
+        let mut sum = 0;
+        for c in count.iter_mut() {
+            let n = *c;
+            *c = sum;
+            sum += n;
+        }
+        for &k in keys.iter() {
+            let d = ((k >> shift) as usize) & ((1 << DIGIT) - 1);
+            other[count[d]] = k;
+            count[d] += 1;
+        }
+        std::mem::swap(keys, &mut other);
+        shift += DIGIT;
+    }
+}
+
+/// The centroid of each run of equal voxel keys in the sorted `keys`, in
+/// key order. Within a voxel, points are summed in ascending index, so the
+/// result depends neither on the sort nor on the number of threads.
+fn centroids_of_runs<T, K, V, I>(points: &[Point], keys: &[T], voxel: V, index: I) -> Vec<Point>
+where
+    T: Sync,
+    V: Fn(&T) -> K + Sync,
+    I: Fn(&T) -> usize + Sync,
+    K: PartialEq,
+{
+    // Cut the sorted keys into chunks at run starts, one chunk per task.
     let n = keys.len();
     let tasks = (rayon::current_num_threads() * 4).max(1);
     let mut cuts = vec![0];
     for t in 1..tasks {
         let mut c = (n * t / tasks).max(*cuts.last().expect("not empty"));
-        while c > 0 && c < n && keys[c].0 == keys[c - 1].0 {
+        while c > 0 && c < n && voxel(&keys[c]) == voxel(&keys[c - 1]) {
             c += 1;
         }
         if c < n && c > *cuts.last().expect("not empty") {
@@ -198,11 +250,11 @@ fn centroids_of_runs<K: Ord + Copy + Send + Sync>(points: &[Point], mut keys: Ve
             let mut out = Vec::new();
             let mut start = 0;
             while start < run.len() {
-                let key = run[start].0;
+                let key = voxel(&run[start]);
                 let mut sum = [0.0_f64; 3];
                 let mut end = start;
-                while end < run.len() && run[end].0 == key {
-                    let p = points[run[end].1];
+                while end < run.len() && voxel(&run[end]) == key {
+                    let p = points[index(&run[end])];
                     for a in 0..3 {
                         sum[a] += f64::from(p[a]);
                     }

@@ -66,7 +66,9 @@ where
     if cloud.points.iter().all(is_finite) {
         return kept(&cloud.points);
     }
-    let index: Vec<usize> = (0..cloud.len()).filter(|&i| is_finite(&cloud.points[i])).collect();
+    let index: Vec<usize> = (0..cloud.len())
+        .filter(|&i| is_finite(&cloud.points[i]))
+        .collect();
     let finite: Vec<Point> = index.iter().map(|&i| cloud.points[i]).collect();
     Ok(kept(&finite)?.into_iter().map(|i| index[i]).collect())
 }
