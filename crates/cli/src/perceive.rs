@@ -436,75 +436,83 @@ pub fn job(
         points: cloud.len(),
         ms: ms(t),
     });
+    // The filter stages, in the paper's order; each timed and counted.
+    type Stage<'a> = (
+        &'static str,
+        bool,
+        Box<dyn Fn(&PointCloud) -> autoshovel_cloud::Result<PointCloud> + 'a>,
+    );
+    let filters: Vec<Stage> = vec![
+        (
+            "ground",
+            true,
+            Box::new(|c: &PointCloud| {
+                pass_through(
+                    c,
+                    &PassThroughParams::ground_removal(
+                        floor.floor_height_m + p.ground.margin_m * scale,
+                    ),
+                )
+            }),
+        ),
+        (
+            "radius",
+            p.radius.enabled,
+            Box::new(|c: &PointCloud| {
+                radius_outlier_removal(
+                    c,
+                    &RadiusOutlierParams {
+                        radius_m: p.radius.radius_spacings * spacing,
+                        min_neighbors: p.radius.min_neighbors,
+                    },
+                )
+            }),
+        ),
+        (
+            "statistical",
+            p.statistical.enabled,
+            Box::new(|c: &PointCloud| {
+                statistical_outlier_removal(
+                    c,
+                    &StatisticalOutlierParams {
+                        mean_k: p.statistical.mean_k,
+                        std_mul: p.statistical.std_mul,
+                    },
+                )
+            }),
+        ),
+        (
+            "voxel",
+            p.voxel.enabled,
+            Box::new(|c: &PointCloud| {
+                voxel_grid(c, &VoxelGridParams::cube(p.voxel.leaf_spacings * spacing))
+            }),
+        ),
+        (
+            "smooth",
+            p.smooth.enabled,
+            Box::new(|c: &PointCloud| {
+                let params = BilateralParams {
+                    radius_m: p.smooth.radius_spacings * spacing,
+                    sigma_d_m: p.smooth.sigma_d_spacings * spacing,
+                    sigma_n_m: p.smooth.sigma_n_m * scale,
+                    iterations: p.smooth.iterations,
+                };
+                bilateral_normal_smoothing(c, &params)
+            }),
+        ),
+    ];
     let mut cloud = cloud;
-    let t = Instant::now();
-    cloud = pass_through(
-        &cloud,
-        &PassThroughParams::ground_removal(floor.floor_height_m + p.ground.margin_m * scale),
-    )?;
-    stages.push(StageRecord {
-        stage: "ground",
-        points: cloud.len(),
-        ms: ms(t),
-    });
-    if p.radius.enabled {
-        let t = Instant::now();
-        cloud = radius_outlier_removal(
-            &cloud,
-            &RadiusOutlierParams {
-                radius_m: p.radius.radius_spacings * spacing,
-                min_neighbors: p.radius.min_neighbors,
-            },
-        )?;
-        stages.push(StageRecord {
-            stage: "radius",
-            points: cloud.len(),
-            ms: ms(t),
-        });
-    }
-    if p.statistical.enabled {
-        let t = Instant::now();
-        cloud = statistical_outlier_removal(
-            &cloud,
-            &StatisticalOutlierParams {
-                mean_k: p.statistical.mean_k,
-                std_mul: p.statistical.std_mul,
-            },
-        )?;
-        stages.push(StageRecord {
-            stage: "statistical",
-            points: cloud.len(),
-            ms: ms(t),
-        });
-    }
-    if p.voxel.enabled {
-        let t = Instant::now();
-        cloud = voxel_grid(
-            &cloud,
-            &VoxelGridParams::cube(p.voxel.leaf_spacings * spacing),
-        )?;
-        stages.push(StageRecord {
-            stage: "voxel",
-            points: cloud.len(),
-            ms: ms(t),
-        });
-    }
-    if p.smooth.enabled {
-        let t = Instant::now();
-        cloud = bilateral_normal_smoothing(
-            &cloud,
-            &BilateralParams {
-                radius_m: p.smooth.radius_spacings * spacing,
-                sigma_d_m: p.smooth.sigma_d_spacings * spacing,
-                sigma_n_m: p.smooth.sigma_n_m * scale,
-                iterations: p.smooth.iterations,
-            },
-        )?;
-        stages.push(StageRecord {
-            stage: "smooth",
-            points: cloud.len(),
-            ms: ms(t),
-        });
+    for (stage, enabled, run) in filters {
+        if enabled {
+            let t = Instant::now();
+            cloud = run(&cloud)?;
+            stages.push(StageRecord {
+                stage,
+                points: cloud.len(),
+                ms: ms(t),
+            });
+        }
     }
     let t = Instant::now();
     let fit_params = FitParams {
