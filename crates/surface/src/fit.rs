@@ -482,6 +482,27 @@ mod tests {
     use rand::{Rng, SeedableRng};
     use rand_chacha::ChaCha8Rng;
 
+    /// Exact heights of `f` at the centres of the 8 × 8 cells of `extent`.
+    fn exact_grid(extent: &Extent, f: impl Fn(f64, f64) -> f64) -> Vec<GridSample> {
+        let dx = (extent.x_max_m - extent.x_min_m) / 8.0;
+        let dy = (extent.y_max_m - extent.y_min_m) / 8.0;
+        (0..64)
+            .map(|k| {
+                let (ix, iy) = (k % 8, k / 8);
+                let x = extent.x_min_m + (ix as f64 + 0.5) * dx;
+                let y = extent.y_min_m + (iy as f64 + 0.5) * dy;
+                GridSample {
+                    ix,
+                    iy,
+                    x_m: x,
+                    y_m: y,
+                    z_m: f(x, y),
+                    points: 1,
+                }
+            })
+            .collect()
+    }
+
     fn cloud_of(
         f: impl Fn(f64, f64) -> f64,
         n_side: usize,
@@ -542,21 +563,7 @@ mod tests {
             y_min_m: -5.0,
             y_max_m: 15.0,
         };
-        let samples: Vec<GridSample> = (0..64)
-            .map(|k| {
-                let (ix, iy) = (k % 8, k / 8);
-                let x = -10.0 + (ix as f64 + 0.5) * 2.5;
-                let y = -5.0 + (iy as f64 + 0.5) * 2.5;
-                GridSample {
-                    ix,
-                    iy,
-                    x_m: x,
-                    y_m: y,
-                    z_m: f(x, y),
-                    points: 1,
-                }
-            })
-            .collect();
+        let samples = exact_grid(&extent, f);
         let fit = fit_samples(&samples, extent, &FitParams::default()).unwrap();
         assert_eq!(fit.degree, 2, "{:?}", fit.candidates);
         for ((a, b), c) in expected {
@@ -584,21 +591,7 @@ mod tests {
             y_min_m: -1.0,
             y_max_m: 1.0,
         };
-        let samples: Vec<GridSample> = (0..64)
-            .map(|k| {
-                let (ix, iy) = (k % 8, k / 8);
-                let x = -1.0 + (ix as f64 + 0.5) * 0.25;
-                let y = -1.0 + (iy as f64 + 0.5) * 0.25;
-                GridSample {
-                    ix,
-                    iy,
-                    x_m: x,
-                    y_m: y,
-                    z_m: f(x, y),
-                    points: 1,
-                }
-            })
-            .collect();
+        let samples = exact_grid(&extent, f);
         let params = FitParams {
             degree: Some(3),
             ..FitParams::default()

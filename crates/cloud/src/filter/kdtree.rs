@@ -67,6 +67,9 @@ pub(crate) struct KdTree {
     ids: Vec<u32>,
 }
 
+/// A subtree: (node, start, len) in the point array.
+type Subtree = (usize, usize, usize);
+
 impl KdTree {
     /// Builds the tree over `points` (finite, at most u32::MAX of them).
     pub(crate) fn new(points: &[Point]) -> Self {
@@ -144,6 +147,28 @@ impl KdTree {
         self.nearest_in(0, 0, self.len(), self.depth, q, &mut off, 0.0, knn);
     }
 
+    /// The split axis of `node`, the query's signed offset from its split
+    /// plane, and its (node, start, len) children nearer and farther from `q`.
+    #[inline]
+    fn children(
+        &self,
+        node: usize,
+        start: usize,
+        len: usize,
+        q: &[f32; 3],
+    ) -> (usize, f64, Subtree, Subtree) {
+        let (axis, split) = self.splits[node];
+        let half = len / 2;
+        let diff = f64::from(q[axis as usize]) - f64::from(split);
+        let left = (2 * node + 1, start, half);
+        let right = (2 * node + 2, start + half, len - half);
+        if diff < 0.0 {
+            (axis as usize, diff, left, right)
+        } else {
+            (axis as usize, diff, right, left)
+        }
+    }
+
     #[allow(clippy::too_many_arguments)]
     fn nearest_in(
         &self,
@@ -162,21 +187,7 @@ impl KdTree {
             }
             return;
         }
-        let (axis, split) = self.splits[node];
-        let a = axis as usize;
-        let half = len / 2;
-        let diff = f64::from(q[a]) - f64::from(split);
-        let (near, far) = if diff < 0.0 {
-            (
-                (2 * node + 1, start, half),
-                (2 * node + 2, start + half, len - half),
-            )
-        } else {
-            (
-                (2 * node + 2, start + half, len - half),
-                (2 * node + 1, start, half),
-            )
-        };
+        let (a, diff, near, far) = self.children(node, start, len, q);
         self.nearest_in(near.0, near.1, near.2, levels - 1, q, off, rd, knn);
         let old = off[a];
         let far_rd = rd - old * old + diff * diff;
@@ -232,21 +243,7 @@ impl KdTree {
             }
             return;
         }
-        let (axis, split) = self.splits[node];
-        let a = axis as usize;
-        let half = len / 2;
-        let diff = f64::from(q[a]) - f64::from(split);
-        let (near, far) = if diff < 0.0 {
-            (
-                (2 * node + 1, start, half),
-                (2 * node + 2, start + half, len - half),
-            )
-        } else {
-            (
-                (2 * node + 2, start + half, len - half),
-                (2 * node + 1, start, half),
-            )
-        };
+        let (a, diff, near, far) = self.children(node, start, len, q);
         self.count_in(
             near.0,
             near.1,
