@@ -1,5 +1,6 @@
 //! Shared foundation of autoshovel: plane geometry aliases, poses and frame
-//! conventions (SPEC §1), angle wrapping, polylines and cubic B-splines.
+//! conventions (SPEC §1), angle wrapping, polylines, cubic B-splines and
+//! product-of-exponentials twists ([`poe`]).
 //!
 //! Every other crate depends on this one; it depends on nothing of ours.
 
@@ -9,6 +10,7 @@
 mod angle;
 mod bspline;
 mod geom;
+pub mod poe;
 mod polyline;
 
 pub use angle::{angle_diff, deg, rad, wrap_angle};

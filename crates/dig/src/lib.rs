@@ -1,0 +1,26 @@
+//! Rope-shovel dig planning (rope-shovel paper §2 and §4; SPEC §4.2–4.3):
+//! product-of-exponentials kinematics of the 1R-1P dipper ([`kinematics`],
+//! eqs. 1–8), Lagrange dynamics with digging resistance ([`dynamics`], eq.
+//! 10), the 6th-order tooth path ([`trajectory`], eqs. 22–24), the pile as
+//! the planner sees it ([`terrain`], eqs. 21 and 28), and the planner that
+//! puts them under the 18 constraints and the Grey Wolf Optimizer ([`plan`],
+//! eqs. 25–37). The machine is a [`MachineProfile`] read from TOML.
+
+// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
+pub mod calibrate;
+pub mod dynamics;
+mod error;
+pub mod kinematics;
+pub mod plan;
+pub mod profile;
+pub mod terrain;
+pub mod trajectory;
+
+pub use error::{DigError, Result};
+pub use kinematics::{Joints, RopeShovel};
+pub use plan::{plan_dig, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace, CONSTRAINT_NAMES};
+pub use profile::{Geometry, MachineProfile};
+pub use terrain::DigSurface;
+pub use trajectory::{Decision, Trajectory};

@@ -1,0 +1,530 @@
+//! The dig-planning model of the rope-shovel paper §4: objective (eqs.
+//! 25–27), excavated volume (eq. 28), the 18 constraints (eqs. 29–35) and
+//! their optimisation by the Grey Wolf Optimizer (eq. 37).
+//!
+//! One evaluation samples the trajectory of eq. 22 at `numerics.samples`
+//! instants, solves the inverse kinematics (eqs. 7–8) and the inverse
+//! dynamics (eq. 10) at each, accumulates the material swept (eq. 28) and the
+//! energy of the hoist and crowd (eq. 25), and returns f and every c_i.
+//!
+//! # Constraints (value ≤ 0 is satisfied; time-varying ones take the worst instant)
+//! | c | eq. | value |
+//! |---|---|---|
+//! | c1, c2 | 29 | fill_min − V/V_cd, V/V_cd − fill_max |
+//! | c3, c4 | 30 | t_min − t_d, t_d − t_max |
+//! | c5, c6 | 31 | β_min − min β, max β − β_max (printed with min and max swapped) |
+//! | c7, c8 | 32 | −min v_h − 0.001 v_h,max, max v_h − v_h,max |
+//! | c9, c10 | 32 | −min v_c − 0.001 v_c,max, max v_c − v_c,max |
+//! | c11–c14 | 33 | max F_h − F_h,max, max F_c − F_c,max, max P_h − P_h,max, max P_c − P_c,max |
+//! | c15 | 34 | f̄(g_x) − g_y: the tip ends above the surface (H_dm − h) |
+//! | c16 | 34 | H_kk + H_cd − g_y: the dipper bottom clears the hopper |
+//! | c17 | 35 | max D − L_dg: the handle stroke |
+//! | c18 | 35 | max y − H_tl: below the top of the boom point sheave |
+//!
+//! The digging back angle β is the clearance between the tip velocity and
+//! the tooth's back face, which is tilted δ₁ from the handle normal: β = δ₁
+//! when the tip moves along the normal, less when the crowd outruns the hoist.
+//! For the optimiser the violations are normalised by their limits (fill
+//! as is, time by t_max, angles in radians, speeds, forces and powers by
+//! their ratings, heights by H_tl, stroke by L_dg) and summed.
+
+use autoshovel_optim::{minimize, Evaluation, GwoParams, GwoResult, Problem};
+
+use crate::dynamics::{inverse_dynamics, Drive, MassModel};
+use crate::error::{DigError, Result};
+use crate::kinematics::{handle_axes, Joints, RopeShovel};
+use crate::profile::MachineProfile;
+use crate::terrain::{swept_width, DigSurface};
+use crate::trajectory::Decision;
+
+const G: f64 = 9.81;
+
+/// Names of c1–c18, as in the summary.
+pub const CONSTRAINT_NAMES: [&str; 18] = [
+    "c1_fill_min",
+    "c2_fill_max",
+    "c3_time_min",
+    "c4_time_max",
+    "c5_back_angle_min",
+    "c6_back_angle_max",
+    "c7_hoist_speed_positive",
+    "c8_hoist_speed_max",
+    "c9_crowd_speed_positive",
+    "c10_crowd_speed_max",
+    "c11_hoist_force_max",
+    "c12_crowd_force_max",
+    "c13_hoist_power_max",
+    "c14_crowd_power_max",
+    "c15_leaves_surface",
+    "c16_hopper_clearance",
+    "c17_handle_stroke",
+    "c18_sheave_height",
+];
+
+/// c7 and c9 allow a reversal of this share of the rated speed: at the
+/// ends of the dig both speeds are zero by eq. 23, and their sign in the
+/// last microseconds is rounding, not motion.
+pub const SPEED_TOLERANCE: f64 = 1e-3;
+
+/// Units of the constraint values, for messages.
+const CONSTRAINT_UNITS: [&str; 18] = [
+    "", "", "s", "s", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "N", "N", "W", "W", "m", "m",
+    "m", "m",
+];
+
+/// The state of the dig at one sample.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct DigSample {
+    /// Time [s].
+    pub t_s: f64,
+    /// Tooth tip x, y in the dig frame [m].
+    pub tip_m: [f64; 2],
+    /// Joint values.
+    pub joints: Joints,
+    /// Forces and speeds.
+    pub drive: Drive,
+    /// Cut thickness c normal to the path [m].
+    pub cut_thickness_m: f64,
+    /// Material in the dipper so far [kg].
+    pub load_kg: f64,
+    /// Digging back angle β [rad].
+    pub back_angle_rad: f64,
+}
+
+/// Everything one evaluation measures.
+#[derive(Debug, Clone, PartialEq, serde::Serialize)]
+pub struct DigOutcome {
+    /// The decision evaluated.
+    pub decision: Decision,
+    /// f of eq. 27.
+    pub f: f64,
+    /// f1 of eq. 25: energy per kilogram [J/kg].
+    pub f1_j_per_kg: f64,
+    /// f2 of eq. 26: time per kilogram [s/kg].
+    pub f2_s_per_kg: f64,
+    /// ∫ v_h F_h dt [J].
+    pub hoist_energy_j: f64,
+    /// ∫ v_c F_c dt [J].
+    pub crowd_energy_j: f64,
+    /// V of eq. 28 [m³].
+    pub volume_m3: f64,
+    /// m_dig = ρV [kg].
+    pub m_dig_kg: f64,
+    /// V / V_cd.
+    pub fill_factor: f64,
+    /// c1–c18 (≤ 0 satisfied), in SI units.
+    pub constraints: [f64; 18],
+    /// Normalised total violation (0 when feasible).
+    pub violation: f64,
+    /// Every sample had an inverse kinematics and a rope with a moment arm.
+    pub reachable: bool,
+}
+
+impl DigOutcome {
+    /// Every constraint met and every sample reachable.
+    pub fn feasible(&self) -> bool {
+        self.reachable && self.violation == 0.0
+    }
+
+    /// The violated constraints as "name = value unit", worst first.
+    pub fn violated(&self) -> Vec<String> {
+        let mut v: Vec<(usize, f64)> = self
+            .constraints
+            .iter()
+            .enumerate()
+            .filter(|(_, &c)| c > 0.0)
+            .map(|(i, &c)| (i, c))
+            .collect();
+        v.sort_by(|a, b| b.1.total_cmp(&a.1));
+        let mut out: Vec<String> = v
+            .into_iter()
+            .map(|(i, c)| {
+                format!(
+                    "{} exceeded by {:.4} {}",
+                    CONSTRAINT_NAMES[i], c, CONSTRAINT_UNITS[i]
+                )
+            })
+            .collect();
+        if !self.reachable {
+            out.insert(
+                0,
+                "reach: part of the path is out of the dipper's reach".to_string(),
+            );
+        }
+        out
+    }
+}
+
+/// The coordinates the optimiser moves in.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, serde::Serialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum SearchSpace {
+    /// [bend_x, bend_y, t_d, g_x, g_y]: a₆ as mid-dig bends (default).
+    #[default]
+    Bends,
+    /// The paper's [a_x6, a_y6, t_d, g_x, g_y].
+    Paper,
+}
+
+impl std::str::FromStr for SearchSpace {
+    type Err = String;
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s {
+            "bends" => Ok(Self::Bends),
+            "paper" => Ok(Self::Paper),
+            _ => Err(format!("unknown search space '{s}' (use bends or paper)")),
+        }
+    }
+}
+
+/// The planning model of one machine on one pile.
+#[derive(Debug, Clone)]
+pub struct DigModel {
+    /// The machine profile.
+    pub profile: MachineProfile,
+    /// Its kinematics.
+    pub shovel: RopeShovel,
+    /// Its mass model.
+    pub mass: MassModel,
+    /// The pile.
+    pub surface: DigSurface,
+    space: SearchSpace,
+    bounds: Vec<(f64, f64)>,
+    scales: [f64; 18],
+}
+
+impl DigModel {
+    /// Set up a model; refuses a pile whose toe the dipper cannot reach or
+    /// whose material could never fill the dipper.
+    pub fn new(profile: &MachineProfile, surface: DigSurface) -> Result<Self> {
+        let geometry = profile.geometry();
+        let shovel = RopeShovel::new(geometry);
+        match shovel.inverse([0.0, 0.0]) {
+            Some(q) if q.d2 + geometry.d20 <= geometry.handle_length => {}
+            _ => {
+                return Err(DigError::Unreachable(format!(
+                    "the toe (0, 0) is out of the dipper's reach from the saddle at \
+                     ({:.3}, {:.3}) m",
+                    geometry.l1, geometry.l2
+                )))
+            }
+        }
+        // Most material a path inside the search box could take: everything
+        // above the floor between the toe and the farthest end point.
+        let (_, x_end) = surface.x_range();
+        let reach = profile.search.gx_m[1].min(x_end);
+        let steps = 400;
+        let area: f64 = (0..steps)
+            .map(|i| {
+                let x = reach * (i as f64 + 0.5) / steps as f64;
+                surface.height(x).clamp(0.0, profile.search.gy_m[1])
+            })
+            .sum::<f64>()
+            * reach
+            / steps as f64;
+        let most = area * profile.dipper.width_m;
+        let need = profile.limits.fill_min * profile.dipper.capacity_m3;
+        if most < need {
+            return Err(DigError::Surface(format!(
+                "the pile is too small to fill the dipper: at most {:.3e} m³ lies within \
+                 reach (g_x ≤ {:.3} m, g_y ≤ {:.3} m), the fill constraint c1 needs {:.3e} m³",
+                most, reach, profile.search.gy_m[1], need
+            )));
+        }
+        let l = &profile.limits;
+        let scales = [
+            1.0,
+            1.0,
+            l.time_max_s,
+            l.time_max_s,
+            1.0,
+            1.0,
+            l.hoist_speed_max_m_s,
+            l.hoist_speed_max_m_s,
+            l.crowd_speed_max_m_s,
+            l.crowd_speed_max_m_s,
+            l.hoist_force_max_n,
+            l.crowd_force_max_n,
+            l.hoist_power_max_w,
+            l.crowd_power_max_w,
+            geometry.sheave_top_height,
+            geometry.sheave_top_height,
+            geometry.handle_length,
+            geometry.sheave_top_height,
+        ];
+        let mut model = Self {
+            profile: profile.clone(),
+            shovel,
+            mass: MassModel::of(profile),
+            surface,
+            space: SearchSpace::Bends,
+            bounds: Vec::new(),
+            scales,
+        };
+        model.set_search_space(SearchSpace::Bends);
+        Ok(model)
+    }
+
+    /// Choose the optimiser's coordinates (and with them the box of the
+    /// profile's `[search]` table).
+    pub fn set_search_space(&mut self, space: SearchSpace) {
+        let s = &self.profile.search;
+        let (a, b) = match space {
+            SearchSpace::Bends => (s.bend_x_m, s.bend_y_m),
+            SearchSpace::Paper => (s.ax6, s.ay6),
+        };
+        self.space = space;
+        self.bounds = vec![
+            (a[0], a[1]),
+            (b[0], b[1]),
+            (s.td_s[0], s.td_s[1]),
+            (s.gx_m[0], s.gx_m[1]),
+            (s.gy_m[0], s.gy_m[1]),
+        ];
+    }
+
+    /// The optimiser's coordinates.
+    pub fn search_space(&self) -> SearchSpace {
+        self.space
+    }
+
+    /// The decision of an optimiser vector.
+    pub fn decision(&self, x: &[f64]) -> Decision {
+        match self.space {
+            SearchSpace::Bends => Decision::from_bends(x[0], x[1], x[2], x[3], x[4]),
+            SearchSpace::Paper => Decision::from_slice(x),
+        }
+    }
+
+    /// The optimiser vector of a decision (for warm starts).
+    pub fn vector(&self, d: &Decision) -> Vec<f64> {
+        match self.space {
+            SearchSpace::Bends => {
+                let [bx, by] = d.bends();
+                vec![bx, by, d.td_s, d.gx_m, d.gy_m]
+            }
+            SearchSpace::Paper => d.to_vec(),
+        }
+    }
+
+    /// Evaluate one decision (no curves kept).
+    pub fn evaluate(&self, x: &Decision) -> DigOutcome {
+        self.run(x, |_| {})
+    }
+
+    /// Evaluate one decision and keep every sample (for plots and CSV).
+    pub fn simulate(&self, x: &Decision) -> (DigOutcome, Vec<DigSample>) {
+        let mut samples = Vec::with_capacity(self.profile.numerics.samples);
+        let out = self.run(x, |s| samples.push(*s));
+        (out, samples)
+    }
+
+    /// The one loop behind [`DigModel::evaluate`] and [`DigModel::simulate`].
+    fn run(&self, x: &Decision, mut sink: impl FnMut(&DigSample)) -> DigOutcome {
+        let p = &self.profile;
+        let geo = &self.shovel.geometry;
+        let traj = x.trajectory();
+        let n = p.numerics.samples;
+        let dt = x.td_s / (n - 1) as f64;
+        let (b, rho) = (p.dipper.width_m, p.material.density_kg_m3);
+        let (kf, psi) = (p.material.cutting_resistance_pa, p.material.normal_ratio);
+        let eps = p.material.fill_resistance_ratio;
+        let (sp, cp) = (p.geometry.dipper_pitch_deg.to_radians().sin_cos().0, {
+            p.geometry.dipper_pitch_deg.to_radians().cos()
+        });
+
+        let mut reachable = true;
+        let (mut v_h_min, mut v_h_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut v_c_min, mut v_c_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut f_h_max, mut f_c_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let (mut p_h_max, mut p_c_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let (mut beta_min, mut beta_max) = (f64::INFINITY, f64::NEG_INFINITY);
+        let (mut d_max, mut y_max) = (f64::NEG_INFINITY, f64::NEG_INFINITY);
+        let (mut e_h, mut e_c) = (0.0, 0.0);
+        let mut prev: Option<(f64, f64, f64, [f64; 2])> = None; // (swept, P_h, P_c, tip)
+        let mut area = 0.0;
+
+        for i in 0..n {
+            let t = i as f64 * dt;
+            let tip = traj.at(t);
+            let speed = tip.v[0].hypot(tip.v[1]);
+            // Cut thickness along the left normal; at rest (the ends) the
+            // direction of the limit is the direction of the acceleration.
+            let dir = if speed > 1e-12 { tip.v } else { tip.a };
+            let norm = dir[0].hypot(dir[1]);
+            let (c, kappa) = if norm > 0.0 {
+                let left = [-dir[1] / norm, dir[0] / norm];
+                let kappa = if speed > 1e-12 {
+                    (tip.v[0] * tip.a[1] - tip.v[1] * tip.a[0]) / (speed * speed * speed)
+                } else {
+                    0.0
+                };
+                (self.surface.cut_thickness(tip.p, left), kappa)
+            } else {
+                (0.0, 0.0)
+            };
+            let swept = swept_width(c, kappa).max(0.0);
+            if let Some((sw0, _, _, p0)) = prev {
+                let ds = (tip.p[0] - p0[0]).hypot(tip.p[1] - p0[1]);
+                area += 0.5 * (swept + sw0) * ds;
+            }
+            let load = rho * b * area;
+            let Some(js) = self.shovel.joint_state(tip.p, tip.v, tip.a) else {
+                reachable = false;
+                prev = Some((swept, 0.0, 0.0, tip.p));
+                continue;
+            };
+            // Resistance along the path: cutting (k_F·b·c) and, while the
+            // dipper is in the bank, dragging its load (ε·g·m_load).
+            let f_tau = if c > 0.0 {
+                kf * b * c + eps * G * load
+            } else {
+                0.0
+            };
+            let Some(drive) =
+                inverse_dynamics(&self.shovel, &self.mass, &js, tip.v, f_tau, psi, load)
+            else {
+                reachable = false;
+                prev = Some((swept, 0.0, 0.0, tip.p));
+                continue;
+            };
+            let (ph, pc) = (drive.hoist_power_w(), drive.crowd_power_w());
+            if let Some((_, ph0, pc0, _)) = prev {
+                e_h += 0.5 * (ph + ph0) * dt;
+                e_c += 0.5 * (pc + pc0) * dt;
+            }
+            prev = Some((swept, ph, pc, tip.p));
+
+            // Back angle between v and the tooth back face b̂ = cos δ₁ n + sin δ₁ u.
+            let (u, nn) = handle_axes(js.q.theta1);
+            let beta = if speed > 1e-12 {
+                let bh = [cp * nn[0] + sp * u[0], cp * nn[1] + sp * u[1]];
+                let cross = tip.v[0] * bh[1] - tip.v[1] * bh[0];
+                let dot = tip.v[0] * bh[0] + tip.v[1] * bh[1];
+                let beta = -cross.atan2(dot);
+                beta_min = beta_min.min(beta);
+                beta_max = beta_max.max(beta);
+                beta
+            } else {
+                f64::NAN
+            };
+            v_h_min = v_h_min.min(drive.hoist_speed_m_s);
+            v_h_max = v_h_max.max(drive.hoist_speed_m_s);
+            v_c_min = v_c_min.min(drive.crowd_speed_m_s);
+            v_c_max = v_c_max.max(drive.crowd_speed_m_s);
+            f_h_max = f_h_max.max(drive.hoist_force_n);
+            f_c_max = f_c_max.max(drive.crowd_force_n);
+            p_h_max = p_h_max.max(ph);
+            p_c_max = p_c_max.max(pc);
+            d_max = d_max.max(js.q.d2 + geo.d20);
+            y_max = y_max.max(tip.p[1]);
+            sink(&DigSample {
+                t_s: t,
+                tip_m: tip.p,
+                joints: js.q,
+                drive,
+                cut_thickness_m: c,
+                load_kg: load,
+                back_angle_rad: beta,
+            });
+        }
+
+        let volume = b * area;
+        let m_dig = rho * volume;
+        let fill = volume / p.dipper.capacity_m3;
+        let l = &p.limits;
+        let constraints = [
+            l.fill_min - fill,
+            fill - l.fill_max,
+            l.time_min_s - x.td_s,
+            x.td_s - l.time_max_s,
+            l.back_angle_min_deg.to_radians() - beta_min,
+            beta_max - l.back_angle_max_deg.to_radians(),
+            -v_h_min - SPEED_TOLERANCE * l.hoist_speed_max_m_s,
+            v_h_max - l.hoist_speed_max_m_s,
+            -v_c_min - SPEED_TOLERANCE * l.crowd_speed_max_m_s,
+            v_c_max - l.crowd_speed_max_m_s,
+            f_h_max - l.hoist_force_max_n,
+            f_c_max - l.crowd_force_max_n,
+            p_h_max - l.hoist_power_max_w,
+            p_c_max - l.crowd_power_max_w,
+            self.surface.height(x.gx_m) - x.gy_m,
+            l.hopper_height_m + p.dipper.height_m - x.gy_m,
+            d_max - geo.handle_length,
+            y_max - geo.sheave_top_height,
+        ];
+        let mut violation: f64 = constraints
+            .iter()
+            .zip(&self.scales)
+            .map(|(&c, &s)| if c > 0.0 { c / s } else { 0.0 })
+            .sum();
+        if !reachable || violation.is_nan() {
+            violation = violation.max(0.0) + 100.0;
+        }
+        let energy = e_h + e_c;
+        let (f1, f2, f) = if m_dig > 1e-9 && energy.is_finite() {
+            let f1 = energy / m_dig;
+            let f2 = x.td_s / m_dig;
+            (f1, f2, p.objective.k1 * f1 + p.objective.k2 * f2)
+        } else {
+            (f64::INFINITY, f64::INFINITY, f64::INFINITY)
+        };
+        DigOutcome {
+            decision: *x,
+            f,
+            f1_j_per_kg: f1,
+            f2_s_per_kg: f2,
+            hoist_energy_j: e_h,
+            crowd_energy_j: e_c,
+            volume_m3: volume,
+            m_dig_kg: m_dig,
+            fill_factor: fill,
+            constraints,
+            violation,
+            reachable,
+        }
+    }
+}
+
+impl Problem for DigModel {
+    fn bounds(&self) -> &[(f64, f64)] {
+        &self.bounds
+    }
+
+    fn evaluate(&self, x: &[f64]) -> Evaluation {
+        let out = DigModel::evaluate(self, &self.decision(x));
+        Evaluation::new(out.f, out.violation)
+    }
+}
+
+/// A finished plan.
+#[derive(Debug, Clone)]
+pub struct DigPlan {
+    /// The best decision and everything measured on it.
+    pub outcome: DigOutcome,
+    /// The samples along the planned dig.
+    pub samples: Vec<DigSample>,
+    /// The optimiser's record (convergence history, final pack for warm starts).
+    pub search: GwoResult,
+}
+
+/// Plan a dig: minimise f over the search box with the Grey Wolf Optimizer,
+/// starting from `warm_start` wolves (e.g. the previous cycle's
+/// `search.population`) plus the initial pack of `gwo`. A best plan that
+/// still violates a constraint is an error naming the binding constraints.
+pub fn plan_dig(model: &DigModel, gwo: &GwoParams, warm_start: &[Vec<f64>]) -> Result<DigPlan> {
+    let search = minimize(model, gwo, warm_start)?;
+    let decision = model.decision(&search.best);
+    let (outcome, samples) = model.simulate(&decision);
+    if !outcome.feasible() {
+        return Err(DigError::Infeasible {
+            binding: outcome.violated().join("; "),
+            evaluations: search.evaluations,
+        });
+    }
+    Ok(DigPlan {
+        outcome,
+        samples,
+        search,
+    })
+}
