@@ -9,8 +9,9 @@
 //! and the dig time are shared by more material), and the optimiser always
 //! fills to the 110 % limit, while the paper's plans stop near 100 % on all
 //! four piles. Each step plans the dig with the Grey Wolf Optimizer and moves
-//! one parameter by a secant step (k_F on f1, then ε on the fill), until both
-//! are within tolerance. The result is calibrated on one pile and then used
+//! both by a damped Newton step on measured slopes (f1 rises by 1/ρ per
+//! unit of k_F and by about 1.08 J/kg per unit of ε; the fill falls by about
+//! 0.056 per unit of ε), backing off when the limits leave no feasible plan. The result is calibrated on one pile and then used
 //! unchanged to *predict* the others.
 
 use autoshovel_optim::GwoParams;
@@ -19,6 +20,13 @@ use crate::error::{DigError, Result};
 use crate::plan::{plan_dig, DigModel};
 use crate::profile::MachineProfile;
 use crate::terrain::DigSurface;
+
+/// How much the planned fill factor falls per unit of ε, about.
+const FILL_SLOPE: f64 = 0.056;
+/// How much f1 rises per unit of ε at a fixed k_F, about [J/kg].
+const F1_PER_EPS: f64 = 1.08;
+/// Share of the Newton step taken.
+const DAMPING: f64 = 0.6;
 
 /// What to match.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -55,7 +63,8 @@ pub struct Calibration {
 }
 
 /// Calibrate k_F and ε of `profile` on `surface` (module docs); f1 within
-/// 0.5 % and the fill within 0.015 of the target.
+/// 1 % and the fill within 0.03 of the target (the planned fill moves by a few
+/// per cent between seeds: near the optimum f is flat in the fill).
 pub fn calibrate(
     profile: &MachineProfile,
     surface: &DigSurface,
@@ -64,16 +73,21 @@ pub fn calibrate(
 ) -> Result<Calibration> {
     let mut p = profile.clone();
     let mut plans = 0;
-    let mut run = |p: &MachineProfile| -> Result<(f64, f64)> {
+    let (mut f1, mut fill) = (f64::NAN, f64::NAN);
+    while plans < 24 {
         plans += 1;
-        let model = DigModel::new(p, surface.clone())?;
-        let plan = plan_dig(&model, gwo, &[])?;
-        Ok((plan.outcome.f1_j_per_kg, plan.outcome.fill_factor))
-    };
-    let (mut f1, mut fill) = run(&p)?;
-    for _ in 0..12 {
-        if (f1 / target.f1_j_per_kg - 1.0).abs() < 0.005
-            && (fill - target.fill_factor).abs() < 0.015
+        let model = DigModel::new(&p, surface.clone())?;
+        match plan_dig(&model, gwo, &[]) {
+            Ok(plan) => (f1, fill) = (plan.outcome.f1_j_per_kg, plan.outcome.fill_factor),
+            Err(DigError::Infeasible { .. }) => {
+                // Too much resistance to fill the dipper within the limits.
+                p.material.fill_resistance_ratio *= 0.7;
+                p.material.cutting_resistance_pa *= 0.9;
+                continue;
+            }
+            Err(e) => return Err(e),
+        }
+        if (f1 / target.f1_j_per_kg - 1.0).abs() < 0.01 && (fill - target.fill_factor).abs() < 0.03
         {
             return Ok(Calibration {
                 cutting_resistance_pa: p.material.cutting_resistance_pa,
@@ -83,29 +97,14 @@ pub fn calibrate(
                 plans,
             });
         }
-        // ε on the fill: a probe step, then the secant.
-        if (fill - target.fill_factor).abs() >= 0.015 {
-            let e0 = p.material.fill_resistance_ratio;
-            let e1 = if fill > target.fill_factor {
-                e0 + 1.0
-            } else {
-                (e0 - 1.0).max(0.0)
-            };
-            p.material.fill_resistance_ratio = e1;
-            let (f1b, fillb) = run(&p)?;
-            if (fillb - fill).abs() > 1e-4 {
-                let e = e0 + (target.fill_factor - fill) * (e1 - e0) / (fillb - fill);
-                p.material.fill_resistance_ratio = e.clamp(0.0, 4.0 * e1.max(1.0));
-                (f1, fill) = run(&p)?;
-            } else {
-                (f1, fill) = (f1b, fillb);
-            }
-        }
-        // k_F on f1: f1 is nearly affine in k_F with slope 1/ρ.
-        let k0 = p.material.cutting_resistance_pa;
-        let k1 = k0 + (target.f1_j_per_kg - f1) * p.material.density_kg_m3;
-        p.material.cutting_resistance_pa = k1.max(0.0);
-        (f1, fill) = run(&p)?;
+        // A Newton step on the fixed, measured Jacobian: f1 ≈ k_F/ρ + F1_PER_EPS·ε
+        // + …, fill ≈ −FILL_SLOPE·ε + …, damped because each plan is noisy.
+        let d_eps = DAMPING * (fill - target.fill_factor) / FILL_SLOPE;
+        let d_k = DAMPING
+            * p.material.density_kg_m3
+            * (target.f1_j_per_kg - f1 - F1_PER_EPS * d_eps / DAMPING);
+        p.material.fill_resistance_ratio = (p.material.fill_resistance_ratio + d_eps).max(0.0);
+        p.material.cutting_resistance_pa = (p.material.cutting_resistance_pa + d_k).max(0.0);
     }
     Err(DigError::Surface(format!(
         "calibration did not converge in {plans} plans: f1 {f1:.3} J/kg (target {}), \

@@ -29,7 +29,7 @@
 //! the inverse dynamics. The accretion of material is quasi-static (the ṁ·v
 //! reaction, below 0.01 N on the scale model, is left out).
 
-use crate::kinematics::{handle_axes, JointState, RopeShovel};
+use crate::kinematics::{JointState, RopeShovel};
 use crate::profile::MachineProfile;
 
 const G: f64 = 9.81;
@@ -66,6 +66,13 @@ impl MassModel {
     /// carrying `m_load` kg of material.
     #[inline]
     pub fn terms(&self, theta1: f64, d: f64, m_load: f64) -> LagrangeTerms {
+        let (sn, cs) = theta1.sin_cos();
+        self.terms_sc(sn, cs, d, m_load)
+    }
+
+    /// [`MassModel::terms`] from sin θ₁ and cos θ₁.
+    #[inline]
+    pub fn terms_sc(&self, sn: f64, cs: f64, d: f64, m_load: f64) -> LagrangeTerms {
         let (md, ld) = (self.handle_mass, self.handle_length);
         let mc = self.dipper_mass + m_load;
         let (lc, e) = (self.dipper_length, self.dipper_offset);
@@ -75,7 +82,6 @@ impl MassModel {
         let inertia = md * (s_h * s_h + ld * ld / 12.0) + mc * (s_c * s_c + e * e) + ic;
         let inertia_d = 2.0 * md * s_h + 2.0 * mc * s_c;
         // y of a point (s, e) is l₂ − s cos θ + e sin θ.
-        let (sn, cs) = theta1.sin_cos();
         let dp_dtheta = G * (md * s_h * sn + mc * (s_c * sn + e * cs));
         let dp_dd = -G * (md + mc) * cs;
         LagrangeTerms {
@@ -91,15 +97,17 @@ impl MassModel {
     /// Kinetic plus potential energy (zero of potential at the saddle height).
     pub fn energy(&self, theta1: f64, d: f64, theta_dot: f64, d_dot: f64, m_load: f64) -> f64 {
         let t = self.terms(theta1, d, m_load);
-        let kinetic = 0.5 * (t.m11 * theta_dot * theta_dot
-            + 2.0 * t.m12 * theta_dot * d_dot
-            + t.m22 * d_dot * d_dot);
+        let kinetic = 0.5
+            * (t.m11 * theta_dot * theta_dot
+                + 2.0 * t.m12 * theta_dot * d_dot
+                + t.m22 * d_dot * d_dot);
         let (md, ld) = (self.handle_mass, self.handle_length);
         let mc = self.dipper_mass + m_load;
         let (sn, cs) = theta1.sin_cos();
         let y = |s: f64, e: f64| -s * cs + e * sn;
-        let potential =
-            G * (md * y(d - 0.5 * ld, 0.0) + mc * y(d - 0.5 * self.dipper_length, self.dipper_offset));
+        let potential = G
+            * (md * y(d - 0.5 * ld, 0.0)
+                + mc * y(d - 0.5 * self.dipper_length, self.dipper_offset));
         kinetic + potential
     }
 }
@@ -167,20 +175,17 @@ pub fn inverse_dynamics(
     m_load: f64,
 ) -> Option<Drive> {
     let g = &shovel.geometry;
-    let theta = js.q.theta1;
     let d = js.q.d2 + g.d20;
-    let t = mass.terms(theta, d, m_load);
+    let (u, n) = (js.u, js.n);
+    let t = mass.terms_sc(u[0], n[0], d, m_load);
     let (th_dot, d_dot) = (js.theta1_dot, js.d2_dot);
-    let q_theta = t.m11 * js.theta1_ddot
-        + t.m12 * js.d2_ddot
-        + t.inertia_d * d_dot * th_dot
-        + t.dp_dtheta;
-    let q_d = t.m12 * js.theta1_ddot + t.m22 * js.d2_ddot - 0.5 * t.inertia_d * th_dot * th_dot
-        + t.dp_dd;
+    let q_theta =
+        t.m11 * js.theta1_ddot + t.m12 * js.d2_ddot + t.inertia_d * d_dot * th_dot + t.dp_dtheta;
+    let q_d =
+        t.m12 * js.theta1_ddot + t.m22 * js.d2_ddot - 0.5 * t.inertia_d * th_dot * th_dot + t.dp_dd;
 
-    let (u, n) = handle_axes(theta);
     // Digging resistance at the tip (s = D, e = l₃).
-    let speed = tip_v[0].hypot(tip_v[1]);
+    let speed = (tip_v[0] * tip_v[0] + tip_v[1] * tip_v[1]).sqrt();
     let (mut qdig_theta, mut qdig_d) = (0.0, 0.0);
     if f_tau > 0.0 && speed > 0.0 {
         let tv = [tip_v[0] / speed, tip_v[1] / speed];
@@ -194,7 +199,7 @@ pub fn inverse_dynamics(
         qdig_d = u[0] * f[0] + u[1] * f[1];
     }
     // Hoist rope at the bail pin C (s = D − bail_behind_tip, e = 0).
-    let c = shovel.bail(js.q);
+    let c = shovel.bail_at(u, js.q.d2);
     let (rope, _) = shovel.rope(c)?;
     let s_c = d - g.bail_behind_tip;
     let h_theta = s_c * (n[0] * rope[0] + n[1] * rope[1]);
@@ -205,7 +210,10 @@ pub fn inverse_dynamics(
     let hoist = (q_theta - qdig_theta) / h_theta;
     let crowd = q_d - qdig_d - hoist * h_d;
     // v_C · rope: rate at which the rope shortens.
-    let v_c_point = [s_c * th_dot * n[0] + d_dot * u[0], s_c * th_dot * n[1] + d_dot * u[1]];
+    let v_c_point = [
+        s_c * th_dot * n[0] + d_dot * u[0],
+        s_c * th_dot * n[1] + d_dot * u[1],
+    ];
     let hoist_speed = v_c_point[0] * rope[0] + v_c_point[1] * rope[1];
     Some(Drive {
         hoist_force_n: hoist,
@@ -221,7 +229,7 @@ pub fn inverse_dynamics(
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::kinematics::Joints;
+    use crate::kinematics::{handle_axes, Joints};
     use approx::assert_relative_eq;
 
     fn setup() -> (RopeShovel, MassModel) {
@@ -247,7 +255,11 @@ mod tests {
         let printed_inertia =
             md * (d * d - ld * d + ld * ld / 3.0) + mc * (d * d + lc * d + lc * lc / 3.0);
         assert_relative_eq!(t.m11, printed_inertia, epsilon = 1e-12);
-        assert_relative_eq!(t.inertia_d, 2.0 * d * (md + mc) - (md * ld - mc * lc), epsilon = 1e-12);
+        assert_relative_eq!(
+            t.inertia_d,
+            2.0 * d * (md + mc) - (md * ld - mc * lc),
+            epsilon = 1e-12
+        );
         let gravity = md * G * th.sin() * (d - ld / 2.0) + mc * G * th.sin() * (d + lc / 2.0);
         assert_relative_eq!(t.dp_dtheta, gravity, epsilon = 1e-12);
         assert_relative_eq!(t.dp_dd, -(md + mc) * G * th.cos(), epsilon = 1e-12);
@@ -273,7 +285,10 @@ mod tests {
             let (a0, b0) = q(t);
             let (ap, bp) = q(t + e);
             let (am, bm) = q(t - e);
+            let (u, n) = handle_axes(a0);
             JointState {
+                u,
+                n,
                 q: Joints { theta1: a0, d2: b0 },
                 theta1_dot: (ap - am) / (2.0 * e),
                 d2_dot: (bp - bm) / (2.0 * e),
@@ -297,7 +312,13 @@ mod tests {
         }
         let e = |t: f64| {
             let js = state(t);
-            m.energy(js.q.theta1, js.q.d2 + s.geometry.d20, js.theta1_dot, js.d2_dot, load)
+            m.energy(
+                js.q.theta1,
+                js.q.d2 + s.geometry.d20,
+                js.theta1_dot,
+                js.d2_dot,
+                load,
+            )
         };
         let delta = e(tf - 1e-4) - e(1e-4);
         assert_relative_eq!(work, delta + resist, max_relative = 1e-4);

@@ -51,6 +51,10 @@ pub struct JointState {
     pub theta1_ddot: f64,
     /// d̈₂ [m/s²].
     pub d2_ddot: f64,
+    /// Handle direction u = (sin θ₁, −cos θ₁).
+    pub u: [f64; 2],
+    /// Handle normal n = (cos θ₁, sin θ₁).
+    pub n: [f64; 2],
 }
 
 /// The 1R-1P front end of a rope shovel.
@@ -115,13 +119,22 @@ impl RopeShovel {
     }
 
     /// Joint state from the tip's position, velocity and acceleration
-    /// (inverse of the rate relations in the module docs).
+    /// (inverse of the rate relations in the module docs). sin θ₁ and cos θ₁
+    /// come from eq. 7's numerator and denominator over l₃² + D², so no
+    /// trigonometric call is made but the atan2 for θ₁ itself.
     #[inline]
     pub fn joint_state(&self, p: [f64; 2], v: [f64; 2], a: [f64; 2]) -> Option<JointState> {
         let g = &self.geometry;
-        let q = self.inverse(p)?;
-        let (u, n) = handle_axes(q.theta1);
-        let d = q.d2 + g.d20;
+        let (dx, dy) = (p[0] - g.l1, p[1] - g.l2);
+        let r2 = dx * dx + dy * dy;
+        let dd = r2 - g.l3 * g.l3;
+        if !(dd > 0.0) {
+            return None;
+        }
+        let d = dd.sqrt();
+        let (num, den) = (dy * g.l3 + dx * d, dx * g.l3 - dy * d);
+        let (sn, cs) = (num / r2, den / r2);
+        let (u, n) = ([sn, -cs], [cs, sn]);
         let (vn, vu) = (v[0] * n[0] + v[1] * n[1], v[0] * u[0] + v[1] * u[1]);
         let (an, au) = (a[0] * n[0] + a[1] * n[1], a[0] * u[0] + a[1] * u[1]);
         let theta1_dot = vn / d;
@@ -129,20 +142,30 @@ impl RopeShovel {
         let theta1_ddot = (an - 2.0 * theta1_dot * d2_dot + g.l3 * theta1_dot * theta1_dot) / d;
         let d2_ddot = au + g.l3 * theta1_ddot + d * theta1_dot * theta1_dot;
         Some(JointState {
-            q,
+            q: Joints {
+                theta1: num.atan2(den),
+                d2: d - g.d20,
+            },
             theta1_dot,
             d2_dot,
             theta1_ddot,
             d2_ddot,
+            u,
+            n,
         })
     }
 
     /// The bail pin C, on the handle axis `bail_behind_tip` behind the tip's foot.
     #[inline]
     pub fn bail(&self, q: Joints) -> [f64; 2] {
+        self.bail_at(handle_axes(q.theta1).0, q.d2)
+    }
+
+    /// [`RopeShovel::bail`] for a known handle direction u.
+    #[inline]
+    pub fn bail_at(&self, u: [f64; 2], d2: f64) -> [f64; 2] {
         let g = &self.geometry;
-        let (u, _) = handle_axes(q.theta1);
-        let s = q.d2 + g.d20 - g.bail_behind_tip;
+        let s = d2 + g.d20 - g.bail_behind_tip;
         [g.l1 + s * u[0], g.l2 + s * u[1]]
     }
 
@@ -154,7 +177,7 @@ impl RopeShovel {
     pub fn rope(&self, c: [f64; 2]) -> Option<([f64; 2], f64)> {
         let g = &self.geometry;
         let (wx, wy) = (g.sheave[0] - c[0], g.sheave[1] - c[1]);
-        let dist = wx.hypot(wy);
+        let dist = (wx * wx + wy * wy).sqrt();
         let r = g.sheave_radius;
         if !(dist > r) {
             return None;
@@ -195,7 +218,7 @@ mod tests {
 
     #[test]
     fn the_default_start_pose_puts_the_retracted_tip_on_the_toe() {
-        let s = shovel();
+        let s = RopeShovel::new(crate::profile::tests::retracted_start().geometry());
         let q = s.inverse([0.0, 0.0]).unwrap();
         assert_relative_eq!(q.d2, 0.0, epsilon = 1e-12);
         assert_relative_eq!(q.theta1.to_degrees(), -5.6, epsilon = 0.1);
@@ -237,14 +260,21 @@ mod tests {
     #[test]
     fn the_rope_is_tangent_to_the_sheave() {
         let s = shovel();
-        let c = s.bail(Joints { theta1: 0.3, d2: 0.05 });
+        let c = s.bail(Joints {
+            theta1: 0.3,
+            d2: 0.05,
+        });
         let (e, len) = s.rope(c).unwrap();
         let t = [c[0] + e[0] * len, c[1] + e[1] * len];
         let b = s.geometry.sheave;
         let r = (t[0] - b[0]).hypot(t[1] - b[1]);
         assert_relative_eq!(r, s.geometry.sheave_radius, epsilon = 1e-12);
         // Radius ⟂ rope at the tangent point, on the side away from the machine.
-        assert_relative_eq!((t[0] - b[0]) * e[0] + (t[1] - b[1]) * e[1], 0.0, epsilon = 1e-12);
+        assert_relative_eq!(
+            (t[0] - b[0]) * e[0] + (t[1] - b[1]) * e[1],
+            0.0,
+            epsilon = 1e-12
+        );
         assert!(t[0] > b[0] - 1e-9);
     }
 }

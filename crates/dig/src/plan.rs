@@ -32,7 +32,7 @@ use autoshovel_optim::{minimize, Evaluation, GwoParams, GwoResult, Problem};
 
 use crate::dynamics::{inverse_dynamics, Drive, MassModel};
 use crate::error::{DigError, Result};
-use crate::kinematics::{handle_axes, Joints, RopeShovel};
+use crate::kinematics::{Joints, RopeShovel};
 use crate::profile::MachineProfile;
 use crate::terrain::{swept_width, DigSurface};
 use crate::trajectory::Decision;
@@ -68,8 +68,8 @@ pub const SPEED_TOLERANCE: f64 = 1e-3;
 
 /// Units of the constraint values, for messages.
 const CONSTRAINT_UNITS: [&str; 18] = [
-    "", "", "s", "s", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "N", "N", "W", "W", "m", "m",
-    "m", "m",
+    "", "", "s", "s", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "N", "N", "W", "W", "m", "m", "m",
+    "m",
 ];
 
 /// The state of the dig at one sample.
@@ -329,9 +329,7 @@ impl DigModel {
         let (b, rho) = (p.dipper.width_m, p.material.density_kg_m3);
         let (kf, psi) = (p.material.cutting_resistance_pa, p.material.normal_ratio);
         let eps = p.material.fill_resistance_ratio;
-        let (sp, cp) = (p.geometry.dipper_pitch_deg.to_radians().sin_cos().0, {
-            p.geometry.dipper_pitch_deg.to_radians().cos()
-        });
+        let (sp, cp) = p.geometry.dipper_pitch_deg.to_radians().sin_cos();
 
         let mut reachable = true;
         let (mut v_h_min, mut v_h_max) = (f64::INFINITY, f64::NEG_INFINITY);
@@ -347,11 +345,11 @@ impl DigModel {
         for i in 0..n {
             let t = i as f64 * dt;
             let tip = traj.at(t);
-            let speed = tip.v[0].hypot(tip.v[1]);
+            let speed = (tip.v[0] * tip.v[0] + tip.v[1] * tip.v[1]).sqrt();
             // Cut thickness along the left normal; at rest (the ends) the
             // direction of the limit is the direction of the acceleration.
             let dir = if speed > 1e-12 { tip.v } else { tip.a };
-            let norm = dir[0].hypot(dir[1]);
+            let norm = (dir[0] * dir[0] + dir[1] * dir[1]).sqrt();
             let (c, kappa) = if norm > 0.0 {
                 let left = [-dir[1] / norm, dir[0] / norm];
                 let kappa = if speed > 1e-12 {
@@ -365,7 +363,7 @@ impl DigModel {
             };
             let swept = swept_width(c, kappa).max(0.0);
             if let Some((sw0, _, _, p0)) = prev {
-                let ds = (tip.p[0] - p0[0]).hypot(tip.p[1] - p0[1]);
+                let ds = ((tip.p[0] - p0[0]).powi(2) + (tip.p[1] - p0[1]).powi(2)).sqrt();
                 area += 0.5 * (swept + sw0) * ds;
             }
             let load = rho * b * area;
@@ -396,7 +394,7 @@ impl DigModel {
             prev = Some((swept, ph, pc, tip.p));
 
             // Back angle between v and the tooth back face b̂ = cos δ₁ n + sin δ₁ u.
-            let (u, nn) = handle_axes(js.q.theta1);
+            let (u, nn) = (js.u, js.n);
             let beta = if speed > 1e-12 {
                 let bh = [cp * nn[0] + sp * u[0], cp * nn[1] + sp * u[1]];
                 let cross = tip.v[0] * bh[1] - tip.v[1] * bh[0];

@@ -228,10 +228,7 @@ impl MachineProfile {
     /// Parse and check a profile; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self> {
         let profile: MachineProfile = toml::from_str(text).map_err(|e| {
-            let (line, column) = e
-                .span()
-                .map(|s| line_col(text, s.start))
-                .unwrap_or((0, 0));
+            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
             DigError::Parse {
                 file: file.to_string(),
                 line,
@@ -274,8 +271,16 @@ impl MachineProfile {
             ("handle", "length_m", self.handle.length_m),
             ("handle", "mass_kg", self.handle.mass_kg),
             ("material", "density_kg_m3", self.material.density_kg_m3),
-            ("limits", "hoist_speed_max_m_s", self.limits.hoist_speed_max_m_s),
-            ("limits", "crowd_speed_max_m_s", self.limits.crowd_speed_max_m_s),
+            (
+                "limits",
+                "hoist_speed_max_m_s",
+                self.limits.hoist_speed_max_m_s,
+            ),
+            (
+                "limits",
+                "crowd_speed_max_m_s",
+                self.limits.crowd_speed_max_m_s,
+            ),
             ("limits", "hoist_force_max_n", self.limits.hoist_force_max_n),
             ("limits", "crowd_force_max_n", self.limits.crowd_force_max_n),
             ("limits", "hoist_power_max_w", self.limits.hoist_power_max_w),
@@ -548,13 +553,22 @@ fn line_of_key(text: &str, table: &str, key: &str) -> usize {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
     use approx::assert_relative_eq;
 
+    /// The scale model without its toe distance: the toe where the retracted
+    /// tip meets the floor.
+    pub(crate) fn retracted_start() -> MachineProfile {
+        let mut p = MachineProfile::scale_model();
+        p.geometry.toe_distance_m = None;
+        p
+    }
+
     #[test]
     fn the_embedded_profile_gives_the_documented_derived_geometry() {
-        let g = MachineProfile::scale_model().geometry();
+        assert_relative_eq!(MachineProfile::scale_model().geometry().l1, -0.12);
+        let g = retracted_start().geometry();
         assert_relative_eq!(g.l3, 0.2558 * 20.43f64.to_radians().sin(), epsilon = 1e-12);
         assert_relative_eq!(g.l3, 0.08929, epsilon = 1e-4);
         assert_relative_eq!(g.d20, 0.23974, epsilon = 1e-4);
@@ -574,37 +588,55 @@ mod tests {
     #[test]
     fn missing_and_contradictory_limits_are_named_with_their_line() {
         let text = with("hoist_force_max_n = 200.0   # c11\n", "");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
-        assert!(err.contains("p.toml") && err.contains("hoist_force_max_n"), "{err}");
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains("p.toml") && err.contains("hoist_force_max_n"),
+            "{err}"
+        );
 
         let text = with("fill_min = 0.9 ", "fill_min = 1.2 ");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
-        let line = text.lines().position(|l| l.starts_with("fill_min")).unwrap() + 1;
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
+        let line = text
+            .lines()
+            .position(|l| l.starts_with("fill_min"))
+            .unwrap()
+            + 1;
         assert!(err.contains(&format!("p.toml:{line}:")), "{err}");
         assert!(err.contains("fill_max"), "{err}");
 
         let text = with("crowd_power_max_w = 15.0", "crowd_power_max_w = -1");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("[limits] crowd_power_max_w = -1"), "{err}");
 
         let text = with("td_s = [9.0, 15.0]", "td_s = [20.0, 30.0]");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("td_s") && err.contains("dig-time"), "{err}");
 
         let text = with("[numerics]", "[numerics]\nbogus = 1");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("bogus"), "{err}");
     }
 
     #[test]
     fn a_saddle_too_high_to_reach_the_floor_needs_a_toe_distance() {
         let text = with("saddle_height_m = 0.2473", "saddle_height_m = 0.3");
-        let err = MachineProfile::from_toml(&text, "p.toml").unwrap_err().to_string();
+        let no_toe = text.replacen("toe_distance_m = 0.12", "", 1);
+        let err = MachineProfile::from_toml(&no_toe, "p.toml")
+            .unwrap_err()
+            .to_string();
         assert!(err.contains("toe_distance_m"), "{err}");
-        let text = with("# toe_distance_m = 0.0655", "toe_distance_m = 0.1");
-        let text = text.replacen("saddle_height_m = 0.2473", "saddle_height_m = 0.3", 1);
         let p = MachineProfile::from_toml(&text, "p.toml").unwrap();
-        assert_relative_eq!(p.geometry().l1, -0.1);
+        assert_relative_eq!(p.geometry().l1, -0.12);
     }
 
     #[test]

@@ -104,7 +104,11 @@ impl DigSurface {
             x_hi,
             "fitted surface",
         );
-        let top = raw.heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max);
+        let top = raw
+            .heights
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max);
         if !(top > 2.0 * toe_rise_m) {
             return Err(DigError::Surface(format!(
                 "the fitted surface rises only {top:.3} m above the floor; no pile to dig"
@@ -140,7 +144,10 @@ impl DigSurface {
 
     /// Highest point of the profile [m].
     pub fn top(&self) -> f64 {
-        self.heights.iter().cloned().fold(f64::NEG_INFINITY, f64::max)
+        self.heights
+            .iter()
+            .cloned()
+            .fold(f64::NEG_INFINITY, f64::max)
     }
 
     /// f̄(x), linear between samples, held at the ends [m].
@@ -166,25 +173,44 @@ impl DigSurface {
         if below(0.0) <= 0.0 {
             return 0.0;
         }
-        // March out in 5 mm steps, then bisect to 0.01 mm.
-        let mut lo = 0.0;
+        // Bracket with doubling steps from 5 mm, then regula falsi with the
+        // Illinois modification to 1 µm (the profile is piecewise linear).
+        let (mut lo, mut f_lo) = (0.0, below(0.0));
         let mut hi = 0.005;
-        while below(hi) > 0.0 {
-            lo = hi;
-            hi += 0.005;
-            if hi > 2.0 {
+        let mut f_hi = below(hi);
+        while f_hi > 0.0 {
+            (lo, f_lo) = (hi, f_hi);
+            hi *= 2.0;
+            if hi > 4.0 {
                 return hi;
             }
+            f_hi = below(hi);
         }
-        for _ in 0..9 {
-            let mid = 0.5 * (lo + hi);
-            if below(mid) > 0.0 {
-                lo = mid;
+        let mut side = 0i8;
+        for _ in 0..40 {
+            let mid = (lo * f_hi - hi * f_lo) / (f_hi - f_lo);
+            if hi - lo < 1e-6 {
+                break;
+            }
+            let f_mid = below(mid);
+            if f_mid > 0.0 {
+                (lo, f_lo) = (mid, f_mid);
+                if side == 1 {
+                    f_hi *= 0.5;
+                }
+                side = 1;
             } else {
-                hi = mid;
+                (hi, f_hi) = (mid, f_mid);
+                if side == -1 {
+                    f_lo *= 0.5;
+                }
+                side = -1;
+            }
+            if f_mid.abs() < 1e-9 {
+                return mid;
             }
         }
-        0.5 * (lo + hi)
+        (lo * f_hi - hi * f_lo) / (f_hi - f_lo)
     }
 
     /// The profile as (x, y) samples every `step` metres over `[x0, x1]`.
