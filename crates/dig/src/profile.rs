@@ -587,7 +587,7 @@ pub(crate) mod tests {
 
     #[test]
     fn missing_and_contradictory_limits_are_named_with_their_line() {
-        let text = with("hoist_force_max_n = 200.0   # c11\n", "");
+        let text = with("hoist_force_max_n = 400.0   # c11\n", "");
         let err = MachineProfile::from_toml(&text, "p.toml")
             .unwrap_err()
             .to_string();
