@@ -18,6 +18,7 @@ mod demo;
 mod output;
 mod perceive;
 mod pile;
+mod plan_dig;
 mod plan_path;
 mod plots;
 mod study;
@@ -46,6 +47,8 @@ enum Command {
     GeneratePile(pile::Args),
     /// Level, filter and fit a muck-pile scan (rope-shovel paper §3, SPEC §4.1).
     Perceive(perceive::Args),
+    /// Plan the dig: a 6th-order tooth path by the Grey Wolf Optimizer (rope-shovel paper §4, SPEC §4.2–4.3).
+    PlanDig(plan_dig::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
     /// Print a built-in scenario as TOML, to copy and edit.
@@ -90,6 +93,7 @@ fn main() -> ExitCode {
         Command::Track(args) => track::run(&args),
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),
+        Command::PlanDig(args) => plan_dig::run(&args),
         Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
             .iter()
             .find(|(n, _)| *n == name)

@@ -344,6 +344,33 @@ fn progress_bar(show: bool) -> indicatif::ProgressBar {
     bar
 }
 
+/// What the pipeline made of a scan (everything a summary or a later stage
+/// needs): the cleaned cloud and the fitted surface in the levelled frame.
+pub struct Perceived {
+    /// The cleaned, levelled cloud.
+    pub cloud: PointCloud,
+    /// The fitted surface z = f(x, y) (eq. 21), levelled frame.
+    pub fit: SurfaceFit,
+    /// Floor height in the levelled frame [m].
+    pub floor_height_m: f64,
+    /// Roll α used to level [rad].
+    pub roll_rad: f64,
+    /// Pitch β used to level [rad].
+    pub pitch_rad: f64,
+    /// Length scale of the scene.
+    pub scale: f64,
+    /// Mean point spacing [m].
+    pub spacing_m: f64,
+    /// Every stage run, in order.
+    pub stages: Vec<StageRecord>,
+    /// The file format read.
+    pub format: &'static str,
+    /// Finite points read.
+    pub input_points: usize,
+    /// Non-finite points dropped while reading.
+    pub non_finite_dropped: usize,
+}
+
 /// Runs the pipeline on `input`; writes outputs into `out` if given.
 pub fn job(
     input: &Path,
@@ -351,6 +378,69 @@ pub fn job(
     out: Option<&Path>,
     progress: bool,
 ) -> Result<(Value, Written)> {
+    let got = process(input, p, progress)?;
+    let Perceived {
+        cloud,
+        fit,
+        floor_height_m,
+        roll_rad: roll,
+        pitch_rad: pitch,
+        scale,
+        spacing_m: spacing,
+        stages,
+        format,
+        input_points,
+        non_finite_dropped,
+    } = got;
+    let timings: serde_json::Map<String, Value> = stages
+        .iter()
+        .map(|s| (s.stage.to_string(), json!(s.ms)))
+        .collect();
+    let counts: serde_json::Map<String, Value> = stages
+        .iter()
+        .map(|s| (s.stage.to_string(), json!(s.points)))
+        .collect();
+    let mut summary = json!({
+        "job": "perceive",
+        "input": input.display().to_string(),
+        "format": format,
+        "input_points": input_points,
+        "non_finite_dropped": non_finite_dropped,
+        "output_points": cloud.len(),
+        "stage_points": counts,
+        "stages": stages,
+        "roll_deg": roll.to_degrees(),
+        "pitch_deg": pitch.to_degrees(),
+        "floor_height_m": floor_height_m,
+        "scale": scale,
+        "spacing_m": spacing,
+        "r2": num(fit.r2),
+        "timings_ms": timings,
+        "total_ms": stages.iter().map(|s| s.ms).sum::<f64>(),
+        "fit": {
+            "degree": fit.degree,
+            "r2": num(fit.r2),
+            "adjusted_r2": num(fit.adjusted_r2),
+            "rms_residual_m": num(fit.rms_residual_m),
+            "r2_all_points": num(fit.r2_all_points),
+            "rms_all_points_m": num(fit.rms_all_points_m),
+            "samples": fit.samples.len(),
+            "coefficients": fit.coefficients_xy().iter().map(|t| json!({"x_power": t.x_power, "y_power": t.y_power, "coefficient": t.coefficient})).collect::<Vec<_>>(),
+        },
+        "pipeline": p,
+        "success": true,
+    });
+    let mut written = Written::default();
+    if let Some(dir) = out {
+        write_outputs(dir, &cloud, &fit, &mut written)?;
+        write_job_summary(dir, &mut summary, &mut written)?;
+    }
+    Ok((summary, written))
+}
+
+/// Reads `input` and runs the pipeline on it (the module docs), with a
+/// progress bar while reading if `progress`.
+pub fn process(input: &Path, p: &Pipeline, progress: bool) -> Result<Perceived> {
     let mut stages: Vec<StageRecord> = Vec::new();
     let t = Instant::now();
     let bar = progress_bar(progress);
@@ -532,50 +622,19 @@ pub fn job(
         ms: ms(t),
     });
 
-    let timings: serde_json::Map<String, Value> = stages
-        .iter()
-        .map(|s| (s.stage.to_string(), json!(s.ms)))
-        .collect();
-    let counts: serde_json::Map<String, Value> = stages
-        .iter()
-        .map(|s| (s.stage.to_string(), json!(s.points)))
-        .collect();
-    let mut summary = json!({
-        "job": "perceive",
-        "input": input.display().to_string(),
-        "format": report.format,
-        "input_points": input_points,
-        "non_finite_dropped": report.non_finite_dropped,
-        "output_points": cloud.len(),
-        "stage_points": counts,
-        "stages": stages,
-        "roll_deg": roll.to_degrees(),
-        "pitch_deg": pitch.to_degrees(),
-        "floor_height_m": floor.floor_height_m,
-        "scale": scale,
-        "spacing_m": spacing,
-        "r2": num(fit.r2),
-        "timings_ms": timings,
-        "total_ms": stages.iter().map(|s| s.ms).sum::<f64>(),
-        "fit": {
-            "degree": fit.degree,
-            "r2": num(fit.r2),
-            "adjusted_r2": num(fit.adjusted_r2),
-            "rms_residual_m": num(fit.rms_residual_m),
-            "r2_all_points": num(fit.r2_all_points),
-            "rms_all_points_m": num(fit.rms_all_points_m),
-            "samples": fit.samples.len(),
-            "coefficients": fit.coefficients_xy().iter().map(|t| json!({"x_power": t.x_power, "y_power": t.y_power, "coefficient": t.coefficient})).collect::<Vec<_>>(),
-        },
-        "pipeline": p,
-        "success": true,
-    });
-    let mut written = Written::default();
-    if let Some(dir) = out {
-        write_outputs(dir, &cloud, &fit, &mut written)?;
-        write_job_summary(dir, &mut summary, &mut written)?;
-    }
-    Ok((summary, written))
+    Ok(Perceived {
+        cloud,
+        fit,
+        floor_height_m: floor.floor_height_m,
+        roll_rad: roll,
+        pitch_rad: pitch,
+        scale,
+        spacing_m: spacing,
+        stages,
+        format: report.format,
+        input_points,
+        non_finite_dropped: report.non_finite_dropped,
+    })
 }
 
 fn ms(t: Instant) -> f64 {

@@ -140,8 +140,8 @@ fn study_refuses_zero_maps_and_bad_obstacle_ranges() {
     );
 }
 
-// `demo` plans six scenarios and a 100-map study: about 3–4 s in release,
-// roughly 10 s in the test profile (opt-level 1, dependencies at 2).
+// `demo` plans six scenarios, a 100-map study and five digs: about 4 s in
+// release, roughly 10–15 s in the test profile (opt-level 1, dependencies at 2).
 #[test]
 fn demo_writes_index_and_summary() {
     let dir = TempDir::new("demo");
@@ -181,6 +181,8 @@ fn demo_writes_index_and_summary() {
         [
             "perceive convex-concave pile",
             "perceive typical pile",
+            "plan-dig --all-surfaces",
+            "plan-dig typical",
             "plan-path curve apf",
             "plan-path curve improved-apf",
             "plan-path curve-reverse improved-apf",
@@ -219,11 +221,22 @@ fn demo_writes_index_and_summary() {
     assert_eq!(jobs["plan-path curve apf"]["success"], false);
     assert_eq!(jobs["plan-path curve apf"]["local_minimum"], true);
     assert_eq!(jobs["study-paths"]["maps"], 100);
+    assert_eq!(jobs["plan-dig typical"]["feasible"], true);
+    let piles: Vec<&str> = jobs["plan-dig --all-surfaces"]["surfaces"]
+        .as_array()
+        .expect("surfaces")
+        .iter()
+        .map(|p| p["surface"].as_str().expect("surface name"))
+        .collect();
+    assert_eq!(piles, ["typical", "concave", "convex", "convex-concave"]);
     // Each job's plots are where the index links them.
     for sub in [
         "plan-path-curve-improved-apf/path.png",
         "plan-path-curve-improved-apf/profile.svg",
         "study-paths/maps.csv",
+        "plan-dig-typical/dig_path.svg",
+        "plan-dig-all-surfaces/paths.svg",
+        "plan-dig-all-surfaces/table.csv",
     ] {
         assert!(out.join(sub).is_file(), "{sub} missing");
         assert!(index.contains(sub), "index.html should link {sub}");

@@ -8,7 +8,11 @@ use criterion::{black_box, criterion_group, criterion_main, Criterion};
 
 fn model() -> DigModel {
     let p = MachineProfile::scale_model();
-    DigModel::new(&p, DigSurface::from_shape(PileShape::Typical, p.dipper.width_m)).unwrap()
+    DigModel::new(
+        &p,
+        DigSurface::from_shape(PileShape::Typical, p.dipper.width_m),
+    )
+    .unwrap()
 }
 
 fn evaluation(c: &mut Criterion) {

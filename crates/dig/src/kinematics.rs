@@ -107,7 +107,7 @@ impl RopeShovel {
         let g = &self.geometry;
         let (dx, dy) = (p[0] - g.l1, p[1] - g.l2);
         let dd = dx * dx + dy * dy - g.l3 * g.l3;
-        if !(dd > 0.0) {
+        if dd.is_nan() || dd <= 0.0 {
             return None;
         }
         let d = dd.sqrt();
@@ -128,7 +128,7 @@ impl RopeShovel {
         let (dx, dy) = (p[0] - g.l1, p[1] - g.l2);
         let r2 = dx * dx + dy * dy;
         let dd = r2 - g.l3 * g.l3;
-        if !(dd > 0.0) {
+        if dd.is_nan() || dd <= 0.0 {
             return None;
         }
         let d = dd.sqrt();
@@ -179,7 +179,7 @@ impl RopeShovel {
         let (wx, wy) = (g.sheave[0] - c[0], g.sheave[1] - c[1]);
         let dist = (wx * wx + wy * wy).sqrt();
         let r = g.sheave_radius;
-        if !(dist > r) {
+        if dist.is_nan() || dist <= r {
             return None;
         }
         let tangent = (dist * dist - r * r).sqrt();

@@ -20,7 +20,10 @@ pub mod trajectory;
 
 pub use error::{DigError, Result};
 pub use kinematics::{Joints, RopeShovel};
-pub use plan::{plan_dig, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace, CONSTRAINT_NAMES};
+pub use plan::{
+    plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace,
+    CONSTRAINT_NAMES, CONSTRAINT_UNITS,
+};
 pub use profile::{Geometry, MachineProfile};
 pub use terrain::DigSurface;
 pub use trajectory::{Decision, Trajectory};

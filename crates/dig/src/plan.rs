@@ -66,11 +66,34 @@ pub const CONSTRAINT_NAMES: [&str; 18] = [
 /// last microseconds is rounding, not motion.
 pub const SPEED_TOLERANCE: f64 = 1e-3;
 
-/// Units of the constraint values, for messages.
-const CONSTRAINT_UNITS: [&str; 18] = [
+/// Units of the constraint values.
+pub const CONSTRAINT_UNITS: [&str; 18] = [
     "", "", "s", "s", "rad", "rad", "m/s", "m/s", "m/s", "m/s", "N", "N", "W", "W", "m", "m", "m",
     "m",
 ];
+
+/// Whether a constraint bounds its quantity from below or from above.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, serde::Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Bound {
+    /// The quantity must be at least the limit.
+    Min,
+    /// The quantity must be at most the limit.
+    Max,
+}
+
+/// One constraint's limit.
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+pub struct ConstraintLimit {
+    /// Name, as in [`CONSTRAINT_NAMES`].
+    pub name: &'static str,
+    /// The limit, in SI units.
+    pub limit: f64,
+    /// Lower or upper bound.
+    pub bound: Bound,
+    /// Units of the limit and of the constraint value.
+    pub units: &'static str,
+}
 
 /// The state of the dig at one sample.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
@@ -112,7 +135,11 @@ pub struct DigOutcome {
     pub m_dig_kg: f64,
     /// V / V_cd.
     pub fill_factor: f64,
-    /// c1–c18 (≤ 0 satisfied), in SI units.
+    /// The quantity each of c1–c18 bounds (fill, t_d, worst β, speed, force,
+    /// power, end height, stroke, height), in SI units.
+    pub measured: [f64; 18],
+    /// c1–c18 (≤ 0 satisfied), in SI units: limit − measured for a lower
+    /// bound, measured − limit for an upper one.
     pub constraints: [f64; 18],
     /// Normalised total violation (0 when feasible).
     pub violation: f64,
@@ -312,6 +339,41 @@ impl DigModel {
         }
     }
 
+    /// The limits of c1–c18 (the table in the module docs); c15's depends on
+    /// where the path ends, `gx_m`.
+    pub fn constraint_limits(&self, gx_m: f64) -> [ConstraintLimit; 18] {
+        use Bound::{Max, Min};
+        let p = &self.profile;
+        let l = &p.limits;
+        let g = &self.shovel.geometry;
+        let values = [
+            (l.fill_min, Min),
+            (l.fill_max, Max),
+            (l.time_min_s, Min),
+            (l.time_max_s, Max),
+            (l.back_angle_min_deg.to_radians(), Min),
+            (l.back_angle_max_deg.to_radians(), Max),
+            (-SPEED_TOLERANCE * l.hoist_speed_max_m_s, Min),
+            (l.hoist_speed_max_m_s, Max),
+            (-SPEED_TOLERANCE * l.crowd_speed_max_m_s, Min),
+            (l.crowd_speed_max_m_s, Max),
+            (l.hoist_force_max_n, Max),
+            (l.crowd_force_max_n, Max),
+            (l.hoist_power_max_w, Max),
+            (l.crowd_power_max_w, Max),
+            (self.surface.height(gx_m), Min),
+            (l.hopper_height_m + p.dipper.height_m, Min),
+            (g.handle_length, Max),
+            (g.sheave_top_height, Max),
+        ];
+        std::array::from_fn(|i| ConstraintLimit {
+            name: CONSTRAINT_NAMES[i],
+            limit: values[i].0,
+            bound: values[i].1,
+            units: CONSTRAINT_UNITS[i],
+        })
+    }
+
     /// Evaluate one decision (no curves kept).
     pub fn evaluate(&self, x: &Decision) -> DigOutcome {
         self.run(x, |_| {})
@@ -435,27 +497,18 @@ impl DigModel {
         let volume = b * area;
         let m_dig = rho * volume;
         let fill = volume / p.dipper.capacity_m3;
-        let l = &p.limits;
-        let constraints = [
-            l.fill_min - fill,
-            fill - l.fill_max,
-            l.time_min_s - x.td_s,
-            x.td_s - l.time_max_s,
-            l.back_angle_min_deg.to_radians() - beta_min,
-            beta_max - l.back_angle_max_deg.to_radians(),
-            -v_h_min - SPEED_TOLERANCE * l.hoist_speed_max_m_s,
-            v_h_max - l.hoist_speed_max_m_s,
-            -v_c_min - SPEED_TOLERANCE * l.crowd_speed_max_m_s,
-            v_c_max - l.crowd_speed_max_m_s,
-            f_h_max - l.hoist_force_max_n,
-            f_c_max - l.crowd_force_max_n,
-            p_h_max - l.hoist_power_max_w,
-            p_c_max - l.crowd_power_max_w,
-            self.surface.height(x.gx_m) - x.gy_m,
-            l.hopper_height_m + p.dipper.height_m - x.gy_m,
-            d_max - geo.handle_length,
-            y_max - geo.sheave_top_height,
+        let measured = [
+            fill, fill, x.td_s, x.td_s, beta_min, beta_max, v_h_min, v_h_max, v_c_min, v_c_max,
+            f_h_max, f_c_max, p_h_max, p_c_max, x.gy_m, x.gy_m, d_max, y_max,
         ];
+        let limits = self.constraint_limits(x.gx_m);
+        let mut constraints = [0.0; 18];
+        for (c, (m, lim)) in constraints.iter_mut().zip(measured.iter().zip(&limits)) {
+            *c = match lim.bound {
+                Bound::Min => lim.limit - m,
+                Bound::Max => m - lim.limit,
+            };
+        }
         let mut violation: f64 = constraints
             .iter()
             .zip(&self.scales)
@@ -482,6 +535,7 @@ impl DigModel {
             volume_m3: volume,
             m_dig_kg: m_dig,
             fill_factor: fill,
+            measured,
             constraints,
             violation,
             reachable,

@@ -109,7 +109,7 @@ impl DigSurface {
             .iter()
             .cloned()
             .fold(f64::NEG_INFINITY, f64::max);
-        if !(top > 2.0 * toe_rise_m) {
+        if top.is_nan() || top <= 2.0 * toe_rise_m {
             return Err(DigError::Surface(format!(
                 "the fitted surface rises only {top:.3} m above the floor; no pile to dig"
             )));
@@ -154,7 +154,7 @@ impl DigSurface {
     #[inline]
     pub fn height(&self, x: f64) -> f64 {
         let u = (x - self.x0) / DX;
-        if !(u > 0.0) {
+        if u.is_nan() || u <= 0.0 {
             return self.heights[0];
         }
         let i = u as usize;
