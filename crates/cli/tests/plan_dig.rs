@@ -612,6 +612,30 @@ fn cloud_plans_on_a_generated_scale_model_scan_and_explains_a_full_size_one() {
     // The generator's 1:30 pile: a 10 m face at scale 1/30 rises 0.333 m.
     let face = f64_field(p, "face_height_m");
     assert!((face - 10.0 / 30.0).abs() < 0.03, "face {face}");
+    // A convex pile rises at 53° from its toe, so perception leaves no floor
+    // in the fitted extent: the toe is extrapolated down the face.
+    let convex = dir.path().join("convex.pcd");
+    run(&[
+        "generate-pile".as_ref(),
+        "--shape".as_ref(),
+        "convex".as_ref(),
+        "--scale".as_ref(),
+        "0.0333333".as_ref(),
+        "--points".as_ref(),
+        "40000".as_ref(),
+        "--out".as_ref(),
+        convex.as_os_str(),
+    ])
+    .ok();
+    let s = run(&[
+        "plan-dig".as_ref(),
+        "--cloud".as_ref(),
+        convex.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    check_plan(&s, &profile);
     // A full-size scan is far beyond the scale model: refused, with the way out.
     let big = dir.path().join("big.pcd");
     run(&[

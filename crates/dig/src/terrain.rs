@@ -86,9 +86,11 @@ impl DigSurface {
     }
 
     /// A fitted surface (eq. 21) in the levelled sensor frame, with the floor
-    /// at height `floor_z`: the dig plane is y = `y_line`, the toe is found
-    /// where the width-averaged profile first rises `toe_rise_m` above the
-    /// floor going into the pile along +x.
+    /// at height `floor_z`: the dig plane is y = `y_line`. The toe is where
+    /// the width-averaged profile climbs out of the floor: the last sample at
+    /// most `toe_rise_m` above it before the climb to the top, moved back
+    /// down the face along its slope to the floor. When the fitted extent
+    /// starts on the face already, the face is continued down to the floor.
     pub fn from_fit(
         fit: &SurfaceFit,
         floor_z: f64,
@@ -120,20 +122,62 @@ impl DigSurface {
             .iter()
             .position(|&h| h >= 0.9 * top)
             .unwrap_or(0);
-        let i_toe = raw.heights[..=i_top]
-            .iter()
-            .rposition(|&h| h <= toe_rise_m)
-            .ok_or_else(|| {
-                DigError::Surface(format!(
-                    "no toe: the fitted surface is above {toe_rise_m} m over the floor \
-                     all along the dig plane from x = {x_lo:.3} m (scan nearer the machine)"
-                ))
-            })?;
-        let x_toe = raw.x0 + i_toe as f64 * DX;
+        let Some(i_toe) = raw.heights[..=i_top].iter().rposition(|&h| h <= toe_rise_m) else {
+            return Self::extrapolate_toe(raw, x_lo, x_hi);
+        };
+        // Refine: back down the face from the first sample above the
+        // threshold along the slope of the next 20 mm, so the toe is where
+        // the face meets the floor, not where it is toe_rise_m above it.
+        let i_up = (i_toe + 1).min(raw.heights.len() - 1);
+        let k = (i_up + 20).min(raw.heights.len() - 1);
+        let slope = if k > i_up {
+            (raw.heights[k] - raw.heights[i_up]) / ((k - i_up) as f64 * DX)
+        } else {
+            0.0
+        };
+        let back = if slope > 0.0 {
+            (raw.heights[i_up] / slope).clamp(0.0, 10.0 * toe_rise_m)
+        } else {
+            0.0
+        };
+        let x_toe = raw.x0 + i_up as f64 * DX - back;
         Ok(Self {
             x0: raw.x0 - x_toe,
             heights: raw.heights,
             source: format!("fitted surface (toe at sensor x = {x_toe:.3} m)"),
+        })
+    }
+
+    /// The fit starts on the face (perception removes the floor points, so a
+    /// pile that rises steeply from its toe has no floor inside the fitted
+    /// extent): continue the face down to the floor along its slope over the
+    /// first 20 mm, and put the toe where it meets the floor.
+    fn extrapolate_toe(raw: Self, x_lo: f64, x_hi: f64) -> Result<Self> {
+        let k = 20.min(raw.heights.len() - 1);
+        let h0 = raw.heights[0];
+        let slope = (raw.heights[k] - h0) / (k as f64 * DX);
+        let run = if slope > 0.0 {
+            h0 / slope
+        } else {
+            f64::INFINITY
+        };
+        if run.is_nan() || run > 0.25 * (x_hi - x_lo) {
+            return Err(DigError::Surface(format!(
+                "no toe: the fitted surface starts {h0:.3} m above the floor at x = {x_lo:.3} m \
+                 and does not fall towards it (scan nearer the machine)"
+            )));
+        }
+        let n = (run / DX).ceil() as usize;
+        let x_toe = x_lo - n as f64 * DX;
+        let mut heights: Vec<f64> = (0..n).map(|i| h0 * i as f64 / n as f64).collect();
+        heights.extend_from_slice(&raw.heights);
+        Ok(Self {
+            x0: 0.0,
+            heights,
+            source: format!(
+                "fitted surface (toe extrapolated {:.3} m before the scan, at sensor x = {x_toe:.3} m)",
+                n as f64 * DX
+            ),
         })
     }
 
