@@ -24,6 +24,25 @@ pub fn print_json(summary: &serde_json::Value) -> Result<()> {
     Ok(())
 }
 
+/// Reports a finished job: the summary alone on stdout under `--json`,
+/// otherwise the `human` report and the folder written to.
+pub fn report(
+    summary: &serde_json::Value,
+    json: bool,
+    out: Option<&std::path::Path>,
+    human: impl FnOnce(&serde_json::Value),
+) -> Result<()> {
+    if json {
+        print_json(summary)?;
+    } else {
+        human(summary);
+        if let Some(dir) = out {
+            crate::say!("wrote {}", dir.display());
+        }
+    }
+    Ok(())
+}
+
 /// A finite f64 or JSON null (JSON has no NaN).
 pub fn num(v: f64) -> serde_json::Value {
     if v.is_finite() {

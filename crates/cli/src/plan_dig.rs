@@ -328,14 +328,7 @@ pub fn run(args: &Args) -> Result<()> {
         None => Pile::shape(args.surface.unwrap_or_default(), &setup.profile),
     };
     let job = job(&pile, &setup, out.as_deref())?;
-    if args.json {
-        print_json(&job.summary)?;
-    } else {
-        print_human(&job.summary);
-        if let Some(dir) = &out {
-            crate::say!("wrote {}", dir.display());
-        }
-    }
+    crate::output::report(&job.summary, args.json, out.as_deref(), print_human)?;
     match job.error {
         Some(e) => bail!("{e}"),
         None => Ok(()),

@@ -16,7 +16,7 @@ use autoshovel_track::{
 };
 use serde_json::{json, Value};
 
-use crate::output::{num, prepare_dir, print_json, Written};
+use crate::output::{num, prepare_dir, Written};
 
 /// Controller choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -123,14 +123,7 @@ pub fn run(args: &Args) -> Result<()> {
             );
         }
     }
-    if args.json {
-        print_json(&job.summary)?;
-    } else {
-        print_human(&job.summary);
-        if let Some(dir) = &out {
-            crate::say!("wrote {}", dir.display());
-        }
-    }
+    crate::output::report(&job.summary, args.json, out.as_deref(), print_human)?;
     match job.error {
         Some(e) => bail!("{e}"),
         None => Ok(()),

@@ -14,26 +14,7 @@ use common::*;
 use serde_json::Value;
 
 /// The constraint names of the planner, c1–c18.
-const CONSTRAINTS: [&str; 18] = [
-    "c1_fill_min",
-    "c2_fill_max",
-    "c3_time_min",
-    "c4_time_max",
-    "c5_back_angle_min",
-    "c6_back_angle_max",
-    "c7_hoist_speed_positive",
-    "c8_hoist_speed_max",
-    "c9_crowd_speed_positive",
-    "c10_crowd_speed_max",
-    "c11_hoist_force_max",
-    "c12_crowd_force_max",
-    "c13_hoist_power_max",
-    "c14_crowd_power_max",
-    "c15_leaves_surface",
-    "c16_hopper_clearance",
-    "c17_handle_stroke",
-    "c18_sheave_height",
-];
+const CONSTRAINTS: [&str; 18] = autoshovel_dig::CONSTRAINT_NAMES;
 
 /// The built-in profile as `--print-profile` prints it.
 fn builtin_profile() -> String {
