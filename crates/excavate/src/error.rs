@@ -1,0 +1,208 @@
+//! Errors of profile and scenario loading, kinematics and the two-level planner.
+
+use std::path::PathBuf;
+
+use crate::kinematics::Joint;
+use crate::preimage::AvoidSide;
+
+/// Why the inverse kinematics refused a tooth-tip pose.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IkError {
+    /// The stick pin (tip minus the bucket link at the attitude angle) is
+    /// farther from the boom foot than boom + stick, or nearer than their difference.
+    #[error(
+        "out of reach: the stick-pin point is {distance_m:.3} m from the boom foot, \
+         the boom and stick reach {min_m:.3}..{max_m:.3} m"
+    )]
+    OutOfReach {
+        /// Distance from the boom foot to the stick pin the pose needs [m].
+        distance_m: f64,
+        /// Least distance boom and stick can make [m].
+        min_m: f64,
+        /// Greatest distance [m].
+        max_m: f64,
+    },
+    /// A joint would leave its range.
+    #[error(
+        "{joint} joint at {:.2}° is outside its range {:.1}°..{:.1}°",
+        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
+    )]
+    JointOutOfLimit {
+        /// The joint.
+        joint: Joint,
+        /// The angle the pose needs [rad].
+        value_rad: f64,
+        /// Lower limit [rad].
+        min_rad: f64,
+        /// Upper limit [rad].
+        max_rad: f64,
+    },
+    /// The digging attitude angle is outside its range.
+    #[error(
+        "attitude angle {:.2}° is outside its range {:.1}°..{:.1}°",
+        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
+    )]
+    AttitudeOutOfRange {
+        /// The attitude angle φ = θ₁ + θ₂ + θ₃ [rad].
+        value_rad: f64,
+        /// Lower limit [rad].
+        min_rad: f64,
+        /// Upper limit [rad].
+        max_rad: f64,
+    },
+}
+
+/// Everything that can go wrong when loading a profile or a scenario, or planning.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ExcavateError {
+    /// A file could not be read.
+    #[error("cannot read {path}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// A file is not valid TOML, or has unknown or missing keys.
+    #[error("{file}:{line}:{column}: {message}")]
+    Parse {
+        /// The file (or `<builtin …>`).
+        file: String,
+        /// 1-based line (0 when unknown).
+        line: usize,
+        /// 1-based column (0 when unknown).
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value is out of range or contradicts another.
+    #[error("{file}:{line}: {key} = {value} is invalid: expected {expected}")]
+    Invalid {
+        /// The file (or `<builtin …>`).
+        file: String,
+        /// 1-based line of the key (0 when unknown).
+        line: usize,
+        /// `[table] key`.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it should be.
+        expected: String,
+    },
+    /// No built-in scenario has this name.
+    #[error("unknown scenario `{name}`: the built-ins are {known}, or give a TOML file")]
+    UnknownScenario {
+        /// The name asked for.
+        name: String,
+        /// The built-in names, comma-separated.
+        known: String,
+    },
+    /// The bucket cannot put its tip at the start of the dig.
+    #[error("the dig start ({x_m:.3}, {y_m:.3}) m is out of reach at attitude {:.1}°: {cause}; move the start nearer the machine or change the attitude", attitude_rad.to_degrees())]
+    StartOutOfReach {
+        /// Start x [m].
+        x_m: f64,
+        /// Start y [m].
+        y_m: f64,
+        /// Attitude angle asked for [rad].
+        attitude_rad: f64,
+        /// Why.
+        cause: IkError,
+    },
+    /// A buried obstacle encloses the start of the dig.
+    #[error(
+        "obstacle {index} (centre ({:.3}, {:.3}) m, radius {radius_m:.3} m) encloses the dig \
+         start ({:.3}, {:.3}) m; start the dig elsewhere",
+        center_m[0], center_m[1], start_m[0], start_m[1]
+    )]
+    ObstacleEnclosesStart {
+        /// Index of the obstacle in the scenario.
+        index: usize,
+        /// Its centre [m].
+        center_m: [f64; 2],
+        /// Its radius [m].
+        radius_m: f64,
+        /// The start [m].
+        start_m: [f64; 2],
+    },
+    /// The reachable ground cannot hold the volume asked for.
+    #[error(
+        "the target volume cannot be dug: {what} needs {needed_m3:.3} m³ but the most the \
+         reachable ground holds is {reachable_m3:.3} m³ (stopped at x = {stopped_at_x_m:.2} m: \
+         {why}); lower the target or the depth, or start farther out"
+    )]
+    TargetVolumeTooLarge {
+        /// Which part of the dig (`first half`, `second half`, `re-plan`).
+        what: String,
+        /// Volume this part needs [m³].
+        needed_m3: f64,
+        /// The largest volume a feasible candidate held [m³].
+        reachable_m3: f64,
+        /// The last candidate x tried [m].
+        stopped_at_x_m: f64,
+        /// Why the search stopped there.
+        why: String,
+    },
+    /// The planned path cannot be executed by the machine (a level-1 candidate
+    /// or the start itself breaks a limit).
+    #[error("no feasible {what} from ({:.3}, {:.3}) m: {why}", from_m[0], from_m[1])]
+    NoFeasiblePath {
+        /// What was being planned.
+        what: String,
+        /// From where [m].
+        from_m: [f64; 2],
+        /// Why (the last limit met).
+        why: String,
+    },
+    /// The preimage rule chose a side of an obstacle that the machine cannot pass.
+    #[error(
+        "cannot pass obstacle {index} {side} (contact at ({:.3}, {:.3}) m): {why}",
+        contact_m[0], contact_m[1]
+    )]
+    ObstacleImpassable {
+        /// Index of the obstacle in the scenario.
+        index: usize,
+        /// The side the preimage rule chose.
+        side: AvoidSide,
+        /// Where the tip met it [m].
+        contact_m: [f64; 2],
+        /// The limit that blocks the way (joint, reach, attitude) and where.
+        why: String,
+    },
+    /// The soil resists more than the machine can push.
+    #[error(
+        "the soil resists with {force_n:.0} N at t = {t_s:.2} s (tip depth {depth_m:.2} m), more \
+         than the machine's digging force {max_n:.0} N; dig shallower or in softer soil"
+    )]
+    SoilTooHard {
+        /// When [s].
+        t_s: f64,
+        /// The resistance [N].
+        force_n: f64,
+        /// The machine's rating [N].
+        max_n: f64,
+        /// Tip depth below the ground then [m].
+        depth_m: f64,
+    },
+    /// Defensive: an output path would enter an obstacle envelope. Never returned
+    /// as a path; reported as this error instead.
+    #[error("internal: the executed path enters obstacle {index} at ({:.3}, {:.3}) m", at_m[0], at_m[1])]
+    PathThroughObstacle {
+        /// Index of the obstacle.
+        index: usize,
+        /// Where [m].
+        at_m: [f64; 2],
+    },
+    /// More contacts than the planner allows in one pass (each contact costs a
+    /// detour and a re-plan).
+    #[error("more than {max} obstacle contacts in one pass; the soil is too stony for one dig")]
+    TooManyContacts {
+        /// The cap.
+        max: usize,
+    },
+}
+
+/// Shorthand for results of this crate.
+pub type Result<T> = std::result::Result<T, ExcavateError>;

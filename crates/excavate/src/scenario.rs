@@ -1,0 +1,400 @@
+//! Dig scenarios: where and how deep to dig, how much, the soil, the planner's
+//! settings, the ground line and the buried boulders (which the planner does
+//! not see until it meets them) — as TOML.
+//!
+//! Built-ins (embedded from `scenarios/`): `paper-over` and `paper-under`,
+//! the paper's §3 case (start (7, 0), boulder Ø 0.5 m, depth 0.7 m, step
+//! 0.05 m, 0.9 m³) with the boulder placed so that the preimage rule passes
+//! it over in one and under in the other, and `two-boulders`. Every key is
+//! required except `[ground]` (level ground y = 0 when absent) and the
+//! `[[obstacle]]` tables (none when absent). Errors name the file, the line
+//! and the key.
+//!
+//! ```toml
+//! name = "my-dig"
+//! description = "what this is"
+//!
+//! [dig]
+//! start_x_m = 7.0            # x_begin; the start is on the ground there
+//! depth_m = 0.7              # h
+//! step_m = 0.05              # s, of the step search and the forward-search grid
+//! target_volume_m3 = 0.9     # V
+//! attitude_start_deg = -80.0 # attitude angle φ at the start, the midpoint, the end
+//! attitude_mid_deg = -140.0
+//! attitude_end_deg = -200.0
+//!
+//! [soil]
+//! cutting_resistance_pa = 60000.0  # k of F = k·b·c
+//! normal_ratio = 0.3               # ψ
+//! density_kg_m3 = 1800.0
+//! rock_friction = 0.3              # μ between tooth and boulder
+//!
+//! [planner]
+//! clearance_m = 0.1          # margin the forward search keeps from envelopes
+//! search_window_m = 1.0      # grid reach beyond the inflated envelope
+//! speed_fraction = 0.5       # share of the joint speed limits a segment may use
+//! min_segment_time_s = 1.0
+//! dt_s = 0.01                # simulator step
+//! trapezoids = 100           # eq. 2 strips per planned segment
+//! max_contacts = 8
+//! refine_volume = false      # true: bisect inside the last step for the exact volume
+//! max_overdig_m = 0.15       # how far a level-1 path may dip below the dig depth
+//!
+//! [ground]                   # optional polyline, x increasing
+//! points = [[0.0, 0.0], [10.0, 0.0]]
+//!
+//! [[obstacle]]               # an envelope circle (eq. 10); repeat per boulder
+//! center_m = [6.0, -0.5]
+//! radius_m = 0.25
+//! ```
+
+use std::path::Path;
+
+use serde::{Deserialize, Serialize};
+
+use crate::error::{ExcavateError, Result};
+use crate::ground::Ground;
+use crate::obstacle::Envelope;
+use crate::soil::Soil;
+use crate::toml_lines::{self, line_of_key};
+
+/// The built-in scenarios: (name, TOML text).
+pub const BUILTINS: [(&str, &str); 3] = [
+    ("paper-over", include_str!("../scenarios/paper-over.toml")),
+    ("paper-under", include_str!("../scenarios/paper-under.toml")),
+    (
+        "two-boulders",
+        include_str!("../scenarios/two-boulders.toml"),
+    ),
+];
+
+/// The dig the operator asks for.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct DigSpec {
+    /// x_begin [m]; the start is on the ground there.
+    pub start_x_m: f64,
+    /// h: depth of the midpoint below the ground [m].
+    pub depth_m: f64,
+    /// s: step of the level-1 search and the level-2 grid [m].
+    pub step_m: f64,
+    /// V [m³].
+    pub target_volume_m3: f64,
+    /// Attitude angle φ at the start [deg].
+    pub attitude_start_deg: f64,
+    /// φ at the midpoint [deg].
+    pub attitude_mid_deg: f64,
+    /// φ at the end [deg].
+    pub attitude_end_deg: f64,
+}
+
+/// The planner's and simulator's settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PlannerSpec {
+    /// Margin the forward search keeps from every envelope [m].
+    pub clearance_m: f64,
+    /// How far beyond the inflated envelope the search grid reaches [m].
+    pub search_window_m: f64,
+    /// Share of each joint's speed limit a segment may use at its peak.
+    pub speed_fraction: f64,
+    /// Shortest segment [s].
+    pub min_segment_time_s: f64,
+    /// Simulator time step [s].
+    pub dt_s: f64,
+    /// Trapezoids (eq. 2) per planned segment.
+    pub trapezoids: usize,
+    /// Most contacts handled in one pass.
+    pub max_contacts: usize,
+    /// Bisect inside the step search's last step for the exact volume
+    /// (false: the paper's rule, the nearer of the two last candidates).
+    pub refine_volume: bool,
+    /// How far a level-1 path may dip below the dig depth (or below its
+    /// start, where that is deeper) [m].
+    pub max_overdig_m: f64,
+}
+
+/// A whole scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scenario {
+    /// Short name.
+    pub name: String,
+    /// One line on what it shows.
+    pub description: String,
+    /// The dig.
+    pub dig: DigSpec,
+    /// The soil.
+    pub soil: Soil,
+    /// Planner settings.
+    pub planner: PlannerSpec,
+    /// The ground line (level y = 0 when absent).
+    #[serde(default)]
+    pub ground: Ground,
+    /// Buried boulders, unknown to the planner until met.
+    #[serde(default, rename = "obstacle")]
+    pub obstacles: Vec<Envelope>,
+}
+
+impl Scenario {
+    /// Names of the built-ins.
+    pub fn builtin_names() -> Vec<&'static str> {
+        BUILTINS.iter().map(|(n, _)| *n).collect()
+    }
+
+    /// The commented TOML of a built-in.
+    pub fn builtin_toml(name: &str) -> Option<&'static str> {
+        BUILTINS.iter().find(|(n, _)| *n == name).map(|(_, t)| *t)
+    }
+
+    /// A built-in by name.
+    pub fn builtin(name: &str) -> Result<Self> {
+        let text = Self::builtin_toml(name).ok_or_else(|| ExcavateError::UnknownScenario {
+            name: name.to_string(),
+            known: Self::builtin_names().join(", "),
+        })?;
+        Self::from_toml(text, &format!("<builtin {name}>"))
+    }
+
+    /// The paper's case, passed over.
+    pub fn paper_over() -> Self {
+        Self::builtin("paper-over").expect("the built-in is valid")
+    }
+
+    /// The paper's case, passed under.
+    pub fn paper_under() -> Self {
+        Self::builtin("paper-under").expect("the built-in is valid")
+    }
+
+    /// A built-in name, or else a TOML file path.
+    pub fn from_name_or_file(arg: &str) -> Result<Self> {
+        if Self::builtin_toml(arg).is_some() {
+            return Self::builtin(arg);
+        }
+        let path = Path::new(arg);
+        if !path.exists() && !arg.contains('.') && !arg.contains('/') {
+            return Err(ExcavateError::UnknownScenario {
+                name: arg.to_string(),
+                known: Self::builtin_names().join(", "),
+            });
+        }
+        Self::load(path)
+    }
+
+    /// Read and check a scenario file.
+    pub fn load(path: &Path) -> Result<Self> {
+        let text = std::fs::read_to_string(path).map_err(|source| ExcavateError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// Parse and check a scenario; `file` names it in errors.
+    pub fn from_toml(text: &str, file: &str) -> Result<Self> {
+        let s: Scenario = toml_lines::parse(text, file)?;
+        s.check(text, file)?;
+        Ok(s)
+    }
+
+    /// The scenario as TOML (loads back to an equal scenario).
+    pub fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("a scenario serialises")
+    }
+
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        let bad = |table: &str, occurrence: usize, key: &str, value: String, expected: &str| {
+            ExcavateError::Invalid {
+                file: file.to_string(),
+                line: line_of_key(text, table, occurrence, key),
+                key: if table.is_empty() {
+                    key.to_string()
+                } else if table == "obstacle" {
+                    format!("[[obstacle]] #{} {key}", occurrence + 1)
+                } else {
+                    format!("[{table}] {key}")
+                },
+                value,
+                expected: expected.to_string(),
+            }
+        };
+        let d = &self.dig;
+        let positive = [
+            ("dig", "depth_m", d.depth_m),
+            ("dig", "target_volume_m3", d.target_volume_m3),
+            ("dig", "start_x_m", d.start_x_m),
+            ("soil", "density_kg_m3", self.soil.density_kg_m3),
+            ("planner", "clearance_m", self.planner.clearance_m),
+            ("planner", "search_window_m", self.planner.search_window_m),
+            (
+                "planner",
+                "min_segment_time_s",
+                self.planner.min_segment_time_s,
+            ),
+        ];
+        for (table, key, v) in positive {
+            if !(v.is_finite() && v > 0.0) {
+                return Err(bad(table, 0, key, v.to_string(), "a finite value > 0"));
+            }
+        }
+        if !(d.step_m.is_finite() && d.step_m > 0.0 && d.step_m <= 0.5) {
+            return Err(bad(
+                "dig",
+                0,
+                "step_m",
+                d.step_m.to_string(),
+                "a step in (0, 0.5] m",
+            ));
+        }
+        for key in ["attitude_start_deg", "attitude_mid_deg", "attitude_end_deg"] {
+            let v = match key {
+                "attitude_start_deg" => d.attitude_start_deg,
+                "attitude_mid_deg" => d.attitude_mid_deg,
+                _ => d.attitude_end_deg,
+            };
+            if !(v.is_finite() && v.abs() <= 360.0) {
+                return Err(bad("dig", 0, key, v.to_string(), "an angle within ±360°"));
+            }
+        }
+        let non_negative = [
+            ("cutting_resistance_pa", self.soil.cutting_resistance_pa),
+            ("normal_ratio", self.soil.normal_ratio),
+            ("rock_friction", self.soil.rock_friction),
+        ];
+        for (key, v) in non_negative {
+            if !(v.is_finite() && v >= 0.0) {
+                return Err(bad("soil", 0, key, v.to_string(), "a finite value >= 0"));
+            }
+        }
+        let p = &self.planner;
+        if !(p.speed_fraction > 0.0 && p.speed_fraction <= 1.0) {
+            return Err(bad(
+                "planner",
+                0,
+                "speed_fraction",
+                p.speed_fraction.to_string(),
+                "a share in (0, 1]",
+            ));
+        }
+        if !(p.dt_s > 0.0 && p.dt_s <= 0.1) {
+            return Err(bad(
+                "planner",
+                0,
+                "dt_s",
+                p.dt_s.to_string(),
+                "a step in (0, 0.1] s",
+            ));
+        }
+        if !(10..=10_000).contains(&p.trapezoids) {
+            return Err(bad(
+                "planner",
+                0,
+                "trapezoids",
+                p.trapezoids.to_string(),
+                "between 10 and 10000",
+            ));
+        }
+        if !(1..=100).contains(&p.max_contacts) {
+            return Err(bad(
+                "planner",
+                0,
+                "max_contacts",
+                p.max_contacts.to_string(),
+                "between 1 and 100",
+            ));
+        }
+        if let Some(why) = self.ground.problem() {
+            return Err(bad(
+                "ground",
+                0,
+                "points",
+                format!("{:?}", self.ground.points),
+                &format!("a polyline with x increasing ({why})"),
+            ));
+        }
+        for (i, o) in self.obstacles.iter().enumerate() {
+            if !(o.center_m[0].is_finite() && o.center_m[1].is_finite()) {
+                return Err(bad(
+                    "obstacle",
+                    i,
+                    "center_m",
+                    format!("{:?}", o.center_m),
+                    "a finite point [x, y]",
+                ));
+            }
+            if !(o.radius_m.is_finite() && o.radius_m > 0.0) {
+                return Err(bad(
+                    "obstacle",
+                    i,
+                    "radius_m",
+                    o.radius_m.to_string(),
+                    "a finite radius > 0",
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn the_builtins_load_and_round_trip_through_toml() {
+        for name in Scenario::builtin_names() {
+            let s = Scenario::builtin(name).unwrap();
+            assert_eq!(s.name, name);
+            let back = Scenario::from_toml(&s.to_toml(), "x").unwrap();
+            assert_eq!(s, back);
+        }
+        let err = Scenario::builtin("nope").unwrap_err().to_string();
+        assert!(
+            err.contains("paper-over") && err.contains("paper-under"),
+            "{err}"
+        );
+    }
+
+    #[test]
+    fn the_paper_cases_are_section_3() {
+        for s in [Scenario::paper_over(), Scenario::paper_under()] {
+            assert_eq!(s.dig.start_x_m, 7.0);
+            assert_eq!(s.dig.depth_m, 0.7);
+            assert_eq!(s.dig.step_m, 0.05);
+            assert_eq!(s.dig.target_volume_m3, 0.9);
+            assert_eq!(s.obstacles.len(), 1);
+            assert_eq!(s.obstacles[0].radius_m, 0.25);
+            assert!(s.ground.points.is_empty());
+        }
+    }
+
+    #[test]
+    fn errors_name_file_line_and_key() {
+        let text = Scenario::builtin_toml("two-boulders").unwrap();
+        let bad = text.replacen("radius_m = 0.2", "radius_m = -0.2", 1);
+        let err = Scenario::from_toml(&bad, "s.toml").unwrap_err().to_string();
+        let line = bad
+            .lines()
+            .position(|l| l.contains("radius_m = -0.2"))
+            .unwrap()
+            + 1;
+        assert!(err.starts_with(&format!("s.toml:{line}:")), "{err}");
+        assert!(err.contains("[[obstacle]] #"), "{err}");
+
+        let bad = text.replacen("dt_s = ", "dt_s = 5.0 #", 1);
+        let err = Scenario::from_toml(&bad, "s.toml").unwrap_err().to_string();
+        assert!(err.contains("[planner] dt_s = 5"), "{err}");
+
+        let missing = text.replacen("depth_m = ", "# depth_m = ", 1);
+        let err = Scenario::from_toml(&missing, "s.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("s.toml:") && err.contains("depth_m"), "{err}");
+
+        let unknown = text.replacen("[soil]", "[soil]\nhardness = 3", 1);
+        let err = Scenario::from_toml(&unknown, "s.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.contains("hardness"), "{err}");
+    }
+}
