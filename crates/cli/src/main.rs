@@ -19,6 +19,7 @@ mod output;
 mod perceive;
 mod pile;
 mod plan_dig;
+mod plan_excavate;
 mod plan_path;
 mod plots;
 mod study;
@@ -49,6 +50,8 @@ enum Command {
     Perceive(perceive::Args),
     /// Plan the dig: a 6th-order tooth path by the Grey Wolf Optimizer (rope-shovel paper §4, SPEC §4.2–4.3).
     PlanDig(plan_dig::Args),
+    /// Plan a hydraulic excavator's dig round buried boulders: two-level planning (SPEC §5).
+    PlanExcavate(plan_excavate::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
     /// Print a built-in scenario as TOML, to copy and edit.
@@ -94,6 +97,7 @@ fn main() -> ExitCode {
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),
         Command::PlanDig(args) => plan_dig::run(&args),
+        Command::PlanExcavate(args) => plan_excavate::run(&args),
         Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
             .iter()
             .find(|(n, _)| *n == name)

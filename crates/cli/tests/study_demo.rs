@@ -140,8 +140,9 @@ fn study_refuses_zero_maps_and_bad_obstacle_ranges() {
     );
 }
 
-// `demo` plans six scenarios, a 100-map study and five digs: about 4 s in
-// release, roughly 10–15 s in the test profile (opt-level 1, dependencies at 2).
+// `demo` plans six scenarios, a 100-map study, five rope-shovel digs and
+// three excavator digs: about 4 s in release, roughly 10–15 s in the test
+// profile (opt-level 1, dependencies at 2).
 #[test]
 fn demo_writes_index_and_summary() {
     let dir = TempDir::new("demo");
@@ -183,6 +184,9 @@ fn demo_writes_index_and_summary() {
             "perceive typical pile",
             "plan-dig --all-surfaces",
             "plan-dig typical",
+            "plan-excavate paper-over",
+            "plan-excavate paper-under",
+            "plan-excavate two-boulders",
             "plan-path curve apf",
             "plan-path curve improved-apf",
             "plan-path curve-reverse improved-apf",
@@ -229,6 +233,15 @@ fn demo_writes_index_and_summary() {
         .map(|p| p["surface"].as_str().expect("surface name"))
         .collect();
     assert_eq!(piles, ["typical", "concave", "convex", "convex-concave"]);
+    for (name, sides) in [
+        ("paper-over", &["over"][..]),
+        ("paper-under", &["under"][..]),
+        ("two-boulders", &["over", "over"][..]),
+    ] {
+        let job = &jobs[format!("plan-excavate {name}").as_str()];
+        assert_eq!(job["scenario"], name);
+        assert_eq!(job["avoid_directions"], serde_json::json!(sides), "{name}");
+    }
     // Each job's plots are where the index links them.
     for sub in [
         "plan-path-curve-improved-apf/path.png",
@@ -237,6 +250,9 @@ fn demo_writes_index_and_summary() {
         "plan-dig-typical/dig_path.svg",
         "plan-dig-all-surfaces/paths.svg",
         "plan-dig-all-surfaces/table.csv",
+        "plan-excavate-paper-over/tooth_path.svg",
+        "plan-excavate-paper-under/digging_force.png",
+        "plan-excavate-two-boulders/contacts.csv",
     ] {
         assert!(out.join(sub).is_file(), "{sub} missing");
         assert!(index.contains(sub), "index.html should link {sub}");

@@ -56,8 +56,9 @@ pub fn write_csv_cells(
     out.finish()
 }
 
-/// Shortest round-trip text of `v`.
-pub(crate) fn format_f64(v: f64) -> String {
+/// Shortest round-trip text of `v`, as the CSV writers print numbers (for
+/// callers mixing text and numbers in [`write_csv_cells`]).
+pub fn format_f64(v: f64) -> String {
     let a = v.abs();
     if v == 0.0 || !v.is_finite() || (1e-5..1e16).contains(&a) {
         format!("{v}")
