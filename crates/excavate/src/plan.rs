@@ -205,7 +205,7 @@ pub struct Excavation {
     /// max over consecutive samples and joints of |Δθ| / (θ̇_max·Δt): at most 1
     /// means no jump beyond the speed limits.
     pub max_joint_step_ratio: f64,
-    /// Peak |τ| per joint [N·m].
+    /// Peak |τ| per joint, the stall at a contact included [N·m].
     pub peak_torques_nm: [f64; 3],
     /// Peak soil resistance (contacts excluded) [N].
     pub peak_soil_force_n: f64,
@@ -244,7 +244,7 @@ pub struct Summary {
     pub min_envelope_distance_m: Option<f64>,
     /// See [`Excavation::max_joint_step_ratio`].
     pub max_joint_step_ratio: f64,
-    /// Peak |τ| per joint [N·m].
+    /// Peak |τ| per joint, the stall at a contact included [N·m].
     pub peak_torques_nm: [f64; 3],
     /// Peak soil resistance [N].
     pub peak_soil_force_n: f64,
