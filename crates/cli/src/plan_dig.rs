@@ -124,6 +124,10 @@ pub struct Args {
     /// Placement of the optimiser's first pack.
     #[arg(long, value_enum, default_value = "good-point-set")]
     pub init: InitArg,
+    /// Start from the final pack of an earlier plan (its `pack.csv`), as the
+    /// next dig cycle would: those wolves replace the first of the new pack.
+    #[arg(long, conflicts_with = "all_surfaces")]
+    pub warm_start: Option<PathBuf>,
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
@@ -145,6 +149,8 @@ pub struct Setup {
     pub search: SearchArg,
     /// First-pack placement.
     pub init: InitArg,
+    /// Wolves to start from (an earlier plan's final pack) and their file.
+    pub warm_start: Option<(PathBuf, Vec<Decision>)>,
 }
 
 impl Setup {
@@ -172,8 +178,74 @@ impl Setup {
             },
             search,
             init,
+            warm_start: None,
         })
     }
+}
+
+/// Columns of `pack.csv`: a final wolf as a decision of eq. 24 with its
+/// objective and normalised violation, best first.
+const PACK_COLUMNS: [&str; 7] = ["ax6", "ay6", "td_s", "gx_m", "gy_m", "f", "violation"];
+
+/// Reads the wolves of a `pack.csv` written by an earlier plan.
+fn read_pack(path: &Path) -> Result<Vec<Decision>> {
+    let text = std::fs::read_to_string(path)
+        .with_context(|| format!("cannot read warm-start pack {}", path.display()))?;
+    let mut lines = text.lines().enumerate();
+    let header: Vec<&str> = match lines.next() {
+        Some((_, h)) => h.split(',').map(str::trim).collect(),
+        None => bail!(
+            "{}: empty file; expected a pack.csv of plan-dig",
+            path.display()
+        ),
+    };
+    if header[..] != PACK_COLUMNS[..] {
+        bail!(
+            "{}:1: header '{}' is not a plan-dig pack (expected {})",
+            path.display(),
+            header.join(","),
+            PACK_COLUMNS.join(",")
+        );
+    }
+    let mut wolves = Vec::new();
+    for (i, line) in lines {
+        if line.trim().is_empty() {
+            continue;
+        }
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        if cells.len() != PACK_COLUMNS.len() {
+            bail!(
+                "{}:{}: {} values, expected {}",
+                path.display(),
+                i + 1,
+                cells.len(),
+                PACK_COLUMNS.len()
+            );
+        }
+        let mut x = [0.0; 5];
+        for (k, (cell, v)) in cells.iter().zip(x.iter_mut()).enumerate() {
+            *v = cell
+                .parse::<f64>()
+                .ok()
+                .filter(|v| v.is_finite())
+                .with_context(|| {
+                    format!(
+                        "{}:{}: {} = '{cell}' is not a finite number",
+                        path.display(),
+                        i + 1,
+                        PACK_COLUMNS[k]
+                    )
+                })?;
+        }
+        if x[2] <= 0.0 {
+            bail!("{}:{}: td_s = {} must be > 0", path.display(), i + 1, x[2]);
+        }
+        wolves.push(Decision::from_slice(&x));
+    }
+    if wolves.is_empty() {
+        bail!("{}: no wolves in the pack", path.display());
+    }
+    Ok(wolves)
 }
 
 /// The pile to dig and where it came from.
@@ -302,7 +374,10 @@ pub fn run(args: &Args) -> Result<()> {
         let _ = write!(std::io::stdout().lock(), "{text}");
         return Ok(());
     }
-    let setup = Setup::new(args.profile.as_deref(), args.seed, args.search, args.init)?;
+    let mut setup = Setup::new(args.profile.as_deref(), args.seed, args.search, args.init)?;
+    if let Some(path) = &args.warm_start {
+        setup.warm_start = Some((path.clone(), read_pack(path)?));
+    }
     let pipeline = match &args.config {
         Some(p) => load_pipeline(p)?,
         None => Pipeline::default(),
@@ -352,7 +427,15 @@ pub fn job(pile: &Pile, setup: &Setup, out: Option<&Path>) -> Result<Job> {
     })?;
     model.set_search_space(setup.search.space());
     let t0 = Instant::now();
-    let result = plan_dig(&model, &setup.gwo, &[]);
+    let warm: Vec<Vec<f64>> = match &setup.warm_start {
+        Some((_, wolves)) => wolves
+            .iter()
+            .take(setup.gwo.population)
+            .map(|d| model.vector(d))
+            .collect(),
+        None => Vec::new(),
+    };
+    let result = plan_dig(&model, &setup.gwo, &warm);
     let plan_ms = t0.elapsed().as_secs_f64() * 1e3;
     let mut summary = Value::Object(header(pile, setup));
     let mut written = Written::default();
@@ -410,6 +493,15 @@ fn header(pile: &Pile, setup: &Setup) -> Map<String, Value> {
         json!("feasibility rules (Deb 2000)"),
     );
     o.insert("profile".into(), json!(setup.profile_name));
+    if let Some((path, wolves)) = &setup.warm_start {
+        o.insert(
+            "warm_start".into(),
+            json!({
+                "file": path.display().to_string(),
+                "wolves": wolves.len().min(setup.gwo.population),
+            }),
+        );
+    }
     o.insert("k_f_pa".into(), json!(p.material.cutting_resistance_pa));
     o.insert("epsilon".into(), json!(p.material.fill_resistance_ratio));
     o.insert("psi".into(), json!(p.material.normal_ratio));
@@ -573,6 +665,24 @@ fn write_outputs(
         }),
     )?;
     written.file(dir, &conv);
+    let pack = dir.join("pack.csv");
+    write_csv(
+        &pack,
+        &PACK_COLUMNS,
+        plan.search.population.iter().map(|(x, e)| {
+            let d = model.decision(x);
+            vec![
+                d.ax6,
+                d.ay6,
+                d.td_s,
+                d.gx_m,
+                d.gy_m,
+                e.objective,
+                e.violation,
+            ]
+        }),
+    )?;
+    written.file(dir, &pack);
     let (x0, x1) = view_x_range(model, &plan.outcome.decision);
     let surface = dir.join("surface.csv");
     write_csv(

@@ -634,3 +634,58 @@ fn cloud_plans_on_a_generated_scale_model_scan_and_explains_a_full_size_one() {
         r.stderr
     );
 }
+
+#[test]
+fn warm_start_from_the_last_plans_pack_never_plans_worse() {
+    let dir = TempDir::new("plan-dig-warm");
+    let first = dir.path().join("first");
+    let a = run(&[
+        "plan-dig".as_ref(),
+        "--surface".as_ref(),
+        "convex".as_ref(),
+        "--out".as_ref(),
+        first.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    let pack = first.join("pack.csv");
+    let text = std::fs::read_to_string(&pack).unwrap();
+    // One row per wolf, the best first and equal to the plan.
+    assert_eq!(text.lines().count(), 1 + 50);
+    let best: Vec<f64> = text
+        .lines()
+        .nth(1)
+        .unwrap()
+        .split(',')
+        .map(|c| c.parse().unwrap())
+        .collect();
+    assert!((best[5] - f64_field(&a, "f")).abs() < 1e-9);
+    // Next cycle, another seed, from that pack: the old best is in the pack,
+    // and the optimiser never loses its best, so f cannot get worse (beyond
+    // the rounding of the decision's round trip through the CSV).
+    let b = run(&[
+        "plan-dig".as_ref(),
+        "--surface".as_ref(),
+        "convex".as_ref(),
+        "--seed".as_ref(),
+        "9".as_ref(),
+        "--warm-start".as_ref(),
+        pack.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert!(f64_field(&b, "f") <= f64_field(&a, "f") + 1e-9);
+    assert_eq!(b["warm_start"]["wolves"], 50);
+    // A damaged pack is refused with its line.
+    let bad = dir.path().join("bad.csv");
+    std::fs::write(&bad, text.replacen("\n", "\nnot,a,number,at,all,0,0\n", 1)).unwrap();
+    let r = run(&[
+        "plan-dig".as_ref(),
+        "--warm-start".as_ref(),
+        bad.as_os_str(),
+    ])
+    .fails();
+    assert!(r.error_message().contains("bad.csv:2:"), "{}", r.stderr);
+}
