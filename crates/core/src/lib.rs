@@ -1,6 +1,7 @@
 //! Shared foundation of autoshovel: plane geometry aliases, poses and frame
 //! conventions (SPEC §1), angle wrapping, polylines, cubic B-splines and
-//! product-of-exponentials twists ([`poe`]).
+//! product-of-exponentials twists ([`poe`]), and TOML configuration files
+//! with located errors ([`config`]).
 //!
 //! Every other crate depends on this one; it depends on nothing of ours.
 
@@ -9,6 +10,7 @@
 
 mod angle;
 mod bspline;
+pub mod config;
 mod geom;
 pub mod poe;
 mod polyline;

@@ -1,45 +1,13 @@
 //! Errors of dig planning and machine-profile loading.
 
-use std::path::PathBuf;
-
 /// Everything that can go wrong when loading a profile or planning a dig.
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum DigError {
-    /// A profile file could not be read.
-    #[error("cannot read machine profile {path}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// A profile is not valid TOML, or has unknown or missing keys.
-    #[error("{file}:{line}:{column}: {message}")]
-    Parse {
-        /// The file (or `<builtin>`).
-        file: String,
-        /// 1-based line.
-        line: usize,
-        /// 1-based column.
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A value in a profile is out of range or contradicts another.
-    #[error("{file}:{line}: {key} = {value} is invalid: expected {expected}")]
-    Invalid {
-        /// The file (or `<builtin>`).
-        file: String,
-        /// 1-based line of the key (0 when unknown).
-        line: usize,
-        /// `[table] key`.
-        key: String,
-        /// The value given.
-        value: f64,
-        /// What it should be.
-        expected: String,
-    },
+    /// A profile file could not be read, parsed or checked (names the file,
+    /// line and key).
+    #[error(transparent)]
+    Config(#[from] autoshovel_core::config::ConfigError),
     /// The machine cannot put its tooth tip where the plan needs it.
     #[error("unreachable: {0}")]
     Unreachable(String),

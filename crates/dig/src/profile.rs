@@ -30,6 +30,8 @@ use std::path::Path;
 
 use serde::Deserialize;
 
+use autoshovel_core::config;
+
 use crate::error::{DigError, Result};
 
 /// The embedded default profile (the paper's scale model).
@@ -218,24 +220,13 @@ impl MachineProfile {
 
     /// Read and check a profile file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| DigError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = config::read(path)?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
     /// Parse and check a profile; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let profile: MachineProfile = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
-            DigError::Parse {
-                file: file.to_string(),
-                line,
-                column,
-                message: e.message().to_string(),
-            }
-        })?;
+        let profile: MachineProfile = config::parse(text, file)?;
         profile.check(text, file)?;
         Ok(profile)
     }
@@ -247,12 +238,15 @@ impl MachineProfile {
 
     /// Check every value; `text` and `file` locate errors.
     fn check(&self, text: &str, file: &str) -> Result<()> {
-        let bad = |table: &str, key: &str, value: f64, expected: &str| DigError::Invalid {
-            file: file.to_string(),
-            line: line_of_key(text, table, key),
-            key: format!("[{table}] {key}"),
-            value,
-            expected: expected.to_string(),
+        let bad = |table: &str, key: &str, value: f64, expected: &str| {
+            DigError::from(config::invalid(
+                text,
+                file,
+                (table, 0),
+                key,
+                value,
+                expected,
+            ))
         };
         let g = &self.geometry;
         let positive: [(&str, &str, f64); 22] = [
@@ -517,39 +511,6 @@ pub struct Geometry {
     pub dipper_pitch: f64,
     /// L_dg of c17: the handle length, greatest extension d = d₂ + d₂₀.
     pub handle_length: f64,
-}
-
-/// 1-based line and column of a byte offset.
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let offset = offset.min(text.len());
-    let before = &text[..offset];
-    let line = before.matches('\n').count() + 1;
-    let column = before.rfind('\n').map_or(offset, |i| offset - i - 1) + 1;
-    (line, column)
-}
-
-/// The 1-based line of `key = …` inside `[table]`, or 0 when absent.
-fn line_of_key(text: &str, table: &str, key: &str) -> usize {
-    let mut in_table = false;
-    let mut table_line = 0;
-    for (i, line) in text.lines().enumerate() {
-        let t = line.trim();
-        if t.starts_with('[') {
-            in_table = t.trim_start_matches('[').split(']').next().map(str::trim) == Some(table);
-            if in_table {
-                table_line = i + 1;
-            }
-            continue;
-        }
-        if in_table {
-            if let Some((k, _)) = t.split_once('=') {
-                if k.trim() == key {
-                    return i + 1;
-                }
-            }
-        }
-    }
-    table_line
 }
 
 #[cfg(test)]

@@ -1,7 +1,5 @@
 //! Errors of profile and scenario loading, kinematics and the two-level planner.
 
-use std::path::PathBuf;
-
 use crate::kinematics::Joint;
 use crate::preimage::AvoidSide;
 
@@ -57,40 +55,10 @@ pub enum IkError {
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum ExcavateError {
-    /// A file could not be read.
-    #[error("cannot read {path}")]
-    Io {
-        /// The file.
-        path: PathBuf,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// A file is not valid TOML, or has unknown or missing keys.
-    #[error("{file}:{line}:{column}: {message}")]
-    Parse {
-        /// The file (or `<builtin …>`).
-        file: String,
-        /// 1-based line (0 when unknown).
-        line: usize,
-        /// 1-based column (0 when unknown).
-        column: usize,
-        /// What is wrong.
-        message: String,
-    },
-    /// A value is out of range or contradicts another.
-    #[error("{file}:{line}: {key} = {value} is invalid: expected {expected}")]
-    Invalid {
-        /// The file (or `<builtin …>`).
-        file: String,
-        /// 1-based line of the key (0 when unknown).
-        line: usize,
-        /// `[table] key`.
-        key: String,
-        /// The value given.
-        value: String,
-        /// What it should be.
-        expected: String,
-    },
+    /// A profile or scenario file could not be read, parsed or checked
+    /// (names the file, line and key).
+    #[error(transparent)]
+    Config(#[from] autoshovel_core::config::ConfigError),
     /// No built-in scenario has this name.
     #[error("unknown scenario `{name}`: the built-ins are {known}, or give a TOML file")]
     UnknownScenario {

@@ -47,7 +47,6 @@ pub mod segment;
 pub mod simulate;
 pub mod smooth;
 pub mod soil;
-mod toml_lines;
 pub mod volume;
 
 pub use error::{ExcavateError, IkError, Result};

@@ -14,7 +14,7 @@ use std::path::Path;
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ExcavateError, Result};
-use crate::toml_lines::{self, line_of_key};
+use autoshovel_core::config;
 
 /// The embedded default profile (15 t class backhoe).
 pub const EXCAVATOR_15T_TOML: &str = include_str!("../profiles/excavator-15t.toml");
@@ -147,16 +147,13 @@ impl MachineProfile {
 
     /// Read and check a profile file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| ExcavateError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = config::read(path)?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
     /// Parse and check a profile; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let profile: MachineProfile = toml_lines::parse(text, file)?;
+        let profile: MachineProfile = config::parse(text, file)?;
         profile.check(text, file)?;
         Ok(profile)
     }
@@ -168,12 +165,15 @@ impl MachineProfile {
 
     /// Check every value; `text` and `file` locate errors.
     fn check(&self, text: &str, file: &str) -> Result<()> {
-        let bad = |table: &str, key: &str, value: f64, expected: &str| ExcavateError::Invalid {
-            file: file.to_string(),
-            line: line_of_key(text, table, 0, key),
-            key: format!("[{table}] {key}"),
-            value: value.to_string(),
-            expected: expected.to_string(),
+        let bad = |table: &str, key: &str, value: f64, expected: &str| {
+            ExcavateError::from(config::invalid(
+                text,
+                file,
+                (table, 0),
+                key,
+                value,
+                expected,
+            ))
         };
         let g = &self.geometry;
         let m = &self.masses;

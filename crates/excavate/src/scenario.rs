@@ -56,7 +56,7 @@ use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
 use crate::obstacle::Envelope;
 use crate::soil::Soil;
-use crate::toml_lines::{self, line_of_key};
+use autoshovel_core::config::{self, line_of_key, ConfigError};
 
 /// The built-in scenarios: (name, TOML text).
 pub const BUILTINS: [(&str, &str); 3] = [
@@ -183,16 +183,13 @@ impl Scenario {
 
     /// Read and check a scenario file.
     pub fn load(path: &Path) -> Result<Self> {
-        let text = std::fs::read_to_string(path).map_err(|source| ExcavateError::Io {
-            path: path.to_path_buf(),
-            source,
-        })?;
+        let text = config::read(path)?;
         Self::from_toml(&text, &path.display().to_string())
     }
 
     /// Parse and check a scenario; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let s: Scenario = toml_lines::parse(text, file)?;
+        let s: Scenario = config::parse(text, file)?;
         s.check(text, file)?;
         Ok(s)
     }
@@ -204,7 +201,7 @@ impl Scenario {
 
     fn check(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, occurrence: usize, key: &str, value: String, expected: &str| {
-            ExcavateError::Invalid {
+            ExcavateError::from(ConfigError::Invalid {
                 file: file.to_string(),
                 line: line_of_key(text, table, occurrence, key),
                 key: if table.is_empty() {
@@ -216,7 +213,7 @@ impl Scenario {
                 },
                 value,
                 expected: expected.to_string(),
-            }
+            })
         };
         let d = &self.dig;
         let positive = [

@@ -135,7 +135,13 @@ fn unknown_names_missing_files_and_bad_files_are_named() {
     assert!(matches!(e, ExcavateError::UnknownScenario { .. }));
     assert!(e.to_string().contains("paper-over, paper-under"), "{e}");
     let e = Scenario::from_name_or_file("/nonexistent/dig.toml").unwrap_err();
-    assert!(matches!(e, ExcavateError::Io { .. }), "{e:?}");
+    assert!(
+        matches!(
+            e,
+            ExcavateError::Config(autoshovel_core::config::ConfigError::Io { .. })
+        ),
+        "{e:?}"
+    );
     let text =
         Scenario::builtin_toml("paper-over")
             .unwrap()

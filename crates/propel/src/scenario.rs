@@ -37,6 +37,7 @@
 
 use std::path::Path as FsPath;
 
+use autoshovel_core::config::line_col;
 use autoshovel_core::{rad, Pose2, Vec2};
 use serde::Deserialize;
 use toml::Spanned;
@@ -140,16 +141,6 @@ impl Scenario {
         })?;
         raw.validate(text, file)
     }
-}
-
-fn line_col(text: &str, offset: usize) -> (usize, usize) {
-    let before = &text[..offset.min(text.len())];
-    let line = before.matches('\n').count() + 1;
-    let column = before
-        .rfind('\n')
-        .map(|i| before.len() - i)
-        .unwrap_or(before.len() + 1);
-    (line, column)
 }
 
 #[derive(Debug, Deserialize)]

@@ -1,0 +1,179 @@
+//! TOML configuration files (machine profiles, scenarios) with errors that
+//! name the file, the line and the key at fault.
+//!
+//! One error type and the line-finding helpers, shared by every crate that
+//! reads a TOML file: read the text ([`read`]), deserialise it with the
+//! span of a syntax or type error turned into `file:line:column` ([`parse`]),
+//! then check values and report a bad one at the line of its key
+//! ([`invalid`], [`line_of_key`]).
+
+use std::fmt::Display;
+use std::path::{Path, PathBuf};
+
+/// What can go wrong with a configuration file.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum ConfigError {
+    /// The file could not be read.
+    #[error("cannot read {path}")]
+    Io {
+        /// The file.
+        path: PathBuf,
+        /// The cause.
+        source: std::io::Error,
+    },
+    /// Not valid TOML, or unknown, missing or mistyped keys.
+    #[error("{file}:{line}:{column}: {message}")]
+    Parse {
+        /// The file (or `<builtin …>`).
+        file: String,
+        /// 1-based line (0 when unknown).
+        line: usize,
+        /// 1-based column (0 when unknown).
+        column: usize,
+        /// What is wrong.
+        message: String,
+    },
+    /// A value out of range or contradicting another.
+    #[error("{file}:{line}: {key} = {value} is invalid: expected {expected}")]
+    Invalid {
+        /// The file (or `<builtin …>`).
+        file: String,
+        /// 1-based line of the key (0 when unknown).
+        line: usize,
+        /// `[table] key`, or `key` at the top level.
+        key: String,
+        /// The value given.
+        value: String,
+        /// What it should be.
+        expected: String,
+    },
+}
+
+/// The text of a configuration file.
+pub fn read(path: &Path) -> Result<String, ConfigError> {
+    std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
+        path: path.to_path_buf(),
+        source,
+    })
+}
+
+/// Deserialise `text` (named `file` in errors); a TOML error becomes
+/// [`ConfigError::Parse`] at the line and column of its span.
+pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, ConfigError> {
+    toml::from_str(text).map_err(|e| {
+        let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
+        ConfigError::Parse {
+            file: file.to_string(),
+            line,
+            column,
+            message: e.message().trim().to_string(),
+        }
+    })
+}
+
+/// [`ConfigError::Invalid`] for `key` of the `occurrence`-th (0-based)
+/// `[table]` / `[[table]]` (the top level when `table` is empty), located
+/// with [`line_of_key`].
+pub fn invalid(
+    text: &str,
+    file: &str,
+    (table, occurrence): (&str, usize),
+    key: &str,
+    value: impl Display,
+    expected: impl Into<String>,
+) -> ConfigError {
+    ConfigError::Invalid {
+        file: file.to_string(),
+        line: line_of_key(text, table, occurrence, key),
+        key: if table.is_empty() {
+            key.to_string()
+        } else {
+            format!("[{table}] {key}")
+        },
+        value: value.to_string(),
+        expected: expected.into(),
+    }
+}
+
+/// 1-based line and column of a byte offset.
+pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
+    let mut offset = offset.min(text.len());
+    while !text.is_char_boundary(offset) {
+        offset -= 1;
+    }
+    let before = &text[..offset];
+    let line = before.matches('\n').count() + 1;
+    let column = before.rfind('\n').map_or(offset, |i| offset - i - 1) + 1;
+    (line, column)
+}
+
+/// The 1-based line of `key = …` in the `occurrence`-th (0-based) table
+/// headed `[table]` or `[[table]]`; a top-level key when `table` is empty.
+/// Falls back to the table's header line, and to 0 when the table is absent.
+pub fn line_of_key(text: &str, table: &str, occurrence: usize, key: &str) -> usize {
+    let mut seen: Option<usize> = if table.is_empty() { Some(0) } else { None };
+    let mut active = table.is_empty();
+    let mut header_line = 0;
+    for (i, line) in text.lines().enumerate() {
+        let t = line.trim();
+        if t.starts_with('[') {
+            let name = t.trim_start_matches('[').split(']').next().map(str::trim);
+            if !table.is_empty() && name == Some(table) {
+                let n = seen.map_or(0, |n| n + 1);
+                seen = Some(n);
+                active = n == occurrence;
+                if active {
+                    header_line = i + 1;
+                }
+            } else {
+                active = false;
+            }
+            continue;
+        }
+        if active {
+            if let Some((k, _)) = t.split_once('=') {
+                if k.trim() == key {
+                    return i + 1;
+                }
+            }
+        }
+    }
+    header_line
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_are_found_in_their_table_and_occurrence() {
+        let text = "name = \"a\"\n[dig]\nx = 1\n[[obstacle]]\nr = 1\n[[obstacle]]\n# c\nr = 2\n";
+        assert_eq!(line_of_key(text, "", 0, "name"), 1);
+        assert_eq!(line_of_key(text, "dig", 0, "x"), 3);
+        assert_eq!(line_of_key(text, "obstacle", 0, "r"), 5);
+        assert_eq!(line_of_key(text, "obstacle", 1, "r"), 8);
+        assert_eq!(line_of_key(text, "obstacle", 1, "missing"), 6);
+        assert_eq!(line_of_key(text, "nothing", 0, "x"), 0);
+        assert_eq!(line_col("ab\ncd", 4), (2, 2));
+        assert_eq!(line_col("é", 1), (1, 1));
+    }
+
+    #[test]
+    fn parse_errors_name_file_line_and_column() {
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct S {
+            a: f64,
+        }
+        let e = parse::<S>("\n\na = \"x\"\n", "f.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("f.toml:3:5:"), "{e}");
+        let e = invalid("[t]\nk = 2\n", "f.toml", ("t", 0), "k", 2.0, "less than 1");
+        assert_eq!(
+            e.to_string(),
+            "f.toml:2: [t] k = 2 is invalid: expected less than 1"
+        );
+    }
+}
