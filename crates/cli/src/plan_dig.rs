@@ -27,6 +27,7 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use anyhow::{bail, Context, Result};
+use autoshovel_dig::TomlFile as _;
 use autoshovel_dig::{
     plan_dig, Decision, DigModel, DigOutcome, DigPlan, DigSample, DigSurface, MachineProfile,
     SearchSpace, CONSTRAINT_NAMES,

@@ -22,6 +22,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use autoshovel_excavate::profile::EXCAVATOR_15T_TOML;
 use autoshovel_excavate::segment::SegmentKind;
+use autoshovel_excavate::TomlFile as _;
 use autoshovel_excavate::{
     excavate, Backhoe, ContactReport, Excavation, Joints, MachineProfile, Sample, Scenario,
 };

@@ -50,6 +50,37 @@ pub enum ConfigError {
     },
 }
 
+/// A checked configuration read from TOML: implement [`TomlFile::check`]
+/// and get loading, parsing and printing that name the file, line and key
+/// at fault.
+pub trait TomlFile: serde::de::DeserializeOwned + serde::Serialize {
+    /// The error of the crate that owns the type.
+    type Error: From<ConfigError>;
+
+    /// Check every value once, at the edge; `text` and `file` locate errors
+    /// (see [`invalid`]).
+    fn check(&self, text: &str, file: &str) -> Result<(), Self::Error>;
+
+    /// Parse and check `text`; `file` names it in errors.
+    fn from_toml(text: &str, file: &str) -> Result<Self, Self::Error> {
+        let value: Self = parse(text, file)?;
+        value.check(text, file)?;
+        Ok(value)
+    }
+
+    /// Read, parse and check a file.
+    fn load(path: &Path) -> Result<Self, Self::Error> {
+        let text = read(path)?;
+        Self::from_toml(&text, &path.display().to_string())
+    }
+
+    /// As TOML (without the comments of an embedded file); loads back to an
+    /// equal value.
+    fn to_toml(&self) -> String {
+        toml::to_string_pretty(self).expect("a checked configuration serialises")
+    }
+}
+
 /// The text of a configuration file.
 pub fn read(path: &Path) -> Result<String, ConfigError> {
     std::fs::read_to_string(path).map_err(|source| ConfigError::Io {

@@ -18,6 +18,7 @@ pub mod profile;
 pub mod terrain;
 pub mod trajectory;
 
+pub use autoshovel_core::config::TomlFile;
 pub use error::{DigError, Result};
 pub use kinematics::{Joints, RopeShovel};
 pub use plan::{

@@ -26,11 +26,9 @@
 //! meets the floor with the handle retracted, which puts it 65.5 mm in front
 //! of O with the handle 5.6° behind the vertical.
 
-use std::path::Path;
-
 use serde::Deserialize;
 
-use autoshovel_core::config;
+use autoshovel_core::config::{self, TomlFile};
 
 use crate::error::{DigError, Result};
 
@@ -218,26 +216,8 @@ impl MachineProfile {
             .expect("the embedded profile is valid")
     }
 
-    /// Read and check a profile file.
-    pub fn load(path: &Path) -> Result<Self> {
-        let text = config::read(path)?;
-        Self::from_toml(&text, &path.display().to_string())
-    }
-
-    /// Parse and check a profile; `file` names it in errors.
-    pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let profile: MachineProfile = config::parse(text, file)?;
-        profile.check(text, file)?;
-        Ok(profile)
-    }
-
-    /// The profile as TOML (for `--print-profile` of a loaded profile).
-    pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).expect("a profile serialises")
-    }
-
     /// Check every value; `text` and `file` locate errors.
-    fn check(&self, text: &str, file: &str) -> Result<()> {
+    fn check_values(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, key: &str, value: f64, expected: &str| {
             DigError::from(config::invalid(
                 text,
@@ -511,6 +491,14 @@ pub struct Geometry {
     pub dipper_pitch: f64,
     /// L_dg of c17: the handle length, greatest extension d = d₂ + d₂₀.
     pub handle_length: f64,
+}
+
+impl TomlFile for MachineProfile {
+    type Error = DigError;
+
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        self.check_values(text, file)
+    }
 }
 
 #[cfg(test)]

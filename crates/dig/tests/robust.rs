@@ -1,7 +1,7 @@
 //! Damaged and extreme machine profiles: an error or a plan, never a panic.
 
 use autoshovel_dig::profile::SCALE_MODEL_TOML;
-use autoshovel_dig::{DigModel, DigSurface, MachineProfile};
+use autoshovel_dig::{DigModel, DigSurface, MachineProfile, TomlFile};
 use autoshovel_surface::PileShape;
 use proptest::prelude::*;
 

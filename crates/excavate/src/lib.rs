@@ -49,6 +49,7 @@ pub mod smooth;
 pub mod soil;
 pub mod volume;
 
+pub use autoshovel_core::config::TomlFile;
 pub use error::{ExcavateError, IkError, Result};
 pub use kinematics::{Backhoe, Joint, Joints};
 pub use plan::{excavate, ContactReport, Excavation, Sample, Summary};

@@ -9,12 +9,10 @@
 //! a silent default. Values are checked once here; errors name the file, the
 //! line and the key. Angles are in degrees in the file and radians inside.
 
-use std::path::Path;
-
 use serde::{Deserialize, Serialize};
 
 use crate::error::{ExcavateError, Result};
-use autoshovel_core::config;
+use autoshovel_core::config::{self, TomlFile};
 
 /// The embedded default profile (15 t class backhoe).
 pub const EXCAVATOR_15T_TOML: &str = include_str!("../profiles/excavator-15t.toml");
@@ -145,26 +143,8 @@ impl MachineProfile {
             .expect("the embedded profile is valid")
     }
 
-    /// Read and check a profile file.
-    pub fn load(path: &Path) -> Result<Self> {
-        let text = config::read(path)?;
-        Self::from_toml(&text, &path.display().to_string())
-    }
-
-    /// Parse and check a profile; `file` names it in errors.
-    pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let profile: MachineProfile = config::parse(text, file)?;
-        profile.check(text, file)?;
-        Ok(profile)
-    }
-
-    /// The profile as TOML (without the comments of the embedded file).
-    pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).expect("a profile serialises")
-    }
-
     /// Check every value; `text` and `file` locate errors.
-    fn check(&self, text: &str, file: &str) -> Result<()> {
+    fn check_values(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, key: &str, value: f64, expected: &str| {
             ExcavateError::from(config::invalid(
                 text,
@@ -302,6 +282,14 @@ impl MachineProfile {
             ));
         }
         Ok(())
+    }
+}
+
+impl TomlFile for MachineProfile {
+    type Error = ExcavateError;
+
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        self.check_values(text, file)
     }
 }
 

@@ -56,7 +56,7 @@ use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
 use crate::obstacle::Envelope;
 use crate::soil::Soil;
-use autoshovel_core::config::{self, line_of_key, ConfigError};
+use autoshovel_core::config::{line_of_key, ConfigError, TomlFile};
 
 /// The built-in scenarios: (name, TOML text).
 pub const BUILTINS: [(&str, &str); 3] = [
@@ -181,25 +181,7 @@ impl Scenario {
         Self::load(path)
     }
 
-    /// Read and check a scenario file.
-    pub fn load(path: &Path) -> Result<Self> {
-        let text = config::read(path)?;
-        Self::from_toml(&text, &path.display().to_string())
-    }
-
-    /// Parse and check a scenario; `file` names it in errors.
-    pub fn from_toml(text: &str, file: &str) -> Result<Self> {
-        let s: Scenario = config::parse(text, file)?;
-        s.check(text, file)?;
-        Ok(s)
-    }
-
-    /// The scenario as TOML (loads back to an equal scenario).
-    pub fn to_toml(&self) -> String {
-        toml::to_string_pretty(self).expect("a scenario serialises")
-    }
-
-    fn check(&self, text: &str, file: &str) -> Result<()> {
+    fn check_values(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, occurrence: usize, key: &str, value: String, expected: &str| {
             ExcavateError::from(ConfigError::Invalid {
                 file: file.to_string(),
@@ -330,6 +312,14 @@ impl Scenario {
             }
         }
         Ok(())
+    }
+}
+
+impl TomlFile for Scenario {
+    type Error = ExcavateError;
+
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        self.check_values(text, file)
     }
 }
 

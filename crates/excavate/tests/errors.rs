@@ -1,6 +1,7 @@
 //! Bad input ends in a clear, structured error — never in a path through a boulder.
 
 use autoshovel_excavate::obstacle::Envelope;
+use autoshovel_excavate::TomlFile as _;
 use autoshovel_excavate::{
     excavate, AvoidSide, ExcavateError, IkError, Joint, MachineProfile, Scenario,
 };

@@ -7,6 +7,7 @@
 
 use std::path::Path;
 
+use autoshovel_excavate::TomlFile as _;
 use autoshovel_excavate::{excavate, AvoidSide, Excavation, MachineProfile, Scenario};
 
 /// Checks shared by every scenario; returns nothing, panics with the reason.

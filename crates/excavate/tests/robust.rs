@@ -1,5 +1,6 @@
 //! Damaged scenario files: an error or a dig, never a panic.
 
+use autoshovel_excavate::TomlFile as _;
 use autoshovel_excavate::{excavate, MachineProfile, Scenario};
 use proptest::prelude::*;
 
