@@ -267,35 +267,24 @@ fn printed_profile_round_trips_and_out_writes_every_file() {
         assert_eq!(s[key], builtin[key], "{key}");
     }
     // Files: the summary printed is the one written, and lists them all.
-    let written: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(written, s, "--json prints what summary.json holds");
-    let files: Vec<&str> = s["files"]
-        .as_array()
-        .expect("files")
-        .iter()
-        .map(|f| f.as_str().unwrap())
-        .collect();
-    for f in [
-        "summary.json",
-        "samples.csv",
-        "convergence.csv",
-        "surface.csv",
-        "dig_path.svg",
-        "dig_path.png",
-        "speeds.svg",
-        "speeds.png",
-        "forces.svg",
-        "forces.png",
-        "convergence.svg",
-        "convergence.png",
-    ] {
-        assert!(out.join(f).is_file(), "{f} missing");
-        assert!(
-            files.contains(&f),
-            "summary files should list {f}: {files:?}"
-        );
-    }
+    assert_written(
+        &out,
+        &s,
+        &[
+            "summary.json",
+            "samples.csv",
+            "convergence.csv",
+            "surface.csv",
+            "dig_path.svg",
+            "dig_path.png",
+            "speeds.svg",
+            "speeds.png",
+            "forces.svg",
+            "forces.png",
+            "convergence.svg",
+            "convergence.png",
+        ],
+    );
     // samples.csv: every sample, from the toe (0, 0) at rest to (g_x, g_y) at t_d.
     let csv = std::fs::read_to_string(out.join("samples.csv")).unwrap();
     let mut lines = csv.lines();

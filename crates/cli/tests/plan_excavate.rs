@@ -264,41 +264,24 @@ fn out_writes_the_data_and_plots_that_agree_with_the_summary() {
     let scenario = scenario_text("paper-under");
     let profile = profile_text();
     check_summary(&s, &scenario, &profile);
-    let written: Value =
-        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
-    assert_eq!(written, s, "--json prints what summary.json holds");
-    let files: Vec<&str> = s["files"]
-        .as_array()
-        .expect("files")
-        .iter()
-        .map(|f| f.as_str().unwrap())
-        .collect();
-    for f in [
-        "summary.json",
-        "samples.csv",
-        "contacts.csv",
-        "planned_path.csv",
-        "tooth_path.svg",
-        "tooth_path.png",
-        "excavator.svg",
-        "excavator.png",
-        "digging_force.svg",
-        "digging_force.png",
-        "joints.svg",
-        "joints.png",
-    ] {
-        assert!(out.join(f).is_file(), "{f} missing");
-        assert!(
-            files.contains(&f),
-            "summary files should list {f}: {files:?}"
-        );
-        let bytes = std::fs::read(out.join(f)).unwrap();
-        if f.ends_with(".png") {
-            assert!(bytes.starts_with(b"\x89PNG"), "{f} is not a PNG");
-        } else if f.ends_with(".svg") {
-            assert!(String::from_utf8_lossy(&bytes).contains("<svg"), "{f}");
-        }
-    }
+    assert_written(
+        &out,
+        &s,
+        &[
+            "summary.json",
+            "samples.csv",
+            "contacts.csv",
+            "planned_path.csv",
+            "tooth_path.svg",
+            "tooth_path.png",
+            "excavator.svg",
+            "excavator.png",
+            "digging_force.svg",
+            "digging_force.png",
+            "joints.svg",
+            "joints.png",
+        ],
+    );
     // samples.csv: every sample field, from the start at rest to the end.
     let (header, rows) = read_csv(&out.join("samples.csv"));
     for c in [

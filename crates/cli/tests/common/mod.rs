@@ -295,3 +295,32 @@ pub fn without_timing(v: &Value) -> Value {
         other => other.clone(),
     }
 }
+
+/// A job's `--out` folder: `summary.json` is the summary printed under
+/// `--json`, and each of `files` exists, is listed in the summary's
+/// `files`, and is a PNG or SVG where its name says so.
+#[allow(dead_code)]
+pub fn assert_written(out: &Path, summary: &Value, files: &[&str]) {
+    let written: Value =
+        serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap()).unwrap();
+    assert_eq!(&written, summary, "--json prints what summary.json holds");
+    let listed: Vec<&str> = summary["files"]
+        .as_array()
+        .expect("files")
+        .iter()
+        .map(|f| f.as_str().unwrap())
+        .collect();
+    for f in files {
+        assert!(out.join(f).is_file(), "{f} missing");
+        assert!(
+            listed.contains(f),
+            "summary files should list {f}: {listed:?}"
+        );
+        let bytes = std::fs::read(out.join(f)).unwrap();
+        if f.ends_with(".png") {
+            assert!(bytes.starts_with(b"\x89PNG"), "{f} is not a PNG");
+        } else if f.ends_with(".svg") {
+            assert!(String::from_utf8_lossy(&bytes).contains("<svg"), "{f}");
+        }
+    }
+}
