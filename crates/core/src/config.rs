@@ -127,6 +127,29 @@ pub fn invalid(
     }
 }
 
+/// Checks every `([table], key, value)` with `ok`; the first that fails is
+/// [`invalid`] with `expected` (e.g. [`POSITIVE`]).
+pub fn check_each(
+    text: &str,
+    file: &str,
+    values: &[(&str, &str, f64)],
+    (ok, expected): (fn(f64) -> bool, &str),
+) -> Result<(), ConfigError> {
+    for &(table, key, v) in values {
+        if !ok(v) {
+            return Err(invalid(text, file, (table, 0), key, v, expected));
+        }
+    }
+    Ok(())
+}
+
+/// A finite value > 0, for [`check_each`].
+pub const POSITIVE: (fn(f64) -> bool, &str) = (|v| v.is_finite() && v > 0.0, "a finite value > 0");
+
+/// A finite value ≥ 0, for [`check_each`].
+pub const NON_NEGATIVE: (fn(f64) -> bool, &str) =
+    (|v| v.is_finite() && v >= 0.0, "a finite value >= 0");
+
 /// 1-based line and column of a byte offset.
 pub fn line_col(text: &str, offset: usize) -> (usize, usize) {
     let mut offset = offset.min(text.len());

@@ -261,11 +261,7 @@ impl MachineProfile {
             ("limits", "crowd_power_max_w", self.limits.crowd_power_max_w),
             ("limits", "time_min_s", self.limits.time_min_s),
         ];
-        for (table, key, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(table, key, v, "a finite value > 0"));
-            }
-        }
+        config::check_each(text, file, &positive, config::POSITIVE)?;
         let non_negative = [
             (
                 "material",
@@ -283,11 +279,7 @@ impl MachineProfile {
             ("objective", "k1", self.objective.k1),
             ("objective", "k2", self.objective.k2),
         ];
-        for (table, key, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(bad(table, key, v, "a finite value >= 0"));
-            }
-        }
+        config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
         if self.objective.k1 + self.objective.k2 == 0.0 {
             return Err(bad("objective", "k2", 0.0, "k1 + k2 > 0"));
         }

@@ -3,8 +3,7 @@
 //! and one forward search.
 
 use autoshovel_core::Vec2;
-use autoshovel_excavate::ground::Ground;
-use autoshovel_excavate::level1::{plan_level1, Level1Request, StepSearch};
+use autoshovel_excavate::level1::plan_level1;
 use autoshovel_excavate::obstacle::Envelope;
 use autoshovel_excavate::search::{forward_search, SearchParams};
 use autoshovel_excavate::{excavate, AvoidSide, Backhoe, MachineProfile, Scenario};
@@ -27,29 +26,9 @@ fn whole_plan(c: &mut Criterion) {
 
 fn pieces(c: &mut Criterion) {
     let m = Backhoe::new(&MachineProfile::default());
-    let ground = Ground::flat();
-    let search = StepSearch {
-        machine: &m,
-        ground: &ground,
-        bucket_width_m: 1.0,
-        step_m: 0.05,
-        trapezoids: 100,
-        speed_fraction: 0.5,
-        min_segment_time_s: 1.0,
-        known: &[],
-        refine: false,
-        max_overdig_m: 0.15,
-    };
-    let req = Level1Request {
-        start_x_m: 7.0,
-        depth_m: 0.7,
-        target_volume_m3: 0.9,
-        attitude_rad: [
-            -80f64.to_radians(),
-            -140f64.to_radians(),
-            -200f64.to_radians(),
-        ],
-    };
+    let paper = Scenario::paper_over();
+    let search = paper.step_search(&m, 1.0, &[]);
+    let req = paper.level1_request();
     c.bench_function("level1/paper (two step searches)", |b| {
         b.iter(|| plan_level1(black_box(&search), &req).unwrap())
     });

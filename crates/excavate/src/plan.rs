@@ -31,7 +31,7 @@ use crate::dynamics::Dynamics;
 use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
 use crate::kinematics::{Backhoe, Joints};
-use crate::level1::{plan_level1, EndLevel, Level1Plan, Level1Request, StepFound, StepSearch};
+use crate::level1::{plan_level1, EndLevel, Level1Plan, StepFound, StepSearch};
 use crate::obstacle::Envelope;
 use crate::preimage::{decide, gamma_rad, AvoidSide};
 use crate::profile::MachineProfile;
@@ -325,18 +325,13 @@ struct Run<'a> {
 
 impl<'a> Run<'a> {
     fn new(sc: &'a Scenario, profile: &MachineProfile) -> Self {
-        let d = &sc.dig;
         Self {
             sc,
             machine: Backhoe::new(profile),
             dynamics: Dynamics::new(profile),
             max_force_n: profile.force.max_digging_force_n,
             width_m: profile.bucket.width_m,
-            attitude: [
-                d.attitude_start_deg.to_radians(),
-                d.attitude_mid_deg.to_radians(),
-                d.attitude_end_deg.to_radians(),
-            ],
+            attitude: sc.level1_request().attitude_rad,
             known: vec![false; sc.obstacles.len()],
             first_half_done: false,
             t_s: 0.0,
@@ -365,19 +360,7 @@ impl<'a> Run<'a> {
     }
 
     fn step_search<'b>(&'b self, known: &'b [Envelope]) -> StepSearch<'b> {
-        let p = &self.sc.planner;
-        StepSearch {
-            machine: &self.machine,
-            ground: &self.sc.ground,
-            bucket_width_m: self.width_m,
-            step_m: self.sc.dig.step_m,
-            trapezoids: p.trapezoids,
-            speed_fraction: p.speed_fraction,
-            min_segment_time_s: p.min_segment_time_s,
-            known,
-            refine: p.refine_volume,
-            max_overdig_m: p.max_overdig_m,
-        }
+        self.sc.step_search(&self.machine, self.width_m, known)
     }
 
     fn sample_path(&self, segments: &[Segment]) -> Vec<[f64; 2]> {
@@ -406,12 +389,7 @@ impl<'a> Run<'a> {
                 });
             }
         }
-        let req = Level1Request {
-            start_x_m: d.start_x_m,
-            depth_m: d.depth_m,
-            target_volume_m3: d.target_volume_m3,
-            attitude_rad: self.attitude,
-        };
+        let req = self.sc.level1_request();
         let plan = plan_level1(&self.step_search(&[]), &req)?;
         let level1 = self.level1_report(&plan);
         let mut pending: VecDeque<PlannedSegment> = plan_segments(&plan);

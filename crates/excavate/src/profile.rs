@@ -180,21 +180,13 @@ impl MachineProfile {
                 self.force.max_digging_force_n,
             ),
         ];
-        for (table, key, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(table, key, v, "a finite value > 0"));
-            }
-        }
+        config::check_each(text, file, &positive, config::POSITIVE)?;
         let non_negative = [
             ("masses", "boom_inertia_kg_m2", m.boom_inertia_kg_m2),
             ("masses", "stick_inertia_kg_m2", m.stick_inertia_kg_m2),
             ("masses", "bucket_inertia_kg_m2", m.bucket_inertia_kg_m2),
         ];
-        for (table, key, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(bad(table, key, v, "a finite value >= 0"));
-            }
-        }
+        config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
         if !g.boom_foot_x_m.is_finite() {
             return Err(bad(
                 "geometry",

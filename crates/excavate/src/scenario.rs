@@ -54,9 +54,11 @@ use serde::{Deserialize, Serialize};
 
 use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
+use crate::kinematics::Backhoe;
+use crate::level1::{Level1Request, StepSearch};
 use crate::obstacle::Envelope;
 use crate::soil::Soil;
-use autoshovel_core::config::{line_of_key, ConfigError, TomlFile};
+use autoshovel_core::config::{self, line_of_key, ConfigError, TomlFile};
 
 /// The built-in scenarios: (name, TOML text).
 pub const BUILTINS: [(&str, &str); 3] = [
@@ -137,6 +139,45 @@ pub struct Scenario {
 }
 
 impl Scenario {
+    /// Level 1's request for this dig: start, depth, target and the three
+    /// attitudes in radians.
+    pub fn level1_request(&self) -> Level1Request {
+        let d = &self.dig;
+        Level1Request {
+            start_x_m: d.start_x_m,
+            depth_m: d.depth_m,
+            target_volume_m3: d.target_volume_m3,
+            attitude_rad: [
+                d.attitude_start_deg.to_radians(),
+                d.attitude_mid_deg.to_radians(),
+                d.attitude_end_deg.to_radians(),
+            ],
+        }
+    }
+
+    /// The step-search settings of this dig for `machine` with a bucket
+    /// `bucket_width_m` wide, avoiding the `known` boulders.
+    pub fn step_search<'a>(
+        &'a self,
+        machine: &'a Backhoe,
+        bucket_width_m: f64,
+        known: &'a [Envelope],
+    ) -> StepSearch<'a> {
+        let p = &self.planner;
+        StepSearch {
+            machine,
+            ground: &self.ground,
+            bucket_width_m,
+            step_m: self.dig.step_m,
+            trapezoids: p.trapezoids,
+            speed_fraction: p.speed_fraction,
+            min_segment_time_s: p.min_segment_time_s,
+            known,
+            refine: p.refine_volume,
+            max_overdig_m: p.max_overdig_m,
+        }
+    }
+
     /// Names of the built-ins.
     pub fn builtin_names() -> Vec<&'static str> {
         BUILTINS.iter().map(|(n, _)| *n).collect()
@@ -211,11 +252,7 @@ impl Scenario {
                 self.planner.min_segment_time_s,
             ),
         ];
-        for (table, key, v) in positive {
-            if !(v.is_finite() && v > 0.0) {
-                return Err(bad(table, 0, key, v.to_string(), "a finite value > 0"));
-            }
-        }
+        config::check_each(text, file, &positive, config::POSITIVE)?;
         if !(d.step_m.is_finite() && d.step_m > 0.0 && d.step_m <= 0.5) {
             return Err(bad(
                 "dig",
@@ -236,15 +273,15 @@ impl Scenario {
             }
         }
         let non_negative = [
-            ("cutting_resistance_pa", self.soil.cutting_resistance_pa),
-            ("normal_ratio", self.soil.normal_ratio),
-            ("rock_friction", self.soil.rock_friction),
+            (
+                "soil",
+                "cutting_resistance_pa",
+                self.soil.cutting_resistance_pa,
+            ),
+            ("soil", "normal_ratio", self.soil.normal_ratio),
+            ("soil", "rock_friction", self.soil.rock_friction),
         ];
-        for (key, v) in non_negative {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err(bad("soil", 0, key, v.to_string(), "a finite value >= 0"));
-            }
-        }
+        config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
         let p = &self.planner;
         if !(p.speed_fraction > 0.0 && p.speed_fraction <= 1.0) {
             return Err(bad(

@@ -5,40 +5,18 @@
 
 use approx::assert_relative_eq;
 use autoshovel_excavate::dynamics::Dynamics;
-use autoshovel_excavate::ground::Ground;
-use autoshovel_excavate::level1::{plan_level1, Level1Request, StepSearch};
+use autoshovel_excavate::level1::plan_level1;
 use autoshovel_excavate::soil::Soil;
-use autoshovel_excavate::MachineProfile;
+use autoshovel_excavate::{MachineProfile, Scenario};
 
 #[test]
 fn motor_work_is_energy_change_plus_work_against_the_soil() {
     let profile = MachineProfile::default();
     let d = Dynamics::new(&profile);
-    let ground = Ground::flat();
-    let search = StepSearch {
-        machine: &d.machine,
-        ground: &ground,
-        bucket_width_m: 1.0,
-        step_m: 0.05,
-        trapezoids: 100,
-        speed_fraction: 0.5,
-        min_segment_time_s: 1.0,
-        known: &[],
-        refine: false,
-        max_overdig_m: 0.15,
-    };
+    let paper = Scenario::paper_over();
     let plan = plan_level1(
-        &search,
-        &Level1Request {
-            start_x_m: 7.0,
-            depth_m: 0.7,
-            target_volume_m3: 0.9,
-            attitude_rad: [
-                -80f64.to_radians(),
-                -140f64.to_radians(),
-                -200f64.to_radians(),
-            ],
-        },
+        &paper.step_search(&d.machine, profile.bucket.width_m, &[]),
+        &paper.level1_request(),
     )
     .unwrap();
     let soil = Soil {
@@ -54,7 +32,7 @@ fn motor_work_is_energy_change_plus_work_against_the_soil() {
         let h = total / n as f64;
         let power = |t: f64| {
             let s = seg.state(&d.machine, t);
-            let f = soil.resistance(&ground, s.tip, s.direction, 1.0);
+            let f = soil.resistance(&paper.ground, s.tip, s.direction, 1.0);
             let tau = d.inverse_dynamics(&s.q, &s.qd, &s.qdd, load, f);
             (tau.dot(&s.qd), -f.dot(&s.tip_velocity))
         };

@@ -7,33 +7,21 @@ use autoshovel_excavate::ground::Ground;
 use autoshovel_excavate::level1::{plan_level1, Level1Request, StepSearch};
 use autoshovel_excavate::segment::Motion;
 use autoshovel_excavate::volume::swept_area;
-use autoshovel_excavate::{Backhoe, MachineProfile};
+use autoshovel_excavate::{Backhoe, MachineProfile, Scenario};
+use std::sync::LazyLock;
+
+/// The paper's case (§3): start (7, 0), depth 0.7 m, step 0.05 m, 0.9 m³.
+static PAPER: LazyLock<Scenario> = LazyLock::new(Scenario::paper_over);
 
 fn request() -> Level1Request {
-    Level1Request {
-        start_x_m: 7.0,
-        depth_m: 0.7,
-        target_volume_m3: 0.9,
-        attitude_rad: [
-            -80f64.to_radians(),
-            -140f64.to_radians(),
-            -200f64.to_radians(),
-        ],
-    }
+    PAPER.level1_request()
 }
 
 fn search<'a>(m: &'a Backhoe, g: &'a Ground, refine: bool) -> StepSearch<'a> {
     StepSearch {
-        machine: m,
         ground: g,
-        bucket_width_m: 1.0,
-        step_m: 0.05,
-        trapezoids: 100,
-        speed_fraction: 0.5,
-        min_segment_time_s: 1.0,
-        known: &[],
         refine,
-        max_overdig_m: 0.15,
+        ..PAPER.step_search(m, 1.0, &[])
     }
 }
 
