@@ -21,7 +21,6 @@ mod pile;
 mod plan_dig;
 mod plan_excavate;
 mod plan_path;
-mod plots;
 mod study;
 mod track;
 

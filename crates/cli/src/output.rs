@@ -1,10 +1,15 @@
 //! Output conventions shared by every job (SPEC §6): `--out DIR` gets
 //! `summary.json`, CSV and SVG+PNG plots; `--json` prints the summary alone
 //! on stdout; human-readable lines go to stdout only without `--json`.
+//!
+//! Every job is a [`Job`] of its typed summary (made by the library crate
+//! that computes it) and the files written.
 
 use std::path::{Path, PathBuf};
 
 use anyhow::{bail, Context, Result};
+pub use autoshovel_report::Written;
+use serde::Serialize;
 
 /// Makes sure `dir` is a directory we may write into, creating it if needed.
 /// An existing directory is used as it is: only the files a job names are
@@ -18,11 +23,73 @@ pub fn prepare_dir(dir: &Path) -> Result<PathBuf> {
     Ok(dir.to_path_buf())
 }
 
-/// Prints the summary as pretty JSON on stdout.
-pub fn print_json(summary: &serde_json::Value) -> Result<()> {
+/// Prints a summary as pretty JSON on stdout.
+pub fn print_json<S: Serialize + ?Sized>(summary: &S) -> Result<()> {
     crate::say!("{}", serde_json::to_string_pretty(summary)?);
     Ok(())
 }
+
+/// A finished job: its typed summary and the files it wrote (none without
+/// an output folder).
+#[allow(dead_code)] // until every job is on it
+#[derive(Debug, Clone)]
+pub struct Job<S> {
+    /// The job's summary, as its library crate made it.
+    pub summary: S,
+    /// Files written under the output folder.
+    pub written: Written,
+    /// The output folder, if one was given.
+    pub out: Option<PathBuf>,
+}
+
+#[allow(dead_code)]
+impl<S: Serialize> Job<S> {
+    /// Writes the job's files into `out` (when given) with `write`, then
+    /// `summary.json` listing them all.
+    pub fn finish(
+        summary: S,
+        out: Option<&Path>,
+        write: impl FnOnce(&Path, &mut Written) -> Result<()>,
+    ) -> Result<Self> {
+        let mut written = Written::default();
+        if let Some(dir) = out {
+            write(dir, &mut written)?;
+            autoshovel_report::write_job_summary(dir, &summary, &mut written)?;
+        }
+        Ok(Self {
+            summary,
+            written,
+            out: out.map(Path::to_path_buf),
+        })
+    }
+
+    /// The summary as `summary.json` holds it (with `files` when written).
+    pub fn json(&self) -> Result<serde_json::Value> {
+        Ok(autoshovel_report::summary_value(
+            &autoshovel_report::WithFiles {
+                summary: &self.summary,
+                files: self.out.as_ref().map(|_| self.written.all()),
+            },
+        )?)
+    }
+
+    /// Reports the job: the summary alone on stdout under `--json`,
+    /// otherwise `human`'s lines and the folder written to.
+    pub fn report(&self, json: bool, human: impl FnOnce(&S)) -> Result<()> {
+        if json {
+            print_json(&self.json()?)?;
+        } else {
+            human(&self.summary);
+            if let Some(dir) = &self.out {
+                crate::say!("wrote {}", dir.display());
+            }
+        }
+        Ok(())
+    }
+}
+
+// ---- Value-based glue of the jobs not yet on typed summaries; removed as
+// each job moves to a [`Job`] of its library's summary type.
 
 /// Reports a finished job: the summary alone on stdout under `--json`,
 /// otherwise the `human` report and the folder written to.
@@ -52,36 +119,6 @@ pub fn num(v: f64) -> serde_json::Value {
     }
 }
 
-/// Files a job wrote, relative to its output folder.
-#[derive(Debug, Default, Clone)]
-pub struct Written {
-    /// SVG plots.
-    pub plots: Vec<String>,
-    /// Everything else (CSV, JSON, PNG).
-    pub files: Vec<String>,
-}
-
-impl Written {
-    /// Records a plot pair [svg, png] written under `base`.
-    pub fn plot(&mut self, base: &Path, pair: [PathBuf; 2]) {
-        let [svg, png] = pair;
-        self.plots.push(rel(base, &svg));
-        self.files.push(rel(base, &png));
-    }
-
-    /// Records a data file written under `base`.
-    pub fn file(&mut self, base: &Path, path: &Path) {
-        self.files.push(rel(base, path));
-    }
-}
-
-fn rel(base: &Path, p: &Path) -> String {
-    p.strip_prefix(base)
-        .unwrap_or(p)
-        .to_string_lossy()
-        .replace('\\', "/")
-}
-
 /// Lists every file a job wrote in its summary (`files`) and writes
 /// `summary.json` into `dir`.
 pub fn write_job_summary(
@@ -89,12 +126,6 @@ pub fn write_job_summary(
     summary: &mut serde_json::Value,
     written: &mut Written,
 ) -> Result<()> {
-    written.file(dir, &dir.join(autoshovel_report::SUMMARY_FILE));
-    summary["files"] = serde_json::json!(written
-        .files
-        .iter()
-        .chain(written.plots.iter())
-        .collect::<Vec<_>>());
-    autoshovel_report::write_summary(dir, summary)?;
+    *summary = autoshovel_report::write_job_summary(dir, summary, written)?;
     Ok(())
 }

@@ -868,7 +868,9 @@ fn dig_path_figure(pile: &Pile, model: &DigModel, plan: &DigPlan) -> Figure {
     )
     .equal_aspect()
     .size(1100, 800);
-    for l in crate::plots::pile_layers(&model.surface, x0, x1, p.geometry.pile_angle_deg) {
+    for l in
+        autoshovel_figures::shovel::pile_layers(&model.surface, x0, x1, p.geometry.pile_angle_deg)
+    {
         fig.push(l);
     }
     let h = p.limits.hopper_height_m + p.dipper.height_m;
@@ -876,7 +878,7 @@ fn dig_path_figure(pile: &Pile, model: &DigModel, plan: &DigPlan) -> Figure {
         Layer::line([(x0, h), (x1, h)], Stroke::dashed(Rgb::GREY, 1))
             .with_label("c16: end height H_kk + H_cd"),
     );
-    for l in crate::plots::shovel_frame_layers(&model.shovel) {
+    for l in autoshovel_figures::shovel::shovel_frame_layers(&model.shovel) {
         fig.push(l);
     }
     let (first, last) = (plan.samples.first(), plan.samples.last());
@@ -885,9 +887,14 @@ fn dig_path_figure(pile: &Pile, model: &DigModel, plan: &DigPlan) -> Figure {
         (last, Rgb::ORANGE, "end", false),
     ] {
         if let Some(s) = s {
-            for l in
-                crate::plots::shovel_pose_layers(&model.shovel, p, s.joints, color, label, names)
-            {
+            for l in autoshovel_figures::shovel::shovel_pose_layers(
+                &model.shovel,
+                p,
+                s.joints,
+                color,
+                label,
+                names,
+            ) {
                 fig.push(l);
             }
         }
@@ -1323,7 +1330,7 @@ fn comparison_panel(model: &DigModel, s: &Value, paper: &PaperRow) -> Figure {
     )
     .equal_aspect()
     .size(900, 480);
-    for l in crate::plots::pile_layers(
+    for l in autoshovel_figures::shovel::pile_layers(
         &model.surface,
         -0.05,
         x1,

@@ -12,8 +12,8 @@ use autoshovel_report::{write_csv, write_figure, write_panels, Figure, Layer, Rg
 use serde_json::{json, Value};
 
 use crate::output::{num, prepare_dir, print_json, Written};
-use crate::plots::{heading_arrow, map_figure};
 use crate::PlannerArg;
+use autoshovel_figures::map::{heading_arrow, map_figure};
 
 /// Arguments of `plan-path`.
 #[derive(Debug, clap::Args)]

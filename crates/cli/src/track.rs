@@ -293,7 +293,7 @@ fn write_outputs(
     )
     .equal_aspect();
     if let Some(map) = &scenario.map {
-        for l in crate::plots::map_layers(map) {
+        for l in autoshovel_figures::map::map_layers(map) {
             fig.push(l);
         }
     }

@@ -38,8 +38,10 @@ mod heatmap;
 mod html;
 mod json;
 mod layout;
+mod panels;
 mod render;
 mod style;
+mod written;
 
 pub use crate::csv::{format_f64, write_csv, write_csv_cells};
 pub use crate::error::ReportError;
@@ -50,5 +52,9 @@ pub use crate::json::{write_summary, SUMMARY_FILE};
 pub use crate::layout::{
     data_ranges, plot_area_px, AxisRange, MAX_AREA_PX, MAX_SIDE_PX, MIN_HEIGHT_PX, MIN_WIDTH_PX,
 };
+pub use crate::panels::{
+    finite_range, instant_marks, markdown_table, rating_line, time_panel, Line,
+};
 pub use crate::render::{write_figure, write_panels, MAX_MARKER_PX, MAX_STROKE_PX};
 pub use crate::style::{viridis, Rgb, Stroke};
+pub use crate::written::{summary_value, write_job_summary, WithFiles, Written};

@@ -1,0 +1,1 @@
+//! Figures and tables of the `dig` job (filled as the job moves out of the CLI).

@@ -1,0 +1,18 @@
+//! Each job's figures (SVG + PNG) and CSV tables, built from the typed
+//! results of the library crates: one module per job, the shared drawing
+//! helpers in `autoshovel-report`. Only the `autoshovel` binary depends on
+//! this crate; it sits at the end of the data flow beside it.
+//!
+//! Every `write_*` function takes the output folder and a
+//! [`Written`](autoshovel_report::Written) that records each file written.
+
+// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
+#![allow(rustdoc::broken_intra_doc_links)]
+
+pub mod dig;
+pub mod excavate;
+pub mod map;
+pub mod perceive;
+pub mod shovel;
+pub mod study;
+pub mod track;

@@ -1,0 +1,1 @@
+//! Figures and tables of the `study` job (filled as the job moves out of the CLI).
