@@ -40,7 +40,7 @@ use autoshovel_surface::PileShape;
 use serde_json::{json, Map, Value};
 
 use crate::output::{num, prepare_dir, print_json, write_job_summary, Written};
-use crate::perceive::{load_pipeline, Pipeline};
+use autoshovel_surface::perceive::PerceptionParams as Pipeline;
 
 /// Share of the face height above the floor that marks the toe of a scanned pile.
 pub const TOE_RISE_SHARE: f64 = 0.03;
@@ -281,7 +281,7 @@ impl Pile {
         profile: &MachineProfile,
         progress: bool,
     ) -> Result<Self> {
-        let got = crate::perceive::process(path, pipeline, progress)?;
+        let got = crate::perceive::perceive_with_progress(path, pipeline, progress)?;
         let fit = &got.fit;
         let e = &fit.extent;
         let y_line = 0.5 * (e.y_min_m + e.y_max_m);
@@ -380,7 +380,7 @@ pub fn run(args: &Args) -> Result<()> {
         setup.warm_start = Some((path.clone(), read_pack(path)?));
     }
     let pipeline = match &args.config {
-        Some(p) => load_pipeline(p)?,
+        Some(p) => Pipeline::load(p)?,
         None => Pipeline::default(),
     };
     let out = args.out.as_deref().map(prepare_dir).transpose()?;

@@ -5,24 +5,23 @@
 //! under a fitted surface, and synthetic scans of the four pile shapes of the
 //! paper's Fig. 7.
 //!
+//! The paper's whole §3 pipeline is one call, [`perceive::perceive`], with
+//! one set of defaults ([`perceive::PerceptionParams`]); the stages are
+//! public for other uses:
+//!
 //! ```
-//! use autoshovel_surface::{estimate_tilt, fit_surface, generate_pile, level};
-//! use autoshovel_surface::{FitParams, PileParams, PileShape, TiltParams};
-//! use autoshovel_cloud::PointCloud;
+//! use autoshovel_surface::perceive::{perceive, PerceptionParams};
+//! use autoshovel_surface::{generate_pile, PileParams, PileShape};
 //!
 //! // A tilted scan of a concave pile: roll 3°, pitch −2°.
 //! let p = PileParams { shape: PileShape::Concave, points: 30_000, ..PileParams::default() };
 //! let scan = generate_pile(&p).unwrap();
-//! // Calibrate from the floor, level, cut the floor away (pass-through), fit.
-//! let tilt = estimate_tilt(&scan, &TiltParams::default()).unwrap();
-//! assert!((tilt.roll_rad - p.roll_rad).abs().to_degrees() < 0.2);
-//! assert!((tilt.pitch_rad - p.pitch_rad).abs().to_degrees() < 0.2);
-//! let flat = level(&scan, tilt.roll_rad, tilt.pitch_rad);
-//! let pile = PointCloud::new(
-//!     flat.points.into_iter().filter(|q| f64::from(q[2]) > tilt.floor_height_m + 0.2).collect(),
-//! );
-//! let surface = fit_surface(&pile, &FitParams::default()).unwrap();
-//! assert!(surface.r2 > 0.95);
+//! // Calibrate from the floor, level, filter, fit: every stage counted and timed.
+//! let got = perceive(&scan, &PerceptionParams::default()).unwrap();
+//! assert!((got.roll_rad - p.roll_rad).abs().to_degrees() < 0.2);
+//! assert!((got.pitch_rad - p.pitch_rad).abs().to_degrees() < 0.2);
+//! assert!(got.fit.r2 > 0.95);
+//! assert_eq!(got.stages.last().unwrap().stage, "fit");
 //! ```
 
 // Units in brackets ("[m]", "[rad]") are the house style, not intra-doc links.
@@ -32,6 +31,7 @@ mod calibrate;
 mod error;
 mod fit;
 mod floor;
+pub mod perceive;
 mod pile;
 mod ransac;
 mod sample;
