@@ -1,6 +1,6 @@
 //! Muck-pile surfaces (SPEC §4.1; rope-shovel paper §3): horizontal
-//! calibration of a scan by roll and pitch (eqs. 11–12), their estimate from
-//! the floor by RANSAC, the surface `z = f(x, y)` of eq. 21 fitted by least
+//! calibration of a scan by roll and pitch ([RS eq. 11]–[RS eq. 12]), their estimate from
+//! the floor by RANSAC, the surface `z = f(x, y)` of [RS eq. 21] fitted by least
 //! squares to an 8 × 8 sample grid with the paper's R² > 0.95 check, volumes
 //! under a fitted surface, and synthetic scans of the four pile shapes of the
 //! paper's Fig. 7.

@@ -1,6 +1,6 @@
 //! Synthetic LiDAR scans of a muck pile (SPEC §4.1), in the four shapes of the
 //! rope-shovel paper's Fig. 7: typical (a 40° face), concave, convex and
-//! convex–concave — so calibration, filtering and the surface fit of eq. 21
+//! convex–concave — so calibration, filtering and the surface fit of [RS eq. 21]
 //! can run without a LiDAR.
 //!
 //! # Scene (level frame, before the sensor tilt)
@@ -244,9 +244,9 @@ pub struct PileParams {
     /// Share of the outliers that are isolated points far from the surface
     /// (the rest hover above it), in [0, 1]. Default 0.2.
     pub isolated_share: f64,
-    /// Sensor roll α of eq. 11 [rad]. Default 3°.
+    /// Sensor roll α of [RS eq. 11] [rad]. Default 3°.
     pub roll_rad: f64,
-    /// Sensor pitch β of eq. 11 [rad]. Default −2°.
+    /// Sensor pitch β of [RS eq. 11] [rad]. Default −2°.
     pub pitch_rad: f64,
     /// Seed of the ChaCha8 generator. Default 1.
     pub seed: u64,
