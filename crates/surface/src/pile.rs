@@ -715,3 +715,59 @@ mod tests {
         assert!("wavy".parse::<PileShape>().is_err());
     }
 }
+
+/// The summary of `autoshovel generate-pile` (SPEC §6): what was generated
+/// and where it was written.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GeneratePileSummary {
+    /// "generate-pile".
+    pub job: &'static str,
+    /// Shape name (Fig. 7).
+    pub shape: &'static str,
+    /// Points written.
+    pub points: usize,
+    /// Sensor roll α [deg].
+    pub roll_deg: f64,
+    /// Sensor pitch β [deg].
+    pub pitch_deg: f64,
+    /// Length scale (1 = a 10 m face).
+    pub scale: f64,
+    /// Seed of the noise and sampling.
+    pub seed: u64,
+    /// The file written.
+    pub file: String,
+    /// Its encoding.
+    pub encoding: &'static str,
+    /// Time to generate [ms].
+    pub generate_ms: f64,
+    /// Time to write [ms].
+    pub write_ms: f64,
+    /// Always true (a failed run is an error).
+    pub success: bool,
+}
+
+impl GeneratePileSummary {
+    /// The summary of `points` generated with `p` and written to `file`.
+    pub fn new(
+        p: &PileParams,
+        points: usize,
+        file: &std::path::Path,
+        encoding: &'static str,
+        (generate_ms, write_ms): (f64, f64),
+    ) -> Self {
+        Self {
+            job: "generate-pile",
+            shape: p.shape.name(),
+            points,
+            roll_deg: p.roll_rad.to_degrees(),
+            pitch_deg: p.pitch_rad.to_degrees(),
+            scale: p.scale,
+            seed: p.seed,
+            file: file.display().to_string(),
+            encoding,
+            generate_ms,
+            write_ms,
+            success: true,
+        }
+    }
+}
