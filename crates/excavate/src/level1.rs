@@ -42,9 +42,9 @@
 use autoshovel_core::Vec2;
 use serde::Serialize;
 
-use crate::error::{ExcavateError, IkError, Result};
+use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
-use crate::kinematics::{Backhoe, Joints};
+use crate::kinematics::{Backhoe, IkError, Joints};
 use crate::obstacle::Envelope;
 use crate::quintic::{blend, JointQuintic};
 use crate::segment::{Motion, Segment, SegmentKind};

@@ -291,6 +291,37 @@ impl Excavation {
     pub fn planned_path(&self) -> &[[f64; 2]] {
         &self.level1.path_m
     }
+
+    /// The executed sample at a contact (the contact sample nearest in time).
+    pub fn contact_sample(&self, c: &ContactReport) -> Option<&Sample> {
+        self.samples
+            .iter()
+            .filter(|s| s.contact)
+            .min_by(|a, b| (a.t_s - c.t_s).abs().total_cmp(&(b.t_s - c.t_s).abs()))
+    }
+
+    /// Peak |F| on the tooth over the dig, contacts included (0 without samples) [N].
+    pub fn peak_digging_force_n(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|s| s.digging_force_magnitude_n)
+            .fold(0.0, f64::max)
+    }
+
+    /// True when the tooth met boulder `index` of the scenario.
+    pub fn met(&self, index: usize) -> bool {
+        self.contacts.iter().any(|c| c.obstacle == index)
+    }
+
+    /// Each detour with the segment that executed it (the n-th detour
+    /// segment belongs to the n-th detour).
+    pub fn detour_segments(&self) -> impl Iterator<Item = (&DetourReport, &SegmentReport)> {
+        let segments = self
+            .segments
+            .iter()
+            .filter(|g| g.kind == SegmentKind::Detour);
+        self.detours.iter().zip(segments)
+    }
 }
 
 /// Plan and execute a scenario on a machine; the wall time goes into

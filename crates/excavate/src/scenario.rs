@@ -224,18 +224,17 @@ impl Scenario {
 
     fn check_values(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, occurrence: usize, key: &str, value: String, expected: &str| {
-            ExcavateError::from(ConfigError::Invalid {
-                file: file.to_string(),
-                line: line_of_key(text, table, occurrence, key),
-                key: if table.is_empty() {
-                    key.to_string()
-                } else if table == "obstacle" {
-                    format!("[[obstacle]] #{} {key}", occurrence + 1)
-                } else {
-                    format!("[{table}] {key}")
-                },
-                value,
-                expected: expected.to_string(),
+            ExcavateError::from(if table == "obstacle" {
+                // An array of tables: name the entry as well as the key.
+                ConfigError::Invalid {
+                    file: file.to_string(),
+                    line: line_of_key(text, table, occurrence, key),
+                    key: format!("[[obstacle]] #{} {key}", occurrence + 1),
+                    value,
+                    expected: expected.to_string(),
+                }
+            } else {
+                config::invalid(text, file, (table, occurrence), key, value, expected)
             })
         };
         let d = &self.dig;

@@ -32,7 +32,7 @@ use std::collections::BinaryHeap;
 use autoshovel_core::Vec2;
 use serde::Serialize;
 
-use crate::error::IkError;
+use crate::kinematics::IkError;
 use crate::kinematics::Backhoe;
 use crate::obstacle::Envelope;
 use crate::preimage::AvoidSide;

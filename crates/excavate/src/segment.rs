@@ -28,6 +28,18 @@ pub enum SegmentKind {
     Detour,
 }
 
+impl SegmentKind {
+    /// Its name in tables and summaries (`descent`, `rise`, `detour`), as
+    /// serialised.
+    pub fn name(self) -> &'static str {
+        match self {
+            SegmentKind::Descent => "descent",
+            SegmentKind::Rise => "rise",
+            SegmentKind::Detour => "detour",
+        }
+    }
+}
+
 /// The state of the front at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotionState {
