@@ -5,9 +5,9 @@
 //! - [`kinematics`]: boom, stick and bucket by D-H, forward and inverse to the
 //!   tooth tip with a digging attitude angle, joint limits (paper §1.1).
 //! - [`dynamics`]: Lagrange dynamics, joint torques against the digging resistance.
-//! - [`quintic`], [`volume`], [`level1`]: level 1 — quintic joint paths (eq. 1),
-//!   volume by trapezoids (eq. 2), midpoint and end point by the step search (§1.2).
-//! - [`obstacle`], [`soil`], [`simulate`]: envelope circles (eq. 10), the digging
+//! - [`quintic`], [`volume`], [`level1`]: level 1 — quintic joint paths ([HE eq. 1]),
+//!   volume by trapezoids ([HE eq. 2]), midpoint and end point by the step search (§1.2).
+//! - [`obstacle`], [`soil`], [`simulate`]: envelope circles ([HE eq. 10]), the digging
 //!   resistance and the simulator that meets boulders the planner does not know.
 //! - [`preimage`], [`search`], [`smooth`]: level 2 — the side from the angle γ,
 //!   the forward search over the free set P and collision set Q, smoothing (§2.2).

@@ -15,7 +15,7 @@
 //! 5. Execution resumes; each new contact repeats 3–4.
 //!
 //! # Counting the volume
-//! achieved = b·(area between the ground and the executed tip path, eq. 2, less
+//! achieved = b·(area between the ground and the executed tip path, [HE eq. 2], less
 //! the envelopes lying inside that area) + b·π r² for every boulder met or lying
 //! inside that area. A boulder passed under lies inside the dug area and is
 //! counted once, as rock; a boulder passed over lies below the path and counts
@@ -86,7 +86,7 @@ pub struct Sample {
     pub digging_force_magnitude_n: f64,
     /// Soil carried in the bucket [kg].
     pub load_kg: f64,
-    /// Eq. 2 volume swept so far (soil and any boulder inside it) [m³].
+    /// [HE eq. 2] volume swept so far (soil and any boulder inside it) [m³].
     pub swept_volume_m3: f64,
     /// Index into [`Excavation::segments`].
     pub segment: usize,
@@ -111,7 +111,7 @@ pub struct SegmentReport {
     pub from_m: [f64; 2],
     /// Planned end point [m].
     pub to_m: [f64; 2],
-    /// Volume planned for it (eq. 2; none for a detour) [m³].
+    /// Volume planned for it ([HE eq. 2]; none for a detour) [m³].
     pub planned_volume_m3: Option<f64>,
     /// n of the step search that placed its end (none for a detour).
     pub steps: Option<usize>,
@@ -466,7 +466,7 @@ impl<'a> Run<'a> {
                     force += run.contact.as_ref().map_or(Vec2::zeros(), |c| c.force);
                 }
                 let prev = *self.tips.last().expect("the start is in");
-                self.swept_area += strip(self.ground(), prev, state.tip);
+                self.swept_area += strip(self.ground(), prev, state.tip); // [HE eq. 2]
                 self.tips.push(state.tip);
                 self.push_sample(t0 + t, state, force, seg_index, seg.kind, is_contact);
             }
@@ -565,7 +565,7 @@ impl<'a> Run<'a> {
             let det_tips = seg.sample_tips(&self.machine, sc.planner.trapezoids);
             let mut path_so_far = self.tips.clone();
             path_so_far.extend(det_tips.iter().skip(1));
-            let area = self.swept_area + swept_area(self.ground(), &det_tips);
+            let area = self.swept_area + swept_area(self.ground(), &det_tips); // [HE eq. 2]
             let (soil, rock) = self.counted(&path_so_far, area);
             let current = soil + rock;
             let end = *det_tips.last().expect("samples");
@@ -666,7 +666,7 @@ impl<'a> Run<'a> {
         Ok(out)
     }
 
-    /// (soil, boulders) volume [m³] of a path with eq. 2 area `area` (module docs).
+    /// (soil, boulders) volume [m³] of a path with [HE eq. 2] area `area` (module docs).
     fn counted(&self, path: &[Vec2], area: f64) -> (f64, f64) {
         let g = self.ground();
         let mut soil_area = area;
@@ -682,7 +682,7 @@ impl<'a> Run<'a> {
                 rock += e.area_m2() * self.width_m;
             }
         }
-        (soil_area * self.width_m, rock)
+        (soil_area * self.width_m, rock) // [HE eq. 2]: area × h_b
     }
 
     fn push_sample(

@@ -42,7 +42,7 @@ pub struct GeometrySpec {
 pub struct BucketSpec {
     /// Heaped capacity [m³].
     pub capacity_m3: f64,
-    /// h_b: opening width across the dig plane (eq. 2) [m].
+    /// h_b: opening width across the dig plane ([HE eq. 2]) [m].
     pub width_m: f64,
 }
 

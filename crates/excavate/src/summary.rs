@@ -1,5 +1,5 @@
 //! The `plan-excavate` job's summary (SPEC §6): the plan's own
-//! [`Summary`](crate::plan::Summary) and what the report adds — where the
+//! [`Summary`] and what the report adds — where the
 //! scenario and profile came from, every side chosen, the error in %, the
 //! whole level-1 plan, the boulders, the detours, the segments and the peak
 //! digging force. Every field is read from the [`Setup`] and the

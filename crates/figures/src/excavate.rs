@@ -11,10 +11,10 @@
 
 use std::path::Path;
 
+use autoshovel_excavate::segment::SegmentKind;
 use autoshovel_excavate::{
     Backhoe, ContactReport, Excavation, Joints, MachineProfile, Sample, Setup,
 };
-use autoshovel_excavate::segment::SegmentKind;
 use autoshovel_report::{
     format_f64, rating_line, time_panel, write_csv, write_csv_cells, write_panels, Figure, Layer,
     ReportError, Rgb, Stroke, Written,
@@ -52,7 +52,10 @@ pub fn write(
     )?;
     written.file(dir, &planned);
     let profile = &setup.profile;
-    written.plot(dir, write_panels(&[tooth_path_figure(ex)], dir, "tooth_path")?);
+    written.plot(
+        dir,
+        write_panels(&[tooth_path_figure(ex)], dir, "tooth_path")?,
+    );
     written.plot(
         dir,
         write_panels(&[excavator_figure(profile, ex)], dir, "excavator")?,
@@ -143,7 +146,9 @@ pub const CONTACT_COLUMNS: [&str; 13] = [
 
 /// Row of contact `i` (0-based) of `contacts.csv` ([`CONTACT_COLUMNS`]).
 pub fn contact_row(i: usize, c: &ContactReport, ex: &Excavation) -> Vec<String> {
-    let attitude = ex.contact_sample(c).map_or(f64::NAN, |s| s.attitude_rad.to_degrees());
+    let attitude = ex
+        .contact_sample(c)
+        .map_or(f64::NAN, |s| s.attitude_rad.to_degrees());
     vec![
         (i + 1).to_string(),
         c.obstacle.to_string(),
@@ -160,7 +165,6 @@ pub fn contact_row(i: usize, c: &ContactReport, ex: &Excavation) -> Vec<String> 
         format_f64(attitude),
     ]
 }
-
 
 fn pt(p: [f64; 2]) -> (f64, f64) {
     (p[0], p[1])
