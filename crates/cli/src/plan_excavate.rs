@@ -9,7 +9,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use autoshovel_excavate::{ExcavateSummary, Setup};
+use autoshovel_excavate::{ExcavateSummary, Excavation, Setup};
 
 use crate::output::{prepare_dir, Job};
 
@@ -64,7 +64,7 @@ fn print_raw(text: &str) {
 }
 
 /// Plans and executes the dig; an impossible dig is an error naming the scenario.
-fn plan(setup: &Setup) -> Result<autoshovel_excavate::Excavation> {
+fn plan(setup: &Setup) -> Result<Excavation> {
     setup.run().with_context(|| {
         format!(
             "plan-excavate {} ({})",
@@ -78,11 +78,7 @@ pub fn job(setup: &Setup, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
     finish(setup, &plan(setup)?, out)
 }
 
-fn finish(
-    setup: &Setup,
-    ex: &autoshovel_excavate::Excavation,
-    out: Option<&Path>,
-) -> Result<Job<ExcavateSummary>> {
+fn finish(setup: &Setup, ex: &Excavation, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
     Job::finish(ExcavateSummary::new(setup, ex), out, |dir, written| {
         Ok(autoshovel_figures::excavate::write(
             dir, setup, ex, written,

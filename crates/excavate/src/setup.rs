@@ -3,11 +3,12 @@
 
 use std::path::Path;
 
+use autoshovel_core::config::TomlFile;
+
 use crate::error::Result;
 use crate::plan::{excavate, Excavation};
 use crate::profile::{MachineProfile, EXCAVATOR_15T, EXCAVATOR_15T_TOML};
 use crate::scenario::Scenario;
-use crate::TomlFile;
 
 /// What a built-in scenario's source is called in summaries.
 pub const BUILTIN_SOURCE: &str = "builtin";
