@@ -251,42 +251,35 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         ("two-boulders", "Two boulders in one dig: the first passed over while descending, the second met while lifting out after the re-plan; each contact repeats preimage decision, forward search and re-plan."),
     ];
     for (name, description) in excavate_runs {
-        let setup = crate::plan_excavate::Setup::load(name, None)?;
+        let setup = autoshovel_excavate::Setup::load(name, None)?;
         let sub = format!("plan-excavate-{name}");
         let dir = prepare_dir(&out.join(&sub))?;
         let job = crate::plan_excavate::job(&setup, Some(&dir))?;
         let key = format!("plan-excavate {name}");
         if !json_only {
             let s = &job.summary;
-            let g = |k: &str| s[k].as_f64().unwrap_or(f64::NAN);
-            let contacts: Vec<String> = s["contacts"]
-                .as_array()
-                .into_iter()
-                .flatten()
-                .map(|c| {
-                    format!(
-                        "{:.2} s γ {:.0}° {}",
-                        c["t_s"].as_f64().unwrap_or(f64::NAN),
-                        c["gamma_deg"].as_f64().unwrap_or(f64::NAN),
-                        c["decision"].as_str().unwrap_or("?")
-                    )
-                })
+            let contacts: Vec<String> = s
+                .plan
+                .contacts
+                .iter()
+                .map(|c| format!("{:.2} s γ {:.0}° {}", c.t_s, c.gamma_deg, c.decision))
                 .collect();
             crate::say!(
                 "{key:40} ok: {:.3} m³ of {:.3} m³ ({:+.2} %), contacts: {}, dig {:.1} s, {:.1} ms",
-                g("achieved_volume_m3"),
-                g("target_volume_m3"),
-                g("volume_error_pct"),
+                s.plan.achieved_volume_m3,
+                s.plan.target_volume_m3,
+                s.volume_error_pct,
                 if contacts.is_empty() {
                     "none".to_string()
                 } else {
                     contacts.join("; ")
                 },
-                g("duration_s"),
-                g("plan_time_ms")
+                s.plan.duration_s,
+                s.plan.plan_time_ms
             );
         }
-        let mut shown = job.summary.clone();
+        let summary = job.json()?;
+        let mut shown = summary.clone();
         if let Some(o) = shown.as_object_mut() {
             o.remove("segments");
         }
@@ -298,7 +291,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
             &job.written.plots,
             &job.written.files,
         ));
-        summaries.insert(key, job.summary);
+        summaries.insert(key, summary);
     }
     let params = StudyParams {
         maps: 100,

@@ -1,55 +1,10 @@
-//! Errors of profile and scenario loading, kinematics and the two-level planner.
+//! The crate's error: scenario loading and the two-level planner. It sits
+//! above the modules whose values it names (the kinematics' [`IkError`], the
+//! preimage rule's [`AvoidSide`]); a machine profile's errors are
+//! [`autoshovel_core::config::ConfigError`]s, wrapped here as `Config`.
 
-use crate::kinematics::Joint;
+use crate::kinematics::IkError;
 use crate::preimage::AvoidSide;
-
-/// Why the inverse kinematics refused a tooth-tip pose.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
-#[non_exhaustive]
-pub enum IkError {
-    /// The stick pin (tip minus the bucket link at the attitude angle) is
-    /// farther from the boom foot than boom + stick, or nearer than their difference.
-    #[error(
-        "out of reach: the stick-pin point is {distance_m:.3} m from the boom foot, \
-         the boom and stick reach {min_m:.3}..{max_m:.3} m"
-    )]
-    OutOfReach {
-        /// Distance from the boom foot to the stick pin the pose needs [m].
-        distance_m: f64,
-        /// Least distance boom and stick can make [m].
-        min_m: f64,
-        /// Greatest distance [m].
-        max_m: f64,
-    },
-    /// A joint would leave its range.
-    #[error(
-        "{joint} joint at {:.2}° is outside its range {:.1}°..{:.1}°",
-        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
-    )]
-    JointOutOfLimit {
-        /// The joint.
-        joint: Joint,
-        /// The angle the pose needs [rad].
-        value_rad: f64,
-        /// Lower limit [rad].
-        min_rad: f64,
-        /// Upper limit [rad].
-        max_rad: f64,
-    },
-    /// The digging attitude angle is outside its range.
-    #[error(
-        "attitude angle {:.2}° is outside its range {:.1}°..{:.1}°",
-        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
-    )]
-    AttitudeOutOfRange {
-        /// The attitude angle φ = θ₁ + θ₂ + θ₃ [rad].
-        value_rad: f64,
-        /// Lower limit [rad].
-        min_rad: f64,
-        /// Upper limit [rad].
-        max_rad: f64,
-    },
-}
 
 /// Everything that can go wrong when loading a profile or a scenario, or planning.
 #[derive(Debug, thiserror::Error)]

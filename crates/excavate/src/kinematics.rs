@@ -35,7 +35,6 @@ use autoshovel_core::Vec2;
 use nalgebra::{Matrix2x3, Matrix4, Vector3};
 use serde::Serialize;
 
-use crate::error::IkError;
 use crate::profile::MachineProfile;
 
 /// Joint angles [θ₁ boom, θ₂ stick, θ₃ bucket] [rad].
@@ -71,6 +70,54 @@ impl fmt::Display for Joint {
             Joint::Bucket => "bucket (θ3)",
         })
     }
+}
+
+/// Why the inverse kinematics refused a tooth-tip pose.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum IkError {
+    /// The stick pin (tip minus the bucket link at the attitude angle) is
+    /// farther from the boom foot than boom + stick, or nearer than their difference.
+    #[error(
+        "out of reach: the stick-pin point is {distance_m:.3} m from the boom foot, \
+         the boom and stick reach {min_m:.3}..{max_m:.3} m"
+    )]
+    OutOfReach {
+        /// Distance from the boom foot to the stick pin the pose needs [m].
+        distance_m: f64,
+        /// Least distance boom and stick can make [m].
+        min_m: f64,
+        /// Greatest distance [m].
+        max_m: f64,
+    },
+    /// A joint would leave its range.
+    #[error(
+        "{joint} joint at {:.2}° is outside its range {:.1}°..{:.1}°",
+        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
+    )]
+    JointOutOfLimit {
+        /// The joint.
+        joint: Joint,
+        /// The angle the pose needs [rad].
+        value_rad: f64,
+        /// Lower limit [rad].
+        min_rad: f64,
+        /// Upper limit [rad].
+        max_rad: f64,
+    },
+    /// The digging attitude angle is outside its range.
+    #[error(
+        "attitude angle {:.2}° is outside its range {:.1}°..{:.1}°",
+        value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
+    )]
+    AttitudeOutOfRange {
+        /// The attitude angle φ = θ₁ + θ₂ + θ₃ [rad].
+        value_rad: f64,
+        /// Lower limit [rad].
+        min_rad: f64,
+        /// Upper limit [rad].
+        max_rad: f64,
+    },
 }
 
 /// One row of a D-H table.

@@ -3,9 +3,9 @@
 //!
 //! The midpoint is found by the paper's three steps: with step s and n = 1, 2, …
 //! take the candidate x′ = x_begin − n·s at the dig depth, join the start to
-//! it by the quintic of eq. 1 (in joint space between the inverse-kinematics
+//! it by the quintic of [HE eq. 1] (in joint space between the inverse-kinematics
 //! solutions at the start and candidate attitudes, which bends the tip path),
-//! integrate its volume by eq. 2, and stop when it holds 0.5·V — the operators'
+//! integrate its volume by [HE eq. 2], and stop when it holds 0.5·V — the operators'
 //! 1 : 1 split between penetration and lifting (paper ref. 12). The end point
 //! is searched the same way from the midpoint, on the ground.
 //!
@@ -42,9 +42,9 @@
 use autoshovel_core::Vec2;
 use serde::Serialize;
 
-use crate::error::{ExcavateError, IkError, Result};
+use crate::error::{ExcavateError, Result};
 use crate::ground::Ground;
-use crate::kinematics::{Backhoe, Joints};
+use crate::kinematics::{Backhoe, IkError, Joints};
 use crate::obstacle::Envelope;
 use crate::quintic::{blend, JointQuintic};
 use crate::segment::{Motion, Segment, SegmentKind};
@@ -95,7 +95,7 @@ pub struct StepFound {
     pub point: Vec2,
     /// Its joints [rad].
     pub joints: Joints,
-    /// Volume of the segment (eq. 2) [m³].
+    /// Volume of the segment ([HE eq. 2]) [m³].
     pub volume_m3: f64,
     /// n of x′ = x₀ − n·s (when refined: the n of the step refined into).
     pub steps: usize,
@@ -296,7 +296,7 @@ impl StepSearch<'_> {
         Err(first)
     }
 
-    /// Eq. 2 volume of a candidate, or why it is infeasible.
+    /// [HE eq. 2] volume of a candidate, or why it is infeasible.
     fn candidate_volume(
         &self,
         seg: &JointQuintic,
@@ -330,7 +330,7 @@ impl StepSearch<'_> {
             }
             path.push(tip);
         }
-        Ok(swept_area(self.ground, &path) * self.bucket_width_m)
+        Ok(swept_area(self.ground, &path) * self.bucket_width_m) // [HE eq. 2]
     }
 }
 

@@ -5,16 +5,18 @@
 //! - [`kinematics`]: boom, stick and bucket by D-H, forward and inverse to the
 //!   tooth tip with a digging attitude angle, joint limits (paper §1.1).
 //! - [`dynamics`]: Lagrange dynamics, joint torques against the digging resistance.
-//! - [`quintic`], [`volume`], [`level1`]: level 1 — quintic joint paths (eq. 1),
-//!   volume by trapezoids (eq. 2), midpoint and end point by the step search (§1.2).
-//! - [`obstacle`], [`soil`], [`simulate`]: envelope circles (eq. 10), the digging
+//! - [`quintic`], [`volume`], [`level1`]: level 1 — quintic joint paths ([HE eq. 1]),
+//!   volume by trapezoids ([HE eq. 2]), midpoint and end point by the step search (§1.2).
+//! - [`obstacle`], [`soil`], [`simulate`]: envelope circles ([HE eq. 10]), the digging
 //!   resistance and the simulator that meets boulders the planner does not know.
 //! - [`preimage`], [`search`], [`smooth`]: level 2 — the side from the angle γ,
 //!   the forward search over the free set P and collision set Q, smoothing (§2.2).
 //! - [`plan`]: both levels run against the simulator, with re-planning of the
 //!   remaining volume after each boulder; [`plan::Excavation`] holds everything
 //!   to plot and summarise.
-//! - [`profile`], [`scenario`]: the machine and the dig as TOML.
+//! - [`profile`], [`scenario`]: the machine and the dig as TOML; [`setup`]
+//!   loads both (built-ins by name) and runs the plan; [`summary`] is the
+//!   `plan-excavate` job's typed summary.
 //!
 //! The dig plane is SPEC §1's: x horizontal away from the machine (origin on
 //! the slew axis at ground level), y up; digging moves towards −x.
@@ -44,15 +46,19 @@ pub mod quintic;
 pub mod scenario;
 pub mod search;
 pub mod segment;
+pub mod setup;
 pub mod simulate;
 pub mod smooth;
 pub mod soil;
+pub mod summary;
 pub mod volume;
 
 pub use autoshovel_core::config::TomlFile;
-pub use error::{ExcavateError, IkError, Result};
-pub use kinematics::{Backhoe, Joint, Joints};
+pub use error::{ExcavateError, Result};
+pub use kinematics::{Backhoe, IkError, Joint, Joints};
 pub use plan::{excavate, ContactReport, Excavation, Sample, Summary};
 pub use preimage::AvoidSide;
 pub use profile::MachineProfile;
 pub use scenario::Scenario;
+pub use setup::Setup;
+pub use summary::ExcavateSummary;

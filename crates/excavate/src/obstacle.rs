@@ -1,4 +1,4 @@
-//! Buried obstacles as envelope circles (paper §2.1, eq. 10):
+//! Buried obstacles as envelope circles (paper §2.1, [HE eq. 10]):
 //! S = {(x, y) | (x − x₀)² + (y − y₀)² ≤ r₀²}. The paper envelops each hard
 //! block larger than 30 % of the bucket volume by a circle, which enlarges it
 //! but makes collision tests one distance comparison.
@@ -30,16 +30,17 @@ impl Envelope {
         Vec2::new(self.center_m[0], self.center_m[1])
     }
 
-    /// Signed distance of a point from the circle (negative inside) [m].
+    /// Signed distance of a point from the circle (negative inside, i.e. in
+    /// S of [HE eq. 10]) [m].
     #[inline]
     pub fn signed_distance(&self, p: Vec2) -> f64 {
-        (p - self.center()).norm() - self.radius_m
+        (p - self.center()).norm() - self.radius_m // [HE eq. 10], as a distance
     }
 
-    /// True when p ∈ S (eq. 10).
+    /// True when p ∈ S ([HE eq. 10]).
     #[inline]
     pub fn contains(&self, p: Vec2) -> bool {
-        (p - self.center()).norm_squared() <= self.radius_m * self.radius_m
+        (p - self.center()).norm_squared() <= self.radius_m * self.radius_m // [HE eq. 10]
     }
 
     /// Outward unit normal at the point of the circle nearest p.

@@ -15,7 +15,7 @@
 //! 5. Execution resumes; each new contact repeats 3–4.
 //!
 //! # Counting the volume
-//! achieved = b·(area between the ground and the executed tip path, eq. 2, less
+//! achieved = b·(area between the ground and the executed tip path, [HE eq. 2], less
 //! the envelopes lying inside that area) + b·π r² for every boulder met or lying
 //! inside that area. A boulder passed under lies inside the dug area and is
 //! counted once, as rock; a boulder passed over lies below the path and counts
@@ -86,7 +86,7 @@ pub struct Sample {
     pub digging_force_magnitude_n: f64,
     /// Soil carried in the bucket [kg].
     pub load_kg: f64,
-    /// Eq. 2 volume swept so far (soil and any boulder inside it) [m³].
+    /// [HE eq. 2] volume swept so far (soil and any boulder inside it) [m³].
     pub swept_volume_m3: f64,
     /// Index into [`Excavation::segments`].
     pub segment: usize,
@@ -111,7 +111,7 @@ pub struct SegmentReport {
     pub from_m: [f64; 2],
     /// Planned end point [m].
     pub to_m: [f64; 2],
-    /// Volume planned for it (eq. 2; none for a detour) [m³].
+    /// Volume planned for it ([HE eq. 2]; none for a detour) [m³].
     pub planned_volume_m3: Option<f64>,
     /// n of the step search that placed its end (none for a detour).
     pub steps: Option<usize>,
@@ -291,6 +291,37 @@ impl Excavation {
     pub fn planned_path(&self) -> &[[f64; 2]] {
         &self.level1.path_m
     }
+
+    /// The executed sample at a contact (the contact sample nearest in time).
+    pub fn contact_sample(&self, c: &ContactReport) -> Option<&Sample> {
+        self.samples
+            .iter()
+            .filter(|s| s.contact)
+            .min_by(|a, b| (a.t_s - c.t_s).abs().total_cmp(&(b.t_s - c.t_s).abs()))
+    }
+
+    /// Peak |F| on the tooth over the dig, contacts included (0 without samples) [N].
+    pub fn peak_digging_force_n(&self) -> f64 {
+        self.samples
+            .iter()
+            .map(|s| s.digging_force_magnitude_n)
+            .fold(0.0, f64::max)
+    }
+
+    /// True when the tooth met boulder `index` of the scenario.
+    pub fn met(&self, index: usize) -> bool {
+        self.contacts.iter().any(|c| c.obstacle == index)
+    }
+
+    /// Each detour with the segment that executed it (the n-th detour
+    /// segment belongs to the n-th detour).
+    pub fn detour_segments(&self) -> impl Iterator<Item = (&DetourReport, &SegmentReport)> {
+        let segments = self
+            .segments
+            .iter()
+            .filter(|g| g.kind == SegmentKind::Detour);
+        self.detours.iter().zip(segments)
+    }
 }
 
 /// Plan and execute a scenario on a machine; the wall time goes into
@@ -435,7 +466,7 @@ impl<'a> Run<'a> {
                     force += run.contact.as_ref().map_or(Vec2::zeros(), |c| c.force);
                 }
                 let prev = *self.tips.last().expect("the start is in");
-                self.swept_area += strip(self.ground(), prev, state.tip);
+                self.swept_area += strip(self.ground(), prev, state.tip); // [HE eq. 2]
                 self.tips.push(state.tip);
                 self.push_sample(t0 + t, state, force, seg_index, seg.kind, is_contact);
             }
@@ -534,7 +565,7 @@ impl<'a> Run<'a> {
             let det_tips = seg.sample_tips(&self.machine, sc.planner.trapezoids);
             let mut path_so_far = self.tips.clone();
             path_so_far.extend(det_tips.iter().skip(1));
-            let area = self.swept_area + swept_area(self.ground(), &det_tips);
+            let area = self.swept_area + swept_area(self.ground(), &det_tips); // [HE eq. 2]
             let (soil, rock) = self.counted(&path_so_far, area);
             let current = soil + rock;
             let end = *det_tips.last().expect("samples");
@@ -635,7 +666,7 @@ impl<'a> Run<'a> {
         Ok(out)
     }
 
-    /// (soil, boulders) volume [m³] of a path with eq. 2 area `area` (module docs).
+    /// (soil, boulders) volume [m³] of a path with [HE eq. 2] area `area` (module docs).
     fn counted(&self, path: &[Vec2], area: f64) -> (f64, f64) {
         let g = self.ground();
         let mut soil_area = area;
@@ -651,7 +682,7 @@ impl<'a> Run<'a> {
                 rock += e.area_m2() * self.width_m;
             }
         }
-        (soil_area * self.width_m, rock)
+        (soil_area * self.width_m, rock) // [HE eq. 2]: area × h_b
     }
 
     fn push_sample(

@@ -11,8 +11,10 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::error::{ExcavateError, Result};
-use autoshovel_core::config::{self, TomlFile};
+use autoshovel_core::config::{self, ConfigError, TomlFile};
+
+/// Name of the embedded default profile.
+pub const EXCAVATOR_15T: &str = "excavator-15t";
 
 /// The embedded default profile (15 t class backhoe).
 pub const EXCAVATOR_15T_TOML: &str = include_str!("../profiles/excavator-15t.toml");
@@ -40,7 +42,7 @@ pub struct GeometrySpec {
 pub struct BucketSpec {
     /// Heaped capacity [m³].
     pub capacity_m3: f64,
-    /// h_b: opening width across the dig plane (eq. 2) [m].
+    /// h_b: opening width across the dig plane ([HE eq. 2]) [m].
     pub width_m: f64,
 }
 
@@ -139,21 +141,14 @@ impl Default for MachineProfile {
 impl MachineProfile {
     /// The 15 t class machine (the embedded `excavator-15t.toml`).
     pub fn excavator_15t() -> Self {
-        Self::from_toml(EXCAVATOR_15T_TOML, "<builtin excavator-15t>")
+        Self::from_toml(EXCAVATOR_15T_TOML, &format!("<builtin {EXCAVATOR_15T}>"))
             .expect("the embedded profile is valid")
     }
 
     /// Check every value; `text` and `file` locate errors.
-    fn check_values(&self, text: &str, file: &str) -> Result<()> {
+    fn check_values(&self, text: &str, file: &str) -> Result<(), ConfigError> {
         let bad = |table: &str, key: &str, value: f64, expected: &str| {
-            ExcavateError::from(config::invalid(
-                text,
-                file,
-                (table, 0),
-                key,
-                value,
-                expected,
-            ))
+            config::invalid(text, file, (table, 0), key, value, expected)
         };
         let g = &self.geometry;
         let m = &self.masses;
@@ -278,9 +273,9 @@ impl MachineProfile {
 }
 
 impl TomlFile for MachineProfile {
-    type Error = ExcavateError;
+    type Error = ConfigError;
 
-    fn check(&self, text: &str, file: &str) -> Result<()> {
+    fn check(&self, text: &str, file: &str) -> Result<(), ConfigError> {
         self.check_values(text, file)
     }
 }

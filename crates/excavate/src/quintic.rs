@@ -1,4 +1,4 @@
-//! Quintic joint paths (paper eq. 1): θ(t) = a₀ + a₁t + a₂t² + a₃t³ + a₄t⁴ + a₅t⁵
+//! Quintic joint paths ([HE eq. 1]): θ(t) = a₀ + a₁t + a₂t² + a₃t³ + a₄t⁴ + a₅t⁵
 //! with the joint angle, velocity and acceleration given at both ends.
 //!
 //! The planner uses zero velocity and acceleration at both ends, for which
@@ -15,7 +15,7 @@ use crate::kinematics::Joints;
 /// Peak of ds/dτ for the zero-boundary blend.
 pub const PEAK_RATE: f64 = 15.0 / 8.0;
 
-/// One scalar quintic (eq. 1) over [0, T].
+/// One scalar quintic ([HE eq. 1]) over [0, T].
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Quintic {
     /// a₀ … a₅.
@@ -25,7 +25,7 @@ pub struct Quintic {
 }
 
 impl Quintic {
-    /// The quintic with θ, θ̇, θ̈ = `start` at t = 0 and `end` at t = T.
+    /// The quintic of [HE eq. 1] with θ, θ̇, θ̈ = `start` at t = 0 and `end` at t = T.
     pub fn new(start: [f64; 3], end: [f64; 3], duration_s: f64) -> Self {
         let t = duration_s;
         let [p0, v0, a0] = start;
@@ -37,28 +37,30 @@ impl Quintic {
             (-30.0 * h + (14.0 * v1 + 16.0 * v0) * t + (3.0 * a0 - 2.0 * a1) * t2) / (2.0 * t4);
         let a5 = (12.0 * h - 6.0 * (v1 + v0) * t - (a0 - a1) * t2) / (2.0 * t5);
         Self {
+            // a₀ … a₅ of [HE eq. 1] from the six boundary conditions.
             coeffs: [p0, v0, 0.5 * a0, a3, a4, a5],
             duration_s,
         }
     }
 
-    /// θ, θ̇, θ̈ at time t.
+    /// θ, θ̇, θ̈ at time t: [HE eq. 1] and its first two derivatives.
     pub fn eval(&self, t: f64) -> [f64; 3] {
         let a = &self.coeffs;
-        let p = a[0] + t * (a[1] + t * (a[2] + t * (a[3] + t * (a[4] + t * a[5]))));
+        let p = a[0] + t * (a[1] + t * (a[2] + t * (a[3] + t * (a[4] + t * a[5])))); // [HE eq. 1]
         let v = a[1] + t * (2.0 * a[2] + t * (3.0 * a[3] + t * (4.0 * a[4] + t * 5.0 * a[5])));
         let acc = 2.0 * a[2] + t * (6.0 * a[3] + t * (12.0 * a[4] + t * 20.0 * a[5]));
         [p, v, acc]
     }
 }
 
-/// The zero-boundary blend s(τ), ds/dτ, d²s/dτ² for τ ∈ [0, 1] (clamped).
+/// The zero-boundary blend s(τ), ds/dτ, d²s/dτ² for τ ∈ [0, 1] (clamped):
+/// [HE eq. 1] at rest at both ends, normalised.
 #[inline]
 pub fn blend(tau: f64) -> [f64; 3] {
     let t = tau.clamp(0.0, 1.0);
     let t2 = t * t;
     [
-        t2 * t * (10.0 + t * (-15.0 + 6.0 * t)),
+        t2 * t * (10.0 + t * (-15.0 + 6.0 * t)), // [HE eq. 1]: s = 10τ³ − 15τ⁴ + 6τ⁵
         30.0 * t2 * (1.0 - t) * (1.0 - t),
         60.0 * t * (1.0 - t) * (1.0 - 2.0 * t),
     ]
@@ -82,14 +84,14 @@ impl JointQuintic {
         self.q0 + (self.q1 - self.q0) * sigma
     }
 
-    /// (q, q̇, q̈) at time t ∈ [0, T].
+    /// (q, q̇, q̈) at time t ∈ [0, T]: [HE eq. 1] per joint, at rest at both ends.
     #[inline]
     pub fn state(&self, t: f64) -> (Joints, Joints, Joints) {
         let [s, ds, dds] = blend(t / self.duration_s);
         let dq = self.q1 - self.q0;
         let t_inv = 1.0 / self.duration_s;
         (
-            self.q0 + dq * s,
+            self.q0 + dq * s, // [HE eq. 1]
             dq * (ds * t_inv),
             dq * (dds * t_inv * t_inv),
         )

@@ -35,7 +35,7 @@
 //! speed_fraction = 0.5       # share of the joint speed limits a segment may use
 //! min_segment_time_s = 1.0
 //! dt_s = 0.01                # simulator step
-//! trapezoids = 100           # eq. 2 strips per planned segment
+//! trapezoids = 100           # [HE eq. 2] strips per planned segment
 //! max_contacts = 8
 //! refine_volume = false      # true: bisect inside the last step for the exact volume
 //! max_overdig_m = 0.15       # how far a level-1 path may dip below the dig depth
@@ -43,7 +43,7 @@
 //! [ground]                   # optional polyline, x increasing
 //! points = [[0.0, 0.0], [10.0, 0.0]]
 //!
-//! [[obstacle]]               # an envelope circle (eq. 10); repeat per boulder
+//! [[obstacle]]               # an envelope circle ([HE eq. 10]); repeat per boulder
 //! center_m = [6.0, -0.5]
 //! radius_m = 0.25
 //! ```
@@ -104,7 +104,7 @@ pub struct PlannerSpec {
     pub min_segment_time_s: f64,
     /// Simulator time step [s].
     pub dt_s: f64,
-    /// Trapezoids (eq. 2) per planned segment.
+    /// Trapezoids ([HE eq. 2]) per planned segment.
     pub trapezoids: usize,
     /// Most contacts handled in one pass.
     pub max_contacts: usize,
@@ -224,18 +224,17 @@ impl Scenario {
 
     fn check_values(&self, text: &str, file: &str) -> Result<()> {
         let bad = |table: &str, occurrence: usize, key: &str, value: String, expected: &str| {
-            ExcavateError::from(ConfigError::Invalid {
-                file: file.to_string(),
-                line: line_of_key(text, table, occurrence, key),
-                key: if table.is_empty() {
-                    key.to_string()
-                } else if table == "obstacle" {
-                    format!("[[obstacle]] #{} {key}", occurrence + 1)
-                } else {
-                    format!("[{table}] {key}")
-                },
-                value,
-                expected: expected.to_string(),
+            ExcavateError::from(if table == "obstacle" {
+                // An array of tables: name the entry as well as the key.
+                ConfigError::Invalid {
+                    file: file.to_string(),
+                    line: line_of_key(text, table, occurrence, key),
+                    key: format!("[[obstacle]] #{} {key}", occurrence + 1),
+                    value,
+                    expected: expected.to_string(),
+                }
+            } else {
+                config::invalid(text, file, (table, occurrence), key, value, expected)
             })
         };
         let d = &self.dig;

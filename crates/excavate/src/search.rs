@@ -32,8 +32,8 @@ use std::collections::BinaryHeap;
 use autoshovel_core::Vec2;
 use serde::Serialize;
 
-use crate::error::IkError;
 use crate::kinematics::Backhoe;
+use crate::kinematics::IkError;
 use crate::obstacle::Envelope;
 use crate::preimage::AvoidSide;
 

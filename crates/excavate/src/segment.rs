@@ -1,5 +1,5 @@
 //! Pieces of a planned bucket motion, each starting and ending at rest: a
-//! joint-space quintic (level 1, eq. 1) or a smoothed detour round a boulder
+//! joint-space quintic (level 1, [HE eq. 1]) or a smoothed detour round a boulder
 //! (level 2), and their state at any time.
 //!
 //! A detour is a clamped cubic B-spline p(u) of the tooth tip, u ∈ [0, 1],
@@ -26,6 +26,18 @@ pub enum SegmentKind {
     Rise,
     /// Level 2: round a boulder.
     Detour,
+}
+
+impl SegmentKind {
+    /// Its name in tables and summaries (`descent`, `rise`, `detour`), as
+    /// serialised.
+    pub fn name(self) -> &'static str {
+        match self {
+            SegmentKind::Descent => "descent",
+            SegmentKind::Rise => "rise",
+            SegmentKind::Detour => "detour",
+        }
+    }
 }
 
 /// The state of the front at one instant.

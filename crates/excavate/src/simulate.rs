@@ -97,7 +97,8 @@ impl SoilSim<'_> {
         }
     }
 
-    /// The earliest contact between (ta, pa) and (tb, pb).
+    /// The earliest contact between (ta, pa) and (tb, pb): the first time the
+    /// tip enters an envelope S of [HE eq. 10].
     fn first_contact(
         &self,
         segment: &Segment,
@@ -112,7 +113,8 @@ impl SoilSim<'_> {
             if known.get(i).copied().unwrap_or(false) || !e.meets_segment(pa, pb) {
                 continue;
             }
-            // A time inside the envelope: the step's end, or a sub-step.
+            // A time inside the envelope ([HE eq. 10]: the tip is in S): the
+            // step's end, or a sub-step.
             let inside = if e.contains(pb) {
                 Some(tb)
             } else {

@@ -11,7 +11,7 @@
 //!
 //! with the specific cutting resistance k [Pa], the bucket width b = h_b and
 //! the cut thickness c, here the depth of the tooth below the ground (in one
-//! pass the bucket takes the whole slice above its tip, which is eq. 2's
+//! pass the bucket takes the whole slice above its tip, which is [HE eq. 2]'s
 //! volume model). F_n pushes the tooth out of the uncut bank, towards the
 //! surface. The force does not depend on speed, so the direction of motion is
 //! the path's tangent even where the tip is at rest at a segment end.

@@ -1,4 +1,4 @@
-//! Dig volume by trapezoids (paper eq. 2): V = h_b·∫ f(x) dx ≈
+//! Dig volume by trapezoids ([HE eq. 2]): V = h_b·∫ f(x) dx ≈
 //! h_b·Σ ½(y_{i−1} + y_i)·Δx, the area between the ground line and the tooth
 //! path times the bucket width.
 //!
@@ -7,7 +7,7 @@
 //! path turns back (a joint-space quintic can bulge outwards, a detour can back
 //! off a boulder). [`swept_area`] therefore sums ½(d_{i−1} + d_i)(x_{i−1} − x_i)
 //! with the depth d = max(0, ground − y): for a path moving towards the
-//! machine (−x) this is eq. 2 exactly, and where the path doubles back the
+//! machine (−x) this is [HE eq. 2] exactly, and where the path doubles back the
 //! signed strips cancel, so the sum is the area enclosed by the path and the
 //! ground (Green's theorem). Parts of the path above the ground add nothing.
 
@@ -15,7 +15,7 @@ use autoshovel_core::Vec2;
 
 use crate::ground::Ground;
 
-/// Eq. 2 as printed: equal intervals on [a, b] with depths y₀ … yₙ, times h_b [m³].
+/// [HE eq. 2] as printed: equal intervals on [a, b] with depths y₀ … yₙ, times h_b [m³].
 pub fn trapezoid_volume(a: f64, b: f64, depths: &[f64], width_m: f64) -> f64 {
     if depths.len() < 2 {
         return 0.0;
@@ -24,31 +24,33 @@ pub fn trapezoid_volume(a: f64, b: f64, depths: &[f64], width_m: f64) -> f64 {
     let dx = (b - a) / n;
     depths
         .windows(2)
-        .map(|w| 0.5 * (w[0] + w[1]) * dx)
+        .map(|w| 0.5 * (w[0] + w[1]) * dx) // [HE eq. 2]
         .sum::<f64>()
         * width_m
 }
 
-/// Area between the ground and a sampled tip path [m²] (module docs).
+/// Area between the ground and a sampled tip path [m²]: [HE eq. 2] on
+/// time samples (module docs).
 pub fn swept_area(ground: &Ground, path: &[Vec2]) -> f64 {
     let mut area = 0.0;
     let mut prev: Option<(f64, f64)> = None;
     for p in path {
         let d = ground.depth(p.x, p.y).max(0.0);
         if let Some((x0, d0)) = prev {
-            area += 0.5 * (d0 + d) * (x0 - p.x);
+            area += 0.5 * (d0 + d) * (x0 - p.x); // [HE eq. 2]
         }
         prev = Some((p.x, d));
     }
     area
 }
 
-/// The strip of one more sample appended to a path: ½(d_prev + d)(x_prev − x) [m²].
+/// The strip of one more sample appended to a path: ½(d_prev + d)(x_prev − x),
+/// one trapezoid of [HE eq. 2] [m²].
 #[inline]
 pub fn strip(ground: &Ground, prev: Vec2, next: Vec2) -> f64 {
     let d0 = ground.depth(prev.x, prev.y).max(0.0);
     let d1 = ground.depth(next.x, next.y).max(0.0);
-    0.5 * (d0 + d1) * (prev.x - next.x)
+    0.5 * (d0 + d1) * (prev.x - next.x) // [HE eq. 2]
 }
 
 /// Area of the part of a disc below the ground [m²]: Simpson over
