@@ -49,24 +49,6 @@ impl CrawlerParams {
     pub fn max_track_speed_mps(&self) -> f64 {
         self.motor_max_rpm * self.mps_per_rpm()
     }
-
-    /// Checks the parameters; names the first impossible one.
-    pub fn validate(&self) -> Result<(), (&'static str, f64)> {
-        for (name, v) in [
-            ("gauge_m", self.gauge_m),
-            ("sprocket_radius_m", self.sprocket_radius_m),
-            ("gear_ratio", self.gear_ratio),
-            ("motor_max_rpm", self.motor_max_rpm),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err((name, v));
-            }
-        }
-        if !(self.motor_max_accel_rpm_per_s.is_finite() && self.motor_max_accel_rpm_per_s >= 0.0) {
-            return Err(("motor_max_accel_rpm_per_s", self.motor_max_accel_rpm_per_s));
-        }
-        Ok(())
-    }
 }
 
 /// Ground interaction (all zero = ideal tracks).
@@ -105,19 +87,6 @@ impl SlipParams {
             right: 0.07,
             lateral_gain_s: 0.05,
         }
-    }
-
-    /// Checks ranges.
-    pub fn validate(&self) -> Result<(), (&'static str, f64)> {
-        for (name, v) in [("left", self.left), ("right", self.right)] {
-            if !(v.is_finite() && (0.0..0.9).contains(&v)) {
-                return Err((name, v));
-            }
-        }
-        if !(self.lateral_gain_s.is_finite() && self.lateral_gain_s >= 0.0) {
-            return Err(("lateral_gain_s", self.lateral_gain_s));
-        }
-        Ok(())
     }
 }
 

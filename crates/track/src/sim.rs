@@ -108,6 +108,17 @@ pub struct Event {
     pub message: String,
 }
 
+impl Event {
+    /// Kind of the event that closes each leg normally.
+    pub const LEG_END: &'static str = "leg-end";
+
+    /// Whether the safety layer or the runner intervened (every event but
+    /// the normal end of a leg).
+    pub fn is_safety(&self) -> bool {
+        self.kind != Self::LEG_END
+    }
+}
+
 /// Measures of a run (SPEC §3, §6).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Metrics {
@@ -322,7 +333,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
             {
                 events.push(Event {
                     t_s: t,
-                    kind: "leg-end",
+                    kind: Event::LEG_END,
                     message: format!("leg {li} ({}) done, machine at rest", leg.direction.name()),
                 });
                 break;
