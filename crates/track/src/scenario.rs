@@ -594,3 +594,39 @@ fn apply_noise(setup: &mut Setup, noise: Noise, seed: u64) {
         }
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "speed_mps = 0.5\n[start]\nx_m = 0.0\ny_m = 0.3\nheading_deg = 0.0\n\
+        [[leg]]\ndirection = \"forward\"\npoints_m = [[0.0, 0.0], [10.0, 0.0]]\n\
+        [controller.fuzzy]\nk1 = 1.5\n";
+
+    #[test]
+    fn gains_load_with_defaults_beside_them_and_round_trip() {
+        let f = ScenarioFile::from_toml(TEXT, "t.toml").unwrap();
+        assert_eq!(f.controller.fuzzy.k1, 1.5);
+        assert_eq!(
+            f.controller.fuzzy.k2,
+            crate::FuzzyParams::default().k2,
+            "unset gains keep their defaults"
+        );
+        assert_eq!(f.controller.pid, crate::PidParams::default());
+        let back = ScenarioFile::from_toml(&f.to_toml(), "t.toml").unwrap();
+        assert_eq!(f, back);
+        let s = f.into_scenario(TEXT, "t.toml", None, 1).unwrap();
+        assert_eq!(s.controllers.fuzzy.k1, 1.5);
+        assert_eq!(s.name, "t.toml");
+    }
+
+    #[test]
+    fn a_bad_gain_names_its_table_key_and_line() {
+        let text = TEXT.replace("k1 = 1.5", "k1 = 0.0");
+        let e = ScenarioFile::from_toml(&text, "t.toml").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.toml:10: [controller.fuzzy] k1 = 0 is invalid: expected a finite value > 0"
+        );
+    }
+}
