@@ -1,5 +1,5 @@
 //! Figures and tables of the `track` job, built from
-//! [`Tracking`](autoshovel_track::Tracking): the reference and actual paths
+//! [`Tracking`]: the reference and actual paths
 //! on the site, deviation and heading error against time, each run's samples
 //! (`track.csv`, or `track_<controller>.csv` with `--compare`), the
 //! comparison table (`compare.csv`) and, when the fuzzy tracker ran, the

@@ -108,7 +108,8 @@ impl ControllerKind {
 }
 
 /// PID on the lateral error e = d + α·d0 [W eq. 23], the paper's baseline of
-/// §5.4 (kp 800, ki 100, kd 300), with anti-windup by clamping the integral
+/// §5.4 (kp 800, ki 100, kd 300) in the parallel form of [W eq. 25]
+/// (kp = K_P, ki = K_P/T_i, kd = K_P·T_d), with anti-windup by clamping the integral
 /// term and not integrating while the output saturates.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -186,6 +187,7 @@ impl Controller for Pid {
             let cap = 0.5 * p.max_steer_rpm / p.ki;
             self.integral = self.integral.clamp(-cap, cap);
         }
+        // u = kp·e + ki·∫e dt + kd·de/dt [W eq. 25]
         let u =
             (p.kp * e + p.ki * self.integral + p.kd * de).clamp(-p.max_steer_rpm, p.max_steer_rpm);
         // e > 0: left of the path → turn right → n_r < n_l.
