@@ -89,7 +89,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         ),
     ];
     for (name, compare, description) in track_runs {
-        let ctl = crate::track::ControllerArg::Fuzzy;
+        let ctl = autoshovel_track::ControllerKind::Fuzzy;
         let scenario = autoshovel_track::scenario::resolve(name, None, 1)?;
         let key = if compare {
             format!("track {name} --compare")
@@ -104,26 +104,26 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let dir = prepare_dir(&out.join(&sub))?;
         let job = crate::track::job(&scenario, ctl, compare, Some(&dir))?;
         if !json_only {
-            let s = &job.summary;
-            let g = |k: &str| s[k].as_f64().unwrap_or(f64::NAN);
+            let m = &job.summary.run.metrics;
             crate::say!(
                 "{key:40} {}: max dev {:.3} m, mean {:.3} m, reached after {:.2} m, final heading error {:.2} deg",
-                if job.error.is_none() { "ok" } else { "FAILED" },
-                g("max_centroid_dev_m"),
-                g("mean_centroid_dev_m"),
-                g("reached_distance_m"),
-                g("final_heading_error_deg")
+                if job.summary.success { "ok" } else { "FAILED" },
+                m.max_centroid_dev_m,
+                m.mean_centroid_dev_m,
+                m.reached_distance_m,
+                m.final_heading_error_deg
             );
         }
+        let summary = job.json()?;
         sections.push(section(
             &key,
             description,
-            &job.summary,
+            &summary,
             &sub,
             &job.written.plots,
             &job.written.files,
         ));
-        summaries.insert(key, job.summary);
+        summaries.insert(key, summary);
     }
     // Perception: a synthetic scan of each pile shape, levelled, filtered and fitted.
     for shape in [

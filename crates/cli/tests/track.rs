@@ -163,3 +163,77 @@ fn bad_tracking_input_is_refused_clearly() {
     let r = run(&["track", "--scenario", "nosuch"]).fails();
     assert!(r.error_message().contains("fig9a"), "{}", r.error_message());
 }
+
+#[test]
+fn scenario_gains_change_the_run_and_the_summary_reports_them() {
+    let (_d, plain) = track_file(GOOD);
+    let args = |p: &std::path::Path| -> Vec<std::ffi::OsString> {
+        ["track", "--scenario"]
+            .iter()
+            .map(Into::into)
+            .chain([
+                p.as_os_str().to_owned(),
+                "--compare".into(),
+                "--json".into(),
+            ])
+            .collect()
+    };
+    let base = run(&args(&plain)).ok().json();
+    assert_eq!(base["gains"]["k1"], 2.42, "{base:#}");
+    assert_eq!(base["params"]["pid"]["kp"], 800.0);
+    let tuned = format!(
+        "{GOOD}[controller.fuzzy]\nk1 = 1.2\n[controller.pid]\nkp = 400.0\n\
+         [controller.pure_pursuit]\nlookahead_m = 3.0\n"
+    );
+    let (_d2, p) = track_file(&tuned);
+    let s = run(&args(&p)).ok().json();
+    // The summary reports the gains each controller ran with, the others at
+    // their defaults.
+    assert_eq!(s["gains"]["k1"], 1.2, "{s:#}");
+    assert_eq!(s["gains"]["k2"], 32.1);
+    assert_eq!(s["params"]["fuzzy"]["k1"], 1.2);
+    assert_eq!(s["params"]["pid"]["kp"], 400.0);
+    assert_eq!(s["params"]["pure_pursuit"]["lookahead_m"], 3.0);
+    let rows = s["compare"].as_array().expect("compare rows");
+    assert_eq!(rows[0]["gains"]["k1"], 1.2);
+    assert_eq!(rows[1]["gains"]["kp"], 400.0);
+    assert_eq!(rows[1]["gains"]["ki"], 100.0);
+    assert_eq!(rows[2]["gains"]["lookahead_m"], 3.0);
+    // ... and every controller's run changes with its gains.
+    let before = base["compare"].as_array().expect("compare rows");
+    for (i, (a, b)) in before.iter().zip(rows).enumerate() {
+        assert_ne!(
+            a["mean_centroid_dev_overall_m"], b["mean_centroid_dev_overall_m"],
+            "row {i}: {a:#} vs {b:#}"
+        );
+    }
+}
+
+#[test]
+fn a_bad_gain_is_refused_naming_its_key_and_line() {
+    for (table, key, value, line) in [
+        ("fuzzy", "k2", "-1.0", 12),
+        ("pid", "kd", "nan", 12),
+        ("pure_pursuit", "max_steer_rpm", "0.0", 12),
+    ] {
+        let text = format!("{GOOD}[controller.{table}]\nalpha_or_other = 1\n");
+        // An unknown key is refused with its line too.
+        let (_d, p) = track_file(&text);
+        let r = run(&["track".as_ref(), "--scenario".as_ref(), p.as_os_str()]).fails();
+        assert!(
+            r.error_message().contains("run.toml:12")
+                && r.error_message().contains("alpha_or_other"),
+            "{}",
+            r.error_message()
+        );
+        let text = format!("{GOOD}[controller.{table}]\n{key} = {value}\n");
+        let (_d, p) = track_file(&text);
+        let r = run(&["track".as_ref(), "--scenario".as_ref(), p.as_os_str()]).fails();
+        let msg = r.error_message();
+        assert!(
+            msg.contains(&format!("run.toml:{line}"))
+                && msg.contains(&format!("[controller.{table}] {key}")),
+            "{table} {key}: {msg}"
+        );
+    }
+}

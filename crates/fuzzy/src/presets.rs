@@ -25,20 +25,23 @@ pub mod shovel_table1 {
         ["ZE", "PS", "PS", "PM", "PM", "PB", "PB"],
     ];
 
-    /// Universe of e, ±this [m].
+    /// Universe of e, ±this [m]: the fuzzy universe [−σ1, σ1] of [W eq. 24]
+    /// (the tracker maps e into it with k1).
     pub const E_MAX: f64 = 0.45;
-    /// Universe of ec, ±this.
+    /// Universe of ec, ±this: [−σ2, σ2] of [W eq. 24].
     pub const EC_MAX: f64 = 30.0;
-    /// Universe of u, ±this [rpm].
+    /// Universe of u, ±this [rpm]: [−σ3, σ3] of [W eq. 24].
     pub const U_MAX: f64 = 2700.0;
 
-    /// The system (inputs [e, ec], output u) at the default output resolution.
+    /// The system (inputs [e, ec], output u) at the default output
+    /// resolution, on the fuzzy universes of [W eq. 24].
     pub fn system() -> Result<MamdaniSystem, FuzzyError> {
         system_with_resolution(DEFAULT_RESOLUTION)
     }
 
     /// The system with `resolution` output samples.
     pub fn system_with_resolution(resolution: usize) -> Result<MamdaniSystem, FuzzyError> {
+        // The fuzzy universes [−σ1, σ1], [−σ2, σ2], [−σ3, σ3] [W eq. 24].
         let e = Variable::evenly_spaced_triangles("e", -E_MAX, E_MAX, &TERMS)?;
         let ec = Variable::evenly_spaced_triangles("ec", -EC_MAX, EC_MAX, &TERMS)?;
         let u = Variable::evenly_spaced_triangles("u", -U_MAX, U_MAX, &TERMS)?;

@@ -1,5 +1,8 @@
-//! The tracker seam: a controller turns the deviations of eqs. 21–22 into the
-//! speed difference between the right and left track motors.
+//! The tracker seam: a controller turns the deviations of [W eq. 21]–[W eq. 22]
+//! into the speed difference between the right and left track motors; the
+//! choice of controller ([`ControllerKind`]) and the gains of every
+//! controller ([`ControllerParams`], the `[controller.*]` tables of a
+//! tracking scenario).
 //!
 //! Sign convention (SPEC §3): deviations are positive left of the path, and
 //! every controller returns `steer_rpm` = n_right − n_left, positive turning
@@ -10,6 +13,9 @@
 
 use autoshovel_core::Pose2;
 
+use serde::{Deserialize, Serialize};
+
+use crate::fuzzy_tracker::{FuzzyParams, FuzzyTracker};
 use crate::geometry::{Deviations, RefLeg};
 use crate::plant::CrawlerParams;
 
@@ -38,10 +44,72 @@ pub trait Controller {
     fn reset(&mut self);
     /// Speed difference n_right − n_left [rpm]; positive turns left.
     fn step(&mut self, input: &ControlInput) -> f64;
+    /// The gains this controller runs with.
+    fn gains(&self) -> Gains;
 }
 
-/// PID on the lateral error e = d + α·d0 (eq. 23), the paper's baseline of
-/// §5.4 (kp 800, ki 100, kd 300), with anti-windup by clamping the integral
+/// The gains of one controller, as it reports them (serialised as the
+/// parameter struct itself).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+#[serde(untagged)]
+pub enum Gains {
+    /// The fuzzy tracker's.
+    Fuzzy(FuzzyParams),
+    /// The PID's.
+    Pid(PidParams),
+    /// Pure pursuit's.
+    PurePursuit(PurePursuitParams),
+}
+
+/// The gains of every controller: the `[controller.fuzzy]`,
+/// `[controller.pid]` and `[controller.pure_pursuit]` tables of a tracking
+/// scenario; each field defaults to today's value.
+#[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct ControllerParams {
+    /// The fuzzy tracker (§4.3).
+    pub fuzzy: FuzzyParams,
+    /// The PID baseline (§5.4).
+    pub pid: PidParams,
+    /// Pure pursuit.
+    pub pure_pursuit: PurePursuitParams,
+}
+
+/// Which controller tracks the path.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum ControllerKind {
+    /// The fuzzy tracker on preview and centroid deviation (§4.3, Table 1).
+    Fuzzy,
+    /// PID on the lateral error (§5.4).
+    Pid,
+    /// Pure pursuit (geometric), forward and reverse.
+    PurePursuit,
+}
+
+impl ControllerKind {
+    /// Every controller, in report order.
+    pub const ALL: [ControllerKind; 3] = [
+        ControllerKind::Fuzzy,
+        ControllerKind::Pid,
+        ControllerKind::PurePursuit,
+    ];
+
+    /// A fresh controller of this kind with its gains from `params`.
+    pub fn build(self, params: &ControllerParams) -> Box<dyn Controller> {
+        match self {
+            ControllerKind::Fuzzy => Box::new(FuzzyTracker::new(params.fuzzy)),
+            ControllerKind::Pid => Box::new(Pid::new(params.pid)),
+            ControllerKind::PurePursuit => Box::new(PurePursuit {
+                params: params.pure_pursuit,
+            }),
+        }
+    }
+}
+
+/// PID on the lateral error e = d + α·d0 [W eq. 23], the paper's baseline of
+/// §5.4 (kp 800, ki 100, kd 300) in the parallel form of [W eq. 25]
+/// (kp = K_P, ki = K_P/T_i, kd = K_P·T_d), with anti-windup by clamping the integral
 /// term and not integrating while the output saturates.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -52,7 +120,7 @@ pub struct PidParams {
     pub ki: f64,
     /// Derivative gain [rpm·s/m].
     pub kd: f64,
-    /// Weight α of the centroid deviation in e (eq. 23).
+    /// Weight α of the centroid deviation in e [W eq. 23].
     pub alpha: f64,
     /// Output limit [rpm].
     pub max_steer_rpm: f64,
@@ -100,8 +168,13 @@ impl Controller for Pid {
         self.prev_e = None;
     }
 
+    fn gains(&self) -> Gains {
+        Gains::Pid(self.params)
+    }
+
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
+        // e = d + α·d0 [W eq. 23]
         let e = input.dev.d_m + p.alpha * input.dev.d0_m;
         let de = match self.prev_e {
             Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
@@ -114,6 +187,7 @@ impl Controller for Pid {
             let cap = 0.5 * p.max_steer_rpm / p.ki;
             self.integral = self.integral.clamp(-cap, cap);
         }
+        // u = kp·e + ki·∫e dt + kd·de/dt [W eq. 25]
         let u =
             (p.kp * e + p.ki * self.integral + p.kd * de).clamp(-p.max_steer_rpm, p.max_steer_rpm);
         // e > 0: left of the path → turn right → n_r < n_l.
@@ -158,6 +232,10 @@ impl Controller for PurePursuit {
     }
 
     fn reset(&mut self) {}
+
+    fn gains(&self) -> Gains {
+        Gains::PurePursuit(self.params)
+    }
 
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;

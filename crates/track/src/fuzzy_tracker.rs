@@ -1,10 +1,10 @@
 //! The fuzzy tracker of the electric-shovel paper §4.3: inputs the lateral
-//! error e = d + α·d0 (eq. 23) and its rate ec, output the speed difference u
+//! error e = d + α·d0 [W eq. 23] and its rate ec, output the speed difference u
 //! between the track motors; seven evenly spaced triangular terms
 //! NB…PB on e ∈ [−0.45, 0.45], ec ∈ [−30, 30], u ∈ [−2700, 2700] rpm;
 //! Mamdani min / max / centroid; the rule base of Table 1 (rows ec, columns e).
 //!
-//! Variable universe (eq. 24): the controller maps the physical inputs into
+//! Variable universe [W eq. 24]: the controller maps the physical inputs into
 //! the fuzzy universes with scaling factors, e_f = k1·e, ec_f = k2·ec, and the
 //! output back with u = k3·u_f. Values beyond a universe saturate at its edge.
 //!
@@ -15,7 +15,7 @@
 use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, Scratch};
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{ControlInput, Controller};
+use crate::controller::{ControlInput, Controller, Gains};
 
 pub use autoshovel_fuzzy::presets::shovel_table1::{TABLE1, TERMS};
 
@@ -28,13 +28,13 @@ pub fn table1_system() -> Result<MamdaniSystem, FuzzyError> {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FuzzyParams {
-    /// Weight α of the centroid deviation in e (eq. 23).
+    /// Weight α of the centroid deviation in e [W eq. 23].
     pub alpha: f64,
-    /// Scaling factor k1 of e (eq. 24) [1/m]: e_f = k1·e.
+    /// Scaling factor k1 of e [W eq. 24] [1/m]: e_f = k1·e.
     pub k1: f64,
-    /// Scaling factor k2 of ec (eq. 24) [s/m]: ec_f = k2·ec.
+    /// Scaling factor k2 of ec [W eq. 24] [s/m]: ec_f = k2·ec.
     pub k2: f64,
-    /// Scaling factor k3 of u (eq. 24): u = k3·u_f.
+    /// Scaling factor k3 of u [W eq. 24]: u = k3·u_f.
     pub k3: f64,
     /// Time constant of the first-order low-pass on ec [s] (0 = none): the
     /// rate of a centimetre-noisy RTK error at 10 Hz is mostly noise.
@@ -100,8 +100,16 @@ impl Controller for FuzzyTracker {
         self.ec_filtered = 0.0;
     }
 
+    fn gains(&self) -> Gains {
+        Gains::Fuzzy(self.params)
+    }
+
+    /// One tick: e = d + α·d0 [W eq. 23], its filtered rate ec, the
+    /// variable universe e_f = k1·e, ec_f = k2·ec, u = k3·u_f [W eq. 24],
+    /// and Table 1's Mamdani inference.
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
+        // e = d + α·d0 [W eq. 23]
         let e = input.dev.d_m + p.alpha * input.dev.d0_m;
         let raw = match self.prev_e {
             Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
@@ -115,6 +123,7 @@ impl Controller for FuzzyTracker {
         };
         self.ec_filtered += a * (raw - self.ec_filtered);
         let ec = self.ec_filtered;
+        // e_f = k1·e, ec_f = k2·ec [W eq. 24]
         let x = [p.k1 * e, p.k2 * ec];
         let u_f = if x.iter().all(|v| v.is_finite()) {
             self.system.infer_with(&x, &mut self.scratch).unwrap_or(0.0)
@@ -122,6 +131,7 @@ impl Controller for FuzzyTracker {
             0.0
         };
         self.last = (x[0], x[1], u_f);
+        // u = k3·u_f [W eq. 24]; n_r − n_l = −u
         -(p.k3 * u_f)
     }
 }

@@ -1,4 +1,4 @@
-//! Tracking geometry (electric-shovel paper eqs. 21–22): the preview point C
+//! Tracking geometry (electric-shovel paper [W eq. 21]–[W eq. 22]): the preview point C
 //! at distance L ahead of the centroid O in the direction of motion, A the
 //! path point nearest O, B the path point nearest C, the preview deviation d
 //! (distance of C from the line AB) and the centroid deviation d0 = |O − A|.
@@ -7,7 +7,7 @@
 //! lies left of the path (seen in the direction of travel): the paper's
 //! absolute values cannot tell which way to steer. On a reverse leg "ahead"
 //! is behind the machine, so C lies behind it, and left is the left of the
-//! motion. Eq. 21 writes C with the north-clockwise RTK heading ϕ; here the
+//! motion. [W eq. 21] writes C with the north-clockwise RTK heading ϕ; here the
 //! pose is already in the library's frame (θ = π/2 − ϕ converted at the sensor).
 
 use autoshovel_core::{arc_lengths, heading_vec, segment_nearest, Pose2, Vec2};
@@ -133,7 +133,7 @@ impl RefLeg {
     }
 }
 
-/// The deviations of eqs. 21–22 (signed, left positive).
+/// The deviations of [W eq. 21]–[W eq. 22] (signed, left positive).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Deviations {
     /// Preview deviation d: signed distance of C from the line AB [m].
@@ -162,10 +162,14 @@ pub const SEARCH_BACK_M: f64 = 2.0;
 pub const SEARCH_AHEAD_M: f64 = 10.0;
 
 /// Deviations of `pose` (centroid, crawler heading) from `leg` with preview
-/// distance `preview_m`. `s_hint` is the previous A's arc length (None: search the whole leg).
+/// distance `preview_m`: the preview point C = O + L·(direction of motion)
+/// [W eq. 21], the preview deviation d and the centroid deviation d0
+/// [W eq. 22], both signed. `s_hint` is the previous A's arc length (None:
+/// search the whole leg).
 pub fn deviations(leg: &RefLeg, pose: Pose2, preview_m: f64, s_hint: Option<f64>) -> Deviations {
     let o = pose.position();
     let motion = heading_vec(leg.direction.motion_heading(pose.theta));
+    // C = O + L·(direction of motion) [W eq. 21]
     let c = o + motion * preview_m;
     let (lo, hi) = match s_hint {
         Some(s) => (s - SEARCH_BACK_M, s + SEARCH_AHEAD_M),
@@ -180,8 +184,10 @@ pub fn deviations(leg: &RefLeg, pose: Pose2, preview_m: f64, s_hint: Option<f64>
         let (end, t_end) = leg.point_at(leg.length_m());
         b = end + t_end * (c - end).dot(&t_end).max(0.0);
     }
+    // d0 = |O − A|, signed [W eq. 22]
     let d0 = cross(t_a, o - a).signum() * (o - a).norm();
     let ab = b - a;
+    // d = ((B − A) × (C − A)) / |B − A|, signed [W eq. 22]
     let d = if ab.norm() > 1e-9 {
         cross(ab, c - a) / ab.norm()
     } else {

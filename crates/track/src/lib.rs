@@ -1,23 +1,34 @@
-//! Crawler trajectory tracking (SPEC §3; electric-shovel paper §4–5): the
-//! crawler plant with slip and motor limits, RTK sensing with noise, offset
-//! and dropouts, the tracking geometry of eqs. 21–22 with signed deviations,
-//! the fuzzy tracker of §4.3 with PID and pure pursuit beside it, and the
-//! closed-loop runner with a safety layer and metrics.
+//! Crawler trajectory tracking (SPEC §3; electric-shovel walking paper §4–5):
+//! the crawler plant with slip and motor limits ([W eq. 16]–[W eq. 20]), RTK
+//! sensing with noise, offset and dropouts, the tracking geometry of
+//! [W eq. 21]–[W eq. 22] with signed deviations, the fuzzy tracker of §4.3
+//! ([W eq. 23], [W eq. 24], Table 1) with PID and pure pursuit beside it, the
+//! closed-loop runner with a safety layer and metrics, tracking scenarios
+//! and the `track` job's typed summary.
 
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod controller;
+pub mod error;
 pub mod fuzzy_tracker;
 pub mod geometry;
+pub mod job;
 pub mod plant;
 pub mod scenario;
 pub mod sensor;
 pub mod sim;
 
-pub use controller::{ControlInput, Controller, Pid, PidParams, PurePursuit, PurePursuitParams};
+pub use autoshovel_core::config::TomlFile;
+pub use controller::{
+    ControlInput, Controller, ControllerKind, ControllerParams, Gains, Pid, PidParams, PurePursuit,
+    PurePursuitParams,
+};
+pub use error::TrackError;
 pub use fuzzy_tracker::{FuzzyParams, FuzzyTracker};
-pub use geometry::{deviations, Deviations, RefLeg};
+pub use geometry::{deviations, Deviations, PathFault, RefLeg};
+pub use job::{track, ControllerRun, RunSummary, TrackParams, TrackSummary, Tracking};
 pub use plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
+pub use scenario::{Noise, ScenarioFile, TrackScenario};
 pub use sensor::{Rtk, RtkFix, RtkParams};
 pub use sim::{simulate, Metrics, Run, Setup, SimParams};

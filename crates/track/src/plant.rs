@@ -1,12 +1,13 @@
 //! The crawler plant: differential-drive kinematics of the electric-shovel
-//! paper (eqs. 16–20: v_c = (v_r + v_l)/2, θ̇ = (v_r − v_l)/B, which eq. 18
-//! prints as (v_r + v_l)/2R) driven by two track motors, with the realism the
+//! paper ([W eq. 16]–[W eq. 20]: v_c = (v_r + v_l)/2 [W eq. 17],
+//! θ̇ = (v_r − v_l)/B, which [W eq. 18] prints as (v_r + v_l)/2R) driven by two track motors, with the realism the
 //! paper's experiment had and a simulation must offer (SPEC §3), each
 //! switchable: motor speed and acceleration limits, per-track longitudinal
 //! slip, lateral (skid) slip in turns.
 //!
 //! Motor speed n [rpm] → track speed v = n·2π·r_s/(60·i) (SPEC §3). Each step
-//! integrates the exact circular arc of constant v_c and θ̇ over `dt`.
+//! integrates the exact circular arc of constant v_c and θ̇ over `dt`
+//! ([W eq. 19], the integral of [W eq. 18] / [W eq. 20], in closed form).
 
 use autoshovel_core::{wrap_angle, Pose2};
 use serde::{Deserialize, Serialize};
@@ -49,24 +50,6 @@ impl CrawlerParams {
     pub fn max_track_speed_mps(&self) -> f64 {
         self.motor_max_rpm * self.mps_per_rpm()
     }
-
-    /// Checks the parameters; names the first impossible one.
-    pub fn validate(&self) -> Result<(), (&'static str, f64)> {
-        for (name, v) in [
-            ("gauge_m", self.gauge_m),
-            ("sprocket_radius_m", self.sprocket_radius_m),
-            ("gear_ratio", self.gear_ratio),
-            ("motor_max_rpm", self.motor_max_rpm),
-        ] {
-            if !(v.is_finite() && v > 0.0) {
-                return Err((name, v));
-            }
-        }
-        if !(self.motor_max_accel_rpm_per_s.is_finite() && self.motor_max_accel_rpm_per_s >= 0.0) {
-            return Err(("motor_max_accel_rpm_per_s", self.motor_max_accel_rpm_per_s));
-        }
-        Ok(())
-    }
 }
 
 /// Ground interaction (all zero = ideal tracks).
@@ -105,19 +88,6 @@ impl SlipParams {
             right: 0.07,
             lateral_gain_s: 0.05,
         }
-    }
-
-    /// Checks ranges.
-    pub fn validate(&self) -> Result<(), (&'static str, f64)> {
-        for (name, v) in [("left", self.left), ("right", self.right)] {
-            if !(v.is_finite() && (0.0..0.9).contains(&v)) {
-                return Err((name, v));
-            }
-        }
-        if !(self.lateral_gain_s.is_finite() && self.lateral_gain_s >= 0.0) {
-            return Err(("lateral_gain_s", self.lateral_gain_s));
-        }
-        Ok(())
     }
 }
 
@@ -204,7 +174,9 @@ impl Crawler {
     }
 
     /// Advances by `dt_s`: motors move towards the (saturated) command within
-    /// their acceleration limit, then the pose follows the exact arc.
+    /// their acceleration limit, then the pose follows the exact arc of
+    /// v_c = (v_r + v_l)/2 [W eq. 17] and θ̇ = (v_r − v_l)/B [W eq. 18],
+    /// integrated in closed form [W eq. 19].
     pub fn step(&mut self, cmd: TrackCommand, dt_s: f64) {
         let p = &self.params;
         let cmd = cmd.saturate(p.motor_max_rpm);
@@ -222,9 +194,12 @@ impl Crawler {
         let k = p.mps_per_rpm();
         let vl = s.left_rpm * k * (1.0 - self.slip.left);
         let vr = s.right_rpm * k * (1.0 - self.slip.right);
+        // v_c = (v_r + v_l)/2 [W eq. 17]
         let v = 0.5 * (vr + vl);
+        // θ̇ = (v_r − v_l)/B [W eq. 18] (printed there as (v_r + v_l)/2R)
         let w = (vr - vl) / p.gauge_m;
         let th = s.pose.theta;
+        // x = ∫ v_c cos θ dt, y = ∫ v_c sin θ dt over the arc [W eq. 19]
         let (dx, dy) = if (w * dt_s).abs() < 1e-9 {
             (v * dt_s * th.cos(), v * dt_s * th.sin())
         } else {
@@ -273,7 +248,7 @@ mod tests {
 
     #[test]
     fn unequal_tracks_drive_a_circle_of_the_closed_form_radius() {
-        // R = B(v_r + v_l) / (2(v_r − v_l)) (eq. 17); a full turn returns to the start.
+        // R = B(v_r + v_l) / (2(v_r − v_l)) [W eq. 17]; a full turn returns to the start.
         let p = CrawlerParams {
             motor_max_accel_rpm_per_s: 0.0,
             ..Default::default()

@@ -23,12 +23,35 @@
 //! [slip]                        # SlipParams fields
 //! [rtk]                         # RtkParams fields
 //! [sim]                         # SimParams fields
+//! [controller.fuzzy]            # FuzzyParams: the fuzzy tracker's gains
+//! alpha = 0.30                  # weight of d0 in e = d + α·d0 [W eq. 23], >= 0
+//! k1 = 2.42                     # e_f = k1·e [W eq. 24] [1/m], > 0
+//! k2 = 32.1                     # ec_f = k2·ec [W eq. 24] [s/m], > 0
+//! k3 = 1.11                     # u = k3·u_f [W eq. 24], > 0
+//! ec_filter_s = 0.34            # low-pass time constant on ec [s], >= 0 (0 = none)
+//! [controller.pid]              # PidParams: the PID baseline (§5.4)
+//! kp = 800.0                    # [rpm/m], >= 0
+//! ki = 100.0                    # [rpm/(m·s)], >= 0
+//! kd = 300.0                    # [rpm·s/m], >= 0
+//! alpha = 0.5                   # weight of d0 in e [W eq. 23], >= 0
+//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! [controller.pure_pursuit]     # PurePursuitParams
+//! lookahead_m = 1.5             # look-ahead at standstill [m], > 0
+//! lookahead_gain_s = 1.0        # growth of the look-ahead with speed [s], >= 0
+//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
 //! ```
+//!
+//! Every field of the `[controller.*]` tables is optional; the values shown
+//! are the defaults ([`ControllerParams::default`]). A value out of range is
+//! refused with the file, line and key at fault.
 
+use autoshovel_core::config::{self, line_of_key, TomlFile};
 use autoshovel_core::{rad, Pose2, Vec2};
 use autoshovel_propel::{plan_path, Direction, FieldKind, PlanOptions, Scenario as TravelScenario};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 
+use crate::controller::ControllerParams;
+use crate::error::TrackError;
 use crate::geometry::RefLeg;
 use crate::plant::{CrawlerParams, SlipParams};
 use crate::sensor::RtkParams;
@@ -38,13 +61,23 @@ use crate::sim::{Setup, SimParams};
 pub const BUILTINS: &[&str] = &["fig9a", "fig9b", "straight", "curve", "v-shape"];
 
 /// Whether a run has sensor noise and slip.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum Noise {
     /// Exact fixes, ideal tracks.
     Off,
     /// RTK noise (Table 2-like) and loose-bench slip.
     Rtk,
+}
+
+impl Noise {
+    /// The setting's name, as in a scenario file and the summary.
+    pub fn name(self) -> &'static str {
+        match self {
+            Noise::Off => "off",
+            Noise::Rtk => "rtk",
+        }
+    }
 }
 
 /// A named tracking setup.
@@ -58,56 +91,8 @@ pub struct TrackScenario {
     pub noise: Noise,
     /// The site, when the path was planned on one (for plots).
     pub map: Option<autoshovel_propel::Map>,
-}
-
-/// Errors of tracking scenarios.
-#[derive(Debug, thiserror::Error)]
-#[non_exhaustive]
-pub enum ScenarioError {
-    /// Unknown name and no such file.
-    #[error("unknown tracking scenario '{name}': not a built-in ({known}) and no such file")]
-    Unknown {
-        /// What was given.
-        name: String,
-        /// The built-ins.
-        known: String,
-    },
-    /// The file could not be read.
-    #[error("cannot read {path}")]
-    Io {
-        /// The file.
-        path: String,
-        /// The cause.
-        source: std::io::Error,
-    },
-    /// TOML syntax or a wrong field.
-    #[error("{file}:{line}:{column}: {message}")]
-    Parse {
-        /// File.
-        file: String,
-        /// Line.
-        line: usize,
-        /// Column.
-        column: usize,
-        /// What.
-        message: String,
-    },
-    /// A value out of range.
-    #[error("{file}: {what}")]
-    Invalid {
-        /// File.
-        file: String,
-        /// What, naming the value.
-        what: String,
-    },
-    /// Planning the travel scenario failed.
-    #[error("{file}: planning the path failed: {source}")]
-    Plan {
-        /// File.
-        file: String,
-        /// The planner's error.
-        source: autoshovel_propel::PropelError,
-    },
+    /// The gains of every controller.
+    pub controllers: ControllerParams,
 }
 
 /// Farthest the start may be from the first leg [m].
@@ -129,15 +114,9 @@ pub fn resolve(
     name_or_path: &str,
     noise: Option<Noise>,
     seed: u64,
-) -> Result<TrackScenario, ScenarioError> {
+) -> Result<TrackScenario, TrackError> {
     let with = |noise: Noise, mut setup: Setup| {
-        if noise == Noise::Rtk {
-            setup.rtk = RtkParams::rtk(seed);
-            setup.slip = SlipParams::loose_bench();
-        } else {
-            setup.rtk = RtkParams::ideal();
-            setup.slip = SlipParams::none();
-        }
+        apply_noise(&mut setup, noise, seed);
         setup
     };
     match name_or_path {
@@ -164,6 +143,7 @@ pub fn resolve(
                 setup: with(noise, setup),
                 noise,
                 map: None,
+                controllers: ControllerParams::default(),
             })
         }
         "straight" | "curve" | "v-shape" => {
@@ -175,41 +155,40 @@ pub fn resolve(
                 setup: with(noise, setup),
                 noise,
                 map: Some(travel.map),
+                controllers: ControllerParams::default(),
             })
         }
         path => {
             let p = std::path::Path::new(path);
             if !p.exists() {
-                return Err(ScenarioError::Unknown {
+                return Err(TrackError::UnknownScenario {
                     name: path.to_string(),
                     known: BUILTINS.join(", "),
                 });
             }
-            let text = std::fs::read_to_string(p).map_err(|source| ScenarioError::Io {
-                path: path.to_string(),
-                source,
-            })?;
+            let text = config::read(p)?;
             from_toml(&text, path, noise, seed)
         }
     }
 }
 
 /// Plans a travel scenario with the improved field and tracks its legs from its start.
-pub fn from_travel(travel: &TravelScenario, file: &str) -> Result<Setup, ScenarioError> {
+pub fn from_travel(travel: &TravelScenario, file: &str) -> Result<Setup, TrackError> {
     let plan = plan_path(travel, &PlanOptions::new(FieldKind::Improved)).map_err(|source| {
-        ScenarioError::Plan {
+        TrackError::Plan {
             file: file.to_string(),
             source,
         }
     })?;
     let legs = travel.legs();
     let mut out = Vec::new();
-    for (leg, (_, to, _)) in plan.path.legs.iter().zip(legs) {
+    for (i, (leg, (_, to, _))) in plan.path.legs.iter().zip(legs).enumerate() {
         let pts: Vec<Vec2> = leg.points.iter().map(|p| p.pose.position()).collect();
-        let leg = RefLeg::new(leg.direction, pts, Some(to.theta)).map_err(|f| {
-            ScenarioError::Invalid {
+        let leg = RefLeg::new(leg.direction, pts, Some(to.theta)).map_err(|fault| {
+            TrackError::PlannedLeg {
                 file: file.to_string(),
-                what: format!("planned path {f}"),
+                leg: i + 1,
+                fault,
             }
         })?;
         out.push(leg);
@@ -224,73 +203,371 @@ pub fn from_travel(travel: &TravelScenario, file: &str) -> Result<Setup, Scenari
     })
 }
 
-#[derive(Debug, Deserialize)]
+/// A tracking scenario file as written (the raw layer of the format in the
+/// module docs); [`TomlFile::from_toml`] / [`TomlFile::load`] check every
+/// value once, then [`ScenarioFile::into_scenario`] builds the run.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct FileSpec {
-    name: Option<String>,
-    speed_mps: Option<f64>,
-    noise: Option<Noise>,
-    start: StartSpec,
+pub struct ScenarioFile {
+    /// Name (default: the file name).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub name: Option<String>,
+    /// Cruise speed [m/s], overriding `[sim] speed_mps`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub speed_mps: Option<f64>,
+    /// RTK noise and loose-bench slip on or off (default off).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub noise: Option<Noise>,
+    /// The crawler's true start pose.
+    pub start: StartSpec,
+    /// The legs, in order (at least one).
     #[serde(default)]
-    leg: Vec<LegSpec>,
-    crawler: Option<CrawlerParams>,
-    slip: Option<SlipParams>,
-    rtk: Option<RtkParams>,
-    sim: Option<SimParams>,
+    pub leg: Vec<LegSpec>,
+    /// Machine.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub crawler: Option<CrawlerParams>,
+    /// Ground (overrides the noise setting's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub slip: Option<SlipParams>,
+    /// Sensor (overrides the noise setting's).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rtk: Option<RtkParams>,
+    /// Loop.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub sim: Option<SimParams>,
+    /// The controllers' gains.
+    #[serde(default)]
+    pub controller: ControllerParams,
 }
 
-#[derive(Debug, Deserialize)]
+/// `[start]` of a tracking scenario.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct StartSpec {
-    x_m: f64,
-    y_m: f64,
-    heading_deg: f64,
+pub struct StartSpec {
+    /// East [m].
+    pub x_m: f64,
+    /// North [m].
+    pub y_m: f64,
+    /// Heading from +x, counter-clockwise [deg].
+    pub heading_deg: f64,
 }
 
-#[derive(Debug, Deserialize)]
+/// One `[[leg]]` of a tracking scenario.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
-struct LegSpec {
-    direction: Direction,
-    points_m: Vec<[f64; 2]>,
-    end_heading_deg: Option<f64>,
+pub struct LegSpec {
+    /// Forward or reverse.
+    pub direction: Direction,
+    /// Path points [m].
+    pub points_m: Vec<[f64; 2]>,
+    /// Required heading at the end [deg] (default: along the last segment).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub end_heading_deg: Option<f64>,
 }
 
-/// Parses a tracking scenario, or plans a travel scenario (a file with `[site]`).
+/// Most points a leg of a file may have.
+pub const MAX_LEG_POINTS: usize = 1_000_000;
+
+/// A finite value in (0, 1000], for [`config::check_each`].
+const RATE: (fn(f64) -> bool, &str) = (
+    |v| v.is_finite() && v > 0.0 && v <= 1000.0,
+    "a rate in (0, 1000] Hz",
+);
+
+/// A slip ratio in [0, 0.9), for [`config::check_each`].
+const SLIP: (fn(f64) -> bool, &str) = (
+    |v| v.is_finite() && (0.0..0.9).contains(&v),
+    "a slip ratio in [0, 0.9)",
+);
+
+/// A finite value, for [`config::check_each`].
+const FINITE: (fn(f64) -> bool, &str) = (|v| v.is_finite(), "a finite number");
+
+impl ScenarioFile {
+    /// The legs, checked; errors name the leg and the line of its points.
+    fn legs(&self, text: &str, file: &str) -> Result<Vec<RefLeg>, TrackError> {
+        let mut legs = Vec::new();
+        for (i, l) in self.leg.iter().enumerate() {
+            if l.points_m.len() > MAX_LEG_POINTS {
+                return Err(config::invalid(
+                    text,
+                    file,
+                    ("leg", i),
+                    "points_m",
+                    format!("{} points", l.points_m.len()),
+                    format!("at most {MAX_LEG_POINTS} points"),
+                )
+                .into());
+            }
+            let end = match l.end_heading_deg {
+                Some(h) if !h.is_finite() => {
+                    return Err(TrackError::NotFinite {
+                        file: file.to_string(),
+                        line: line_of_key(text, "leg", i, "end_heading_deg"),
+                        key: format!("[[leg]] #{} end_heading_deg", i + 1),
+                        value: h,
+                    })
+                }
+                h => h.map(rad),
+            };
+            let pts: Vec<Vec2> = l.points_m.iter().map(|p| Vec2::new(p[0], p[1])).collect();
+            let leg = RefLeg::new(l.direction, pts, end).map_err(|fault| TrackError::Leg {
+                file: file.to_string(),
+                line: line_of_key(text, "leg", i, "points_m"),
+                leg: i + 1,
+                fault,
+            })?;
+            legs.push(leg);
+        }
+        Ok(legs)
+    }
+
+    fn start(&self) -> Pose2 {
+        Pose2::new(self.start.x_m, self.start.y_m, rad(self.start.heading_deg))
+    }
+
+    fn sim(&self) -> SimParams {
+        let mut sim = self.sim.unwrap_or_default();
+        if let Some(v) = self.speed_mps {
+            sim.speed_mps = v;
+        }
+        sim
+    }
+
+    /// The run this file describes: `noise` overrides the file's noise
+    /// setting (default off), `seed` seeds the sensor noise unless the file
+    /// gives `[rtk]`; `text` and `file` locate errors.
+    pub fn into_scenario(
+        self,
+        text: &str,
+        file: &str,
+        noise: Option<Noise>,
+        seed: u64,
+    ) -> Result<TrackScenario, TrackError> {
+        let legs = self.legs(text, file)?;
+        let noise = noise.or(self.noise).unwrap_or(Noise::Off);
+        let mut setup = Setup {
+            legs,
+            start: self.start(),
+            crawler: self.crawler.unwrap_or_default(),
+            slip: SlipParams::none(),
+            rtk: RtkParams::ideal(),
+            sim: self.sim(),
+        };
+        apply_noise(&mut setup, noise, seed);
+        if let Some(slip) = self.slip {
+            setup.slip = slip;
+        }
+        if let Some(rtk) = self.rtk {
+            setup.rtk = rtk;
+        }
+        Ok(TrackScenario {
+            name: self.name.unwrap_or_else(|| file.to_string()),
+            setup,
+            noise,
+            map: None,
+            controllers: self.controller,
+        })
+    }
+
+    fn check_controllers(&self, text: &str, file: &str) -> Result<(), TrackError> {
+        let (f, p, pp) = (
+            &self.controller.fuzzy,
+            &self.controller.pid,
+            &self.controller.pure_pursuit,
+        );
+        const FUZZY: &str = "controller.fuzzy";
+        const PID: &str = "controller.pid";
+        const PP: &str = "controller.pure_pursuit";
+        let positive = [
+            (FUZZY, "k1", f.k1),
+            (FUZZY, "k2", f.k2),
+            (FUZZY, "k3", f.k3),
+            (PID, "max_steer_rpm", p.max_steer_rpm),
+            (PP, "lookahead_m", pp.lookahead_m),
+            (PP, "max_steer_rpm", pp.max_steer_rpm),
+        ];
+        config::check_each(text, file, &positive, config::POSITIVE)?;
+        let non_negative = [
+            (FUZZY, "alpha", f.alpha),
+            (FUZZY, "ec_filter_s", f.ec_filter_s),
+            (PID, "kp", p.kp),
+            (PID, "ki", p.ki),
+            (PID, "kd", p.kd),
+            (PID, "alpha", p.alpha),
+            (PP, "lookahead_gain_s", pp.lookahead_gain_s),
+        ];
+        config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
+        Ok(())
+    }
+
+    fn check_machine(&self, text: &str, file: &str) -> Result<(), TrackError> {
+        if let Some(c) = &self.crawler {
+            let positive = [
+                ("crawler", "gauge_m", c.gauge_m),
+                ("crawler", "sprocket_radius_m", c.sprocket_radius_m),
+                ("crawler", "gear_ratio", c.gear_ratio),
+                ("crawler", "motor_max_rpm", c.motor_max_rpm),
+            ];
+            config::check_each(text, file, &positive, config::POSITIVE)?;
+            let accel = [(
+                "crawler",
+                "motor_max_accel_rpm_per_s",
+                c.motor_max_accel_rpm_per_s,
+            )];
+            config::check_each(text, file, &accel, config::NON_NEGATIVE)?;
+        }
+        if let Some(s) = &self.slip {
+            config::check_each(
+                text,
+                file,
+                &[("slip", "left", s.left), ("slip", "right", s.right)],
+                SLIP,
+            )?;
+            let lateral = [("slip", "lateral_gain_s", s.lateral_gain_s)];
+            config::check_each(text, file, &lateral, config::NON_NEGATIVE)?;
+        }
+        if let Some(r) = &self.rtk {
+            config::check_each(text, file, &[("rtk", "rate_hz", r.rate_hz)], RATE)?;
+            let non_negative = [
+                ("rtk", "position_sigma_m", r.position_sigma_m),
+                ("rtk", "heading_sigma_deg", r.heading_sigma_deg),
+                ("rtk", "dropouts_per_min", r.dropouts_per_min),
+                ("rtk", "dropout_s", r.dropout_s),
+            ];
+            config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
+            let offset = [("rtk", "heading_offset_deg", r.heading_offset_deg)];
+            config::check_each(text, file, &offset, FINITE)?;
+        }
+        Ok(())
+    }
+
+    fn check_sim(&self, text: &str, file: &str) -> Result<(), TrackError> {
+        let s = self.sim();
+        let positive = [
+            ("sim", "plant_dt_s", s.plant_dt_s),
+            ("sim", "accel_mps2", s.accel_mps2),
+            ("sim", "creep_mps", s.creep_mps),
+            ("sim", "pose_timeout_s", s.pose_timeout_s),
+            ("sim", "max_plausible_speed_mps", s.max_plausible_speed_mps),
+            ("sim", "time_per_m_limit_s", s.time_per_m_limit_s),
+        ];
+        config::check_each(text, file, &positive, config::POSITIVE)?;
+        let non_negative = [
+            ("sim", "preview_m", s.preview_m),
+            ("sim", "preview_gain_s", s.preview_gain_s),
+            ("sim", "terminal_preview_m", s.terminal_preview_m),
+            ("sim", "terminal_zone_m", s.terminal_zone_m),
+        ];
+        config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
+        config::check_each(
+            text,
+            file,
+            &[("sim", "control_rate_hz", s.control_rate_hz)],
+            RATE,
+        )?;
+        if s.plant_dt_s > 0.1 {
+            return Err(config::invalid(
+                text,
+                file,
+                ("sim", 0),
+                "plant_dt_s",
+                s.plant_dt_s,
+                "a step of at most 0.1 s",
+            )
+            .into());
+        }
+        let vmax = self.crawler.unwrap_or_default().max_track_speed_mps();
+        let speed_at = if self.speed_mps.is_some() {
+            ("", 0)
+        } else {
+            ("sim", 0)
+        };
+        if !(s.speed_mps.is_finite() && s.speed_mps > 0.0 && s.speed_mps <= vmax) {
+            return Err(config::invalid(
+                text,
+                file,
+                speed_at,
+                "speed_mps",
+                s.speed_mps,
+                format!("a speed > 0 and at most the track speed limit {vmax:.3} m/s"),
+            )
+            .into());
+        }
+        if s.creep_mps > s.speed_mps {
+            return Err(config::invalid(
+                text,
+                file,
+                ("sim", 0),
+                "creep_mps",
+                s.creep_mps,
+                format!("at most speed_mps = {}", s.speed_mps),
+            )
+            .into());
+        }
+        Ok(())
+    }
+}
+
+impl TomlFile for ScenarioFile {
+    type Error = TrackError;
+
+    fn check(&self, text: &str, file: &str) -> Result<(), TrackError> {
+        let s = &self.start;
+        for (k, v) in [
+            ("x_m", s.x_m),
+            ("y_m", s.y_m),
+            ("heading_deg", s.heading_deg),
+        ] {
+            if !v.is_finite() {
+                return Err(TrackError::NotFinite {
+                    file: file.to_string(),
+                    line: line_of_key(text, "start", 0, k),
+                    key: format!("[start] {k}"),
+                    value: v,
+                });
+            }
+        }
+        if self.leg.is_empty() {
+            return Err(config::invalid(
+                text,
+                file,
+                ("", 0),
+                "[[leg]]",
+                "none",
+                "at least one [[leg]] of points",
+            )
+            .into());
+        }
+        let legs = self.legs(text, file)?;
+        let start = self.start();
+        let (a, _, _) = legs[0].nearest(start.position(), f64::NEG_INFINITY, f64::INFINITY);
+        let off = (a - start.position()).norm();
+        if off > MAX_START_OFFSET_M {
+            return Err(TrackError::StartOffPath {
+                file: file.to_string(),
+                line: line_of_key(text, "start", 0, "x_m"),
+                distance_m: off,
+                max_m: MAX_START_OFFSET_M,
+            });
+        }
+        self.check_machine(text, file)?;
+        self.check_sim(text, file)?;
+        self.check_controllers(text, file)
+    }
+}
+
+/// Reads a tracking scenario, or plans a travel scenario (a file with
+/// `[site]`); `file` names it in errors.
 pub fn from_toml(
     text: &str,
     file: &str,
     noise: Option<Noise>,
     seed: u64,
-) -> Result<TrackScenario, ScenarioError> {
-    let parse_err = |e: toml::de::Error| {
-        let (line, column) = e
-            .span()
-            .map(|s| {
-                let before = &text[..s.start.min(text.len())];
-                (
-                    before.matches('\n').count() + 1,
-                    before.len() - before.rfind('\n').map(|i| i + 1).unwrap_or(0) + 1,
-                )
-            })
-            .unwrap_or((0, 0));
-        ScenarioError::Parse {
-            file: file.to_string(),
-            line,
-            column,
-            message: e.message().to_string(),
-        }
-    };
-    let table: toml::Table = toml::from_str(text).map_err(parse_err)?;
-    let invalid = |what: String| ScenarioError::Invalid {
-        file: file.to_string(),
-        what,
-    };
+) -> Result<TrackScenario, TrackError> {
+    let table: toml::Table = config::parse(text, file)?;
     if table.contains_key("site") {
-        let travel =
-            TravelScenario::from_toml(text, file).map_err(|source| ScenarioError::Plan {
-                file: file.to_string(),
-                source,
-            })?;
+        let travel = TravelScenario::from_toml(text, file).map_err(TrackError::Travel)?;
         let noise = noise.unwrap_or(Noise::Rtk);
         let mut setup = from_travel(&travel, file)?;
         apply_noise(&mut setup, noise, seed);
@@ -299,83 +576,10 @@ pub fn from_toml(
             setup,
             noise,
             map: Some(travel.map),
+            controllers: ControllerParams::default(),
         });
     }
-    let spec: FileSpec = toml::from_str(text).map_err(parse_err)?;
-    let s = &spec.start;
-    for (k, v) in [
-        ("x_m", s.x_m),
-        ("y_m", s.y_m),
-        ("heading_deg", s.heading_deg),
-    ] {
-        if !v.is_finite() {
-            return Err(invalid(format!("[start] {k} = {v} is not a finite number")));
-        }
-    }
-    if spec.leg.is_empty() {
-        return Err(invalid(
-            "no [[leg]]: a tracking scenario needs at least one leg of points".into(),
-        ));
-    }
-    let mut legs = Vec::new();
-    for (i, l) in spec.leg.iter().enumerate() {
-        if l.points_m.len() > 1_000_000 {
-            return Err(invalid(format!(
-                "leg #{} has {} points; at most 1000000",
-                i + 1,
-                l.points_m.len()
-            )));
-        }
-        let pts: Vec<Vec2> = l.points_m.iter().map(|p| Vec2::new(p[0], p[1])).collect();
-        let end = match l.end_heading_deg {
-            Some(h) if !h.is_finite() => {
-                return Err(invalid(format!(
-                    "leg #{}: end_heading_deg = {h} is not finite",
-                    i + 1
-                )))
-            }
-            Some(h) => Some(rad(h)),
-            None => None,
-        };
-        legs.push(
-            RefLeg::new(l.direction, pts, end)
-                .map_err(|f| invalid(format!("leg #{} {f}", i + 1)))?,
-        );
-    }
-    let start = Pose2::new(s.x_m, s.y_m, rad(s.heading_deg));
-    let (a, _, _) = legs[0].nearest(start.position(), f64::NEG_INFINITY, f64::INFINITY);
-    let off = (a - start.position()).norm();
-    if off > MAX_START_OFFSET_M {
-        return Err(invalid(format!("the start is {off:.2} m from the first leg; at most {MAX_START_OFFSET_M} m (plan a path to it first)")));
-    }
-    let mut sim = spec.sim.unwrap_or_default();
-    if let Some(v) = spec.speed_mps {
-        sim.speed_mps = v;
-    }
-    let crawler = spec.crawler.unwrap_or_default();
-    let noise = noise.or(spec.noise).unwrap_or(Noise::Off);
-    let mut setup = Setup {
-        legs,
-        start,
-        crawler,
-        slip: SlipParams::none(),
-        rtk: RtkParams::ideal(),
-        sim,
-    };
-    apply_noise(&mut setup, noise, seed);
-    if let Some(slip) = spec.slip {
-        setup.slip = slip;
-    }
-    if let Some(rtk) = spec.rtk {
-        setup.rtk = rtk;
-    }
-    validate(&setup).map_err(invalid)?;
-    Ok(TrackScenario {
-        name: spec.name.unwrap_or_else(|| file.to_string()),
-        setup,
-        noise,
-        map: None,
-    })
+    ScenarioFile::from_toml(text, file)?.into_scenario(text, file, noise, seed)
 }
 
 fn apply_noise(setup: &mut Setup, noise: Noise, seed: u64) {
@@ -391,65 +595,38 @@ fn apply_noise(setup: &mut Setup, noise: Noise, seed: u64) {
     }
 }
 
-/// Checks every parameter of a setup; the message names the first bad value.
-pub fn validate(setup: &Setup) -> Result<(), String> {
-    setup
-        .crawler
-        .validate()
-        .map_err(|(k, v)| format!("[crawler] {k} = {v} is impossible"))?;
-    setup
-        .slip
-        .validate()
-        .map_err(|(k, v)| format!("[slip] {k} = {v} is out of range"))?;
-    setup
-        .rtk
-        .validate()
-        .map_err(|(k, v)| format!("[rtk] {k} = {v} is out of range"))?;
-    let s = &setup.sim;
-    for (k, v) in [
-        ("plant_dt_s", s.plant_dt_s),
-        ("accel_mps2", s.accel_mps2),
-        ("creep_mps", s.creep_mps),
-        ("pose_timeout_s", s.pose_timeout_s),
-        ("max_plausible_speed_mps", s.max_plausible_speed_mps),
-        ("time_per_m_limit_s", s.time_per_m_limit_s),
-    ] {
-        if !(v.is_finite() && v > 0.0) {
-            return Err(format!("[sim] {k} = {v} must be positive"));
-        }
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const TEXT: &str = "speed_mps = 0.5\n[start]\nx_m = 0.0\ny_m = 0.3\nheading_deg = 0.0\n\
+        [[leg]]\ndirection = \"forward\"\npoints_m = [[0.0, 0.0], [10.0, 0.0]]\n\
+        [controller.fuzzy]\nk1 = 1.5\n";
+
+    #[test]
+    fn gains_load_with_defaults_beside_them_and_round_trip() {
+        let f = ScenarioFile::from_toml(TEXT, "t.toml").unwrap();
+        assert_eq!(f.controller.fuzzy.k1, 1.5);
+        assert_eq!(
+            f.controller.fuzzy.k2,
+            crate::FuzzyParams::default().k2,
+            "unset gains keep their defaults"
+        );
+        assert_eq!(f.controller.pid, crate::PidParams::default());
+        let back = ScenarioFile::from_toml(&f.to_toml(), "t.toml").unwrap();
+        assert_eq!(f, back);
+        let s = f.into_scenario(TEXT, "t.toml", None, 1).unwrap();
+        assert_eq!(s.controllers.fuzzy.k1, 1.5);
+        assert_eq!(s.name, "t.toml");
     }
-    for (k, v) in [
-        ("preview_m", s.preview_m),
-        ("preview_gain_s", s.preview_gain_s),
-    ] {
-        if !(v.is_finite() && v >= 0.0) {
-            return Err(format!("[sim] {k} = {v} must be zero or positive"));
-        }
+
+    #[test]
+    fn a_bad_gain_names_its_table_key_and_line() {
+        let text = TEXT.replace("k1 = 1.5", "k1 = 0.0");
+        let e = ScenarioFile::from_toml(&text, "t.toml").unwrap_err();
+        assert_eq!(
+            e.to_string(),
+            "t.toml:10: [controller.fuzzy] k1 = 0 is invalid: expected a finite value > 0"
+        );
     }
-    if !(s.control_rate_hz.is_finite() && s.control_rate_hz > 0.0 && s.control_rate_hz <= 1000.0) {
-        return Err(format!(
-            "[sim] control_rate_hz = {} must be in (0, 1000]",
-            s.control_rate_hz
-        ));
-    }
-    if s.plant_dt_s > 0.1 {
-        return Err(format!(
-            "[sim] plant_dt_s = {} is too coarse (at most 0.1 s)",
-            s.plant_dt_s
-        ));
-    }
-    let vmax = setup.crawler.max_track_speed_mps();
-    if !(s.speed_mps.is_finite() && s.speed_mps > 0.0 && s.speed_mps <= vmax) {
-        return Err(format!(
-            "speed_mps = {} must be positive and at most the track speed limit {vmax:.3} m/s",
-            s.speed_mps
-        ));
-    }
-    if s.creep_mps > s.speed_mps {
-        return Err(format!(
-            "[sim] creep_mps = {} exceeds speed_mps = {}",
-            s.creep_mps, s.speed_mps
-        ));
-    }
-    Ok(())
 }

@@ -65,27 +65,6 @@ impl RtkParams {
             seed,
         }
     }
-
-    /// Checks ranges.
-    pub fn validate(&self) -> Result<(), (&'static str, f64)> {
-        if !(self.rate_hz.is_finite() && self.rate_hz > 0.0 && self.rate_hz <= 1000.0) {
-            return Err(("rate_hz", self.rate_hz));
-        }
-        for (n, v) in [
-            ("position_sigma_m", self.position_sigma_m),
-            ("heading_sigma_deg", self.heading_sigma_deg),
-            ("dropouts_per_min", self.dropouts_per_min),
-            ("dropout_s", self.dropout_s),
-        ] {
-            if !(v.is_finite() && v >= 0.0) {
-                return Err((n, v));
-            }
-        }
-        if !self.heading_offset_deg.is_finite() {
-            return Err(("heading_offset_deg", self.heading_offset_deg));
-        }
-        Ok(())
-    }
 }
 
 /// One RTK fix, in the receiver's own terms.

@@ -30,7 +30,7 @@ pub struct SimParams {
     pub accel_mps2: f64,
     /// Slowest speed before the end of a leg [m/s].
     pub creep_mps: f64,
-    /// Preview distance L at standstill (eq. 21) [m].
+    /// Preview distance L at standstill [W eq. 21] [m].
     pub preview_m: f64,
     /// Growth of L with speed [s].
     pub preview_gain_s: f64,
@@ -106,6 +106,17 @@ pub struct Event {
     pub kind: &'static str,
     /// Human text.
     pub message: String,
+}
+
+impl Event {
+    /// Kind of the event that closes each leg normally.
+    pub const LEG_END: &'static str = "leg-end";
+
+    /// Whether the safety layer or the runner intervened (every event but
+    /// the normal end of a leg).
+    pub fn is_safety(&self) -> bool {
+        self.kind != Self::LEG_END
+    }
 }
 
 /// Measures of a run (SPEC §3, §6).
@@ -253,6 +264,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
             let cmd;
             let mut steer = 0.0;
             let remaining_hint = s_hint.map(|h| leg.length_m() - h).unwrap_or(f64::INFINITY);
+            // The preview distance L of [W eq. 21], growing with speed.
             let mut preview = sp.preview_m + sp.preview_gain_s * speed_ref.abs();
             if remaining_hint <= sp.terminal_zone_m {
                 preview = preview.max(sp.terminal_preview_m);
@@ -322,7 +334,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
             {
                 events.push(Event {
                     t_s: t,
-                    kind: "leg-end",
+                    kind: Event::LEG_END,
                     message: format!("leg {li} ({}) done, machine at rest", leg.direction.name()),
                 });
                 break;
