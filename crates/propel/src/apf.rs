@@ -395,6 +395,10 @@ pub fn descend(
     }
 }
 
+/// Name of the local-minimum escape (a tangent-bug move along the nearest
+/// obstacle's boundary), as summaries report it.
+pub const ESCAPE_STRATEGY: &str = "boundary-following";
+
 /// Closest the boundary-following escape goes to an obstacle [m].
 const MIN_FOLLOW_CLEARANCE_M: f64 = 0.05;
 

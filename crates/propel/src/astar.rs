@@ -16,6 +16,9 @@ use serde::{Deserialize, Serialize};
 use crate::error::{NoPathFault, PropelError, Result};
 use crate::map::Map;
 
+/// Name of the reference planner, as summaries report it.
+pub const REFERENCE_PLANNER: &str = "theta-star";
+
 /// Grid A* parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
