@@ -97,13 +97,12 @@ fn main() -> ExitCode {
         Command::Perceive(args) => perceive::run(&args),
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
-        Command::Scenario { name } => {
-            autoshovel_propel::scenario::builtin_text(&name).map(|text| {
+        Command::Scenario { name } => autoshovel_propel::scenario::builtin_text(&name)
+            .map(|text| {
                 use std::io::Write as _;
                 let _ = write!(std::io::stdout().lock(), "{text}");
             })
-            .map_err(anyhow::Error::from)
-        }
+            .map_err(anyhow::Error::from),
         Command::Demo { out, json } => demo::run(&out, json),
     };
     match result {

@@ -86,7 +86,10 @@ pub fn path_figure(scenario: &Scenario, outcome: &PlanOutcome) -> Figure {
     let title = format!("{} — {}", scenario.name, outcome.options.field.name());
     let mut fig = map_figure(&title, &scenario.map);
     for (i, route) in outcome.reference.iter().flatten().enumerate() {
-        let l = Layer::line(route.points.iter().map(|p| xy(*p)), Stroke::dashed(Rgb::GREY, 1));
+        let l = Layer::line(
+            route.points.iter().map(|p| xy(*p)),
+            Stroke::dashed(Rgb::GREY, 1),
+        );
         fig.push(if i == 0 {
             l.with_label("Theta* reference")
         } else {

@@ -118,7 +118,11 @@ pub fn markdown_table(summary: &StudySummary) -> String {
             format!("{} %", f(p.success_pct, 1)),
             format!("{} %", f(p.reached_pct, 1)),
             p.local_minima.to_string(),
-            format!("{} / {}", f(p.mean_length_ratio, 3), f(p.max_length_ratio, 3)),
+            format!(
+                "{} / {}",
+                f(p.mean_length_ratio, 3),
+                f(p.max_length_ratio, 3)
+            ),
             format!(
                 "{} / {}",
                 f(p.mean_min_clearance_m, 2),

@@ -28,8 +28,8 @@ pub mod study;
 
 pub use apf::{ApfParams, FieldKind};
 pub use astar::{astar, AstarParams, Route};
-pub use error::{PropelError, Result};
 pub use error::{NoPathFault, PoseFault};
+pub use error::{PropelError, Result};
 pub use map::{Boundary, Map, Obstacle, Shape};
 pub use outcome::{
     reference_comparison, Failure, PlanOutcome, PlanPathSummary, ReferenceComparison,

@@ -31,7 +31,7 @@ pub const DEFAULT_HEADING_TOLERANCE_DEG: f64 = 2.0;
 pub fn heading_failure(legs: &[LegStats], tolerance_deg: f64) -> Option<PropelError> {
     legs.iter()
         .enumerate()
-        .find(|(_, l)| !(l.end_heading_error_deg <= tolerance_deg))
+        .find(|(_, l)| l.end_heading_error_deg.is_nan() || l.end_heading_error_deg > tolerance_deg)
         .map(|(leg, l)| PropelError::HeadingNotMet {
             leg,
             legs: legs.len(),
@@ -128,7 +128,11 @@ pub struct PlanOutcome {
 impl PlanOutcome {
     /// Plans `scenario` with `field`'s default options and runs the reference.
     pub fn plan(scenario: &Scenario, field: FieldKind) -> Self {
-        Self::with_reference(scenario, PlanOptions::new(field), reference_routes(scenario))
+        Self::with_reference(
+            scenario,
+            PlanOptions::new(field),
+            reference_routes(scenario),
+        )
     }
 
     /// Plans `scenario` with `options` against an already computed reference.

@@ -3,6 +3,11 @@
 //! with the classic field, the improved field and the Theta* reference, to
 //! measure success rate, local minima, length ratio to the reference,
 //! clearance and final heading error.
+//!
+//! "Success" and the reference comparison are those of
+//! [`crate::outcome`], the same rule as `autoshovel plan-path`'s (every leg
+//! within the heading tolerance, the reference run leg by leg); the roads
+//! here have one leg, so the rule is "the final heading within tolerance".
 
 use autoshovel_core::{angle_diff, heading_vec, perp, Pose2, Vec2};
 use rand::{Rng, SeedableRng};
@@ -280,16 +285,14 @@ pub fn aggregate(rows: &[MapRow], field: FieldKind) -> Aggregate {
         .filter(|(_, o)| o.reached)
         .collect();
     let m = reached.len().max(1) as f64;
-    let ratio =
-        |(r, o): &(&MapRow, Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
+    let ratio = |(r, o): &(&MapRow, Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
     let max = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::max);
     let min = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::min);
     Aggregate {
         planner: field.name(),
         maps: solved.len(),
         reached_pct: 100.0 * reached.len() as f64 / n,
-        success_pct: 100.0 * solved.iter().filter(|r| r.outcome(field).success).count() as f64
-            / n,
+        success_pct: 100.0 * solved.iter().filter(|r| r.outcome(field).success).count() as f64 / n,
         local_minima: solved
             .iter()
             .filter(|r| r.outcome(field).local_minimum)
