@@ -15,8 +15,9 @@ use crate::map::PolygonFault;
 pub enum PropelError {
     /// A scenario file is not valid TOML, or has unknown, missing or
     /// mistyped keys (names the file, line and column).
+    /// (Boxed: keeps the error small for the crates that wrap it.)
     #[error(transparent)]
-    Config(#[from] ConfigError),
+    Config(Box<ConfigError>),
     /// A scenario file could not be read.
     #[error("cannot read scenario file {}", path.display())]
     UnreadableScenario {
@@ -24,7 +25,7 @@ pub enum PropelError {
         path: PathBuf,
         /// The cause ([`ConfigError::Io`]).
         #[source]
-        source: ConfigError,
+        source: Box<ConfigError>,
     },
     /// A number in a scenario is NaN or infinite.
     #[error("{file}:{line}: {key} has a non-finite number ({value})")]
@@ -300,6 +301,12 @@ pub enum NoPathFault {
         /// Cells expanded.
         expanded: usize,
     },
+}
+
+impl From<ConfigError> for PropelError {
+    fn from(e: ConfigError) -> Self {
+        PropelError::Config(Box::new(e))
+    }
 }
 
 impl PropelError {

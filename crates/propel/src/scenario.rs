@@ -119,7 +119,7 @@ impl Scenario {
     pub fn load(path: &FsPath) -> Result<Scenario> {
         let text = config::read(path).map_err(|source| PropelError::UnreadableScenario {
             path: path.to_path_buf(),
-            source,
+            source: Box::new(source),
         })?;
         Scenario::from_toml(&text, &path.display().to_string())
     }
