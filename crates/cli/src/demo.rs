@@ -31,33 +31,40 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let key = format!("plan-path {name} {}", field.name());
         let sub = format!("plan-path-{name}-{}", field.name());
         let dir = prepare_dir(&out.join(&sub))?;
-        let job = crate::plan_path::job(&scenario, field, 2.0, Some(&dir))?;
+        let job = crate::plan_path::job(
+            &scenario,
+            field,
+            autoshovel_propel::DEFAULT_HEADING_TOLERANCE_DEG,
+            Some(&dir),
+        )?;
         if !json_only {
             let s = &job.summary;
+            let v = |x: Option<f64>| x.unwrap_or(f64::NAN);
             crate::say!(
                 "{key:40} {}",
-                if s["success"].as_bool() == Some(true) {
+                if s.success {
                     format!(
                         "ok: {:.2} m, heading error {:.2} deg, clearance {:.2} m, {:.2} ms",
-                        s["length_m"].as_f64().unwrap_or(f64::NAN),
-                        s["final_heading_error_deg"].as_f64().unwrap_or(f64::NAN),
-                        s["min_clearance_m"].as_f64().unwrap_or(f64::NAN),
-                        s["plan_time_ms"].as_f64().unwrap_or(f64::NAN)
+                        v(s.length_m),
+                        v(s.final_heading_error_deg),
+                        v(s.min_clearance_m),
+                        v(s.plan_time_ms)
                     )
                 } else {
-                    format!("failed: {}", s["error"].as_str().unwrap_or(""))
+                    format!("failed: {}", s.error.as_deref().unwrap_or(""))
                 }
             );
         }
+        let summary = job.json()?;
         sections.push(section(
             &key,
             description,
-            &job.summary,
+            &summary,
             &sub,
             &job.written.plots,
             &job.written.files,
         ));
-        summaries.insert(key, job.summary);
+        summaries.insert(key, summary);
     }
     // Every run uses the fuzzy tracker; the last compares all three.
     let track_runs: [(&str, bool, &str); 6] = [
@@ -299,17 +306,21 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     };
     let sub = "study-paths";
     let dir = prepare_dir(&out.join(sub))?;
-    let (summary, written) = crate::study::study(&params, Some(&dir), !json_only)?;
+    let job = crate::study::study(&params, Some(&dir), !json_only)?;
     if !json_only {
-        crate::say!("{}", crate::study::markdown_table(&summary));
+        crate::say!(
+            "{}",
+            autoshovel_figures::study::markdown_table(&job.summary)
+        );
     }
+    let summary = job.json()?;
     sections.push(section(
         "study-paths (100 maps)",
         "Seeded random haul roads with 3–12 obstacles: classic APF, improved APF and the Theta* reference. The full study: autoshovel study-paths --maps 500.",
         &summary,
         sub,
-        &written.plots,
-        &written.files,
+        &job.written.plots,
+        &job.written.files,
     ));
     summaries.insert("study-paths".into(), summary);
     let all = Value::Object(summaries);

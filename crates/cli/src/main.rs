@@ -97,24 +97,12 @@ fn main() -> ExitCode {
         Command::Perceive(args) => perceive::run(&args),
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
-        Command::Scenario { name } => match autoshovel_propel::scenario::BUILTINS
-            .iter()
-            .find(|(n, _)| *n == name)
-        {
-            Some((_, text)) => {
+        Command::Scenario { name } => autoshovel_propel::scenario::builtin_text(&name)
+            .map(|text| {
                 use std::io::Write as _;
                 let _ = write!(std::io::stdout().lock(), "{text}");
-                Ok(())
-            }
-            None => Err(anyhow::anyhow!(
-                "unknown built-in scenario '{name}' (built-ins: {})",
-                autoshovel_propel::scenario::BUILTINS
-                    .iter()
-                    .map(|(n, _)| *n)
-                    .collect::<Vec<_>>()
-                    .join(", ")
-            )),
-        },
+            })
+            .map_err(anyhow::Error::from),
         Command::Demo { out, json } => demo::run(&out, json),
     };
     match result {

@@ -1,32 +1,32 @@
 //! Artificial potential field descent: the classic field (electric-shovel
-//! paper eqs. 1–5) and the improved field (eqs. 6–15), with stall detection
+//! walking paper [W eqs. 1–5]) and the improved field ([W eqs. 6–15]), with stall detection
 //! and a boundary-following escape.
 //!
 //! How the printed equations were read (SPEC §2 asks for the physics the text
 //! describes):
 //! - ρ(q, q_o) is the clearance of the machine's footprint disc to the
 //!   obstacle's *nearest point*, so the field is infinite on contact; ∇ρ(q, q_o)
-//!   is the unit vector from that point to the machine. Eq. 4 prints
+//!   is the unit vector from that point to the machine. [W eq. 4] prints
 //!   ρ(q, q_t) where ρ(q, q_o) is meant.
-//! - Eq. 8 caps the attraction beyond ρ_d at ½ηρ_d, half of what it is just
+//! - [W eq. 8] caps the attraction beyond ρ_d at ½ηρ_d, half of what it is just
 //!   inside ρ_d: the printed potential's slope jumps there. We use the C¹
 //!   capped field (|F| = ηρ_d beyond ρ_d), which is what "capped attraction"
 //!   describes and keeps the descent from kinking at ρ_d.
-//! - Eqs. 9–11 scale the repulsion by ρⁿ(q, q_t). We measure that distance in
+//! - [W eqs. 9–11] scale the repulsion by ρⁿ(q, q_t). We measure that distance in
 //!   units of ρ_d and saturate it at 1, min(ρ(q, q_t)/ρ_d, 1)ⁿ, so that k keeps
 //!   the units of the classic field and far from the target the repulsion is
 //!   the classic one. Unbounded, ρⁿ grows with the distance to the target and
 //!   walls off every gap between an obstacle and the road edge (the random
 //!   road study failed on most maps that way). F_rep1 pushes from the obstacle to the machine and F_rep2, the
 //!   derivative of the same potential with respect to ρ(q, q_t), pulls the
-//!   machine towards the target (eq. 11: F_rep2 = n/2·k(1/ρ − 1/ρ0)²ρⁿ⁻¹).
+//!   machine towards the target ([W eq. 11]: F_rep2 = n/2·k(1/ρ − 1/ρ0)²ρⁿ⁻¹).
 //!   Both vanish at the target, so a goal next to an obstacle is reachable.
-//! - Eqs. 12–13: the virtual obstacle at the target pushes with magnitude
+//! - [W eqs. 12–13]: the virtual obstacle at the target pushes with magnitude
 //!   μ·min(ρ(q, q_t), ρ_t) *against the required final heading h*. With the
 //!   attraction −ηρ u (u from target to machine) the motion direction is
 //!   −(ηu + μh): the ray behind the target (u = −h) is the only stable
 //!   approach, and the angle off it shrinks like ρ^{μ/(η−μ)}, so the machine
-//!   arrives aligned. This needs μ < η. Eq. 13's cap ½μρ_d is read as the
+//!   arrives aligned. This needs μ < η. [W eq. 13]'s cap ½μρ_d is read as the
 //!   same C¹ cap as the attraction, μρ_t.
 //!
 //! Descent: q ← q + δ·F/|F| with a fixed step δ, stopping within the goal
@@ -46,9 +46,9 @@ use crate::map::Map;
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "kebab-case")]
 pub enum FieldKind {
-    /// Eqs. 1–5: quadratic attraction, Khatib repulsion; no heading control.
+    /// [W eqs. 1–5]: quadratic attraction, Khatib repulsion; no heading control.
     Classic,
-    /// Eqs. 6–15: capped attraction, ρⁿ-scaled repulsion, virtual obstacle at the target.
+    /// [W eqs. 6–15]: capped attraction, ρⁿ-scaled repulsion, virtual obstacle at the target.
     Improved,
 }
 
@@ -66,19 +66,19 @@ impl FieldKind {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ApfParams {
-    /// Attraction gain η (eq. 1) [1/m, force per metre].
+    /// Attraction gain η ([W eq. 1]) [1/m, force per metre].
     pub eta: f64,
-    /// Attraction cap distance ρ_d (eq. 6) [m]; improved field only.
+    /// Attraction cap distance ρ_d ([W eq. 6]) [m]; improved field only.
     pub rho_d_m: f64,
-    /// Repulsion gain k (eqs. 3, 9).
+    /// Repulsion gain k ([W eqs. 3, 9]).
     pub k_rep: f64,
-    /// Repulsion influence range ρ0 (eq. 3) [m].
+    /// Repulsion influence range ρ0 ([W eq. 3]) [m].
     pub rho0_m: f64,
-    /// Exponent n of ρⁿ(q, q_t) (eq. 9); improved field only.
+    /// Exponent n of ρⁿ(q, q_t) ([W eq. 9]); improved field only.
     pub n: f64,
-    /// Virtual-obstacle gain μ (eq. 12), below η; improved field only.
+    /// Virtual-obstacle gain μ ([W eq. 12]), below η; improved field only.
     pub mu: f64,
-    /// Virtual-obstacle cap distance ρ_t (eq. 12) [m].
+    /// Virtual-obstacle cap distance ρ_t ([W eq. 12]) [m].
     pub rho_t_m: f64,
     /// Descent step δ [m].
     pub step_m: f64,
@@ -187,7 +187,11 @@ pub struct Target {
     pub motion_heading_rad: f64,
 }
 
-/// The total force of the field at `q` (eq. 5 or eq. 15).
+/// The total force of the field at `q`: the classic field [W eq. 5]
+/// (attraction [W eq. 2] plus Khatib repulsion [W eq. 4]) or the improved
+/// field [W eq. 15] (capped attraction [W eq. 8], virtual obstacle at the
+/// target [W eq. 13], ρⁿ-scaled repulsion [W eq. 10] with its parts
+/// [W eq. 11] and factor [W eq. 9]); see the module notes for how each was read.
 pub fn field_force(
     map: &Map,
     q: Vec2,
@@ -200,19 +204,22 @@ pub fn field_force(
     let rt = d.norm();
     let u_goal = if rt > 1e-12 { d / rt } else { Vec2::zeros() };
     let mut f = match kind {
+        // [W eq. 2]: F_att = ηρ(q, q_t) towards the target.
         FieldKind::Classic => d * p.eta,
         FieldKind::Improved => {
+            // [W eq. 8]: attraction capped beyond ρ_d (C¹ reading).
             let att = if rt <= p.rho_d_m {
                 d * p.eta
             } else {
                 u_goal * (p.eta * p.rho_d_m)
             };
+            // [W eq. 13]: the virtual obstacle pushes against the required heading.
             let virt = -heading_vec(target.motion_heading_rad) * (p.mu * rt.min(p.rho_t_m));
             att + virt
         }
     };
     // (ρ(q,q_t)/ρ_d)ⁿ, saturating at 1 beyond ρ_d (see the module notes).
-    let s = (rt / p.rho_d_m).min(1.0);
+    let s = (rt / p.rho_d_m).min(1.0); // [W eq. 9]: the ρⁿ(q, q_t) factor
     let far = rt > p.rho_d_m;
     map.for_each_nearest(q, |nb| {
         let rho = (nb.distance - footprint_radius_m).max(p.min_clearance_m);
@@ -221,19 +228,21 @@ pub fn field_force(
         }
         let a = 1.0 / rho - 1.0 / p.rho0_m;
         match kind {
+            // [W eq. 4]: F_rep = k(1/ρ − 1/ρ0)/ρ² along ∇ρ(q, q_o).
             FieldKind::Classic => f += nb.normal * (p.k_rep * a / (rho * rho)),
             FieldKind::Improved => {
+                // [W eq. 11]: F*_rep1 and F*_rep2.
                 let rep1 = p.k_rep * a * s.powf(p.n) / (rho * rho);
                 let rep2 = if far {
                     0.0
                 } else {
                     0.5 * p.n * p.k_rep * a * a * s.powf(p.n - 1.0) / p.rho_d_m
                 };
-                f += nb.normal * rep1 + u_goal * rep2;
+                f += nb.normal * rep1 + u_goal * rep2; // [W eq. 10]
             }
         }
     });
-    f
+    f // [W eq. 5] (classic) / [W eq. 15] (improved): the sum of the forces
 }
 
 /// Outcome of one descent.
@@ -394,6 +403,10 @@ pub fn descend(
         }
     }
 }
+
+/// Name of the local-minimum escape (a tangent-bug move along the nearest
+/// obstacle's boundary), as summaries report it.
+pub const ESCAPE_STRATEGY: &str = "boundary-following";
 
 /// Closest the boundary-following escape goes to an obstacle [m].
 const MIN_FOLLOW_CLEARANCE_M: f64 = 0.05;

@@ -13,8 +13,11 @@ use std::collections::BinaryHeap;
 use autoshovel_core::{polyline_length, Vec2};
 use serde::{Deserialize, Serialize};
 
-use crate::error::{PropelError, Result};
+use crate::error::{NoPathFault, PropelError, Result};
 use crate::map::Map;
+
+/// Name of the reference planner, as summaries report it.
+pub const REFERENCE_PLANNER: &str = "theta-star";
 
 /// Grid A* parameters.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -74,7 +77,7 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
     let res = p.resolution_m;
     if !(res.is_finite() && res > 0.0) {
         return Err(PropelError::NoPath {
-            why: format!("resolution_m = {res} must be positive"),
+            fault: NoPathFault::BadResolution { resolution_m: res },
         });
     }
     let span = map.max - map.min;
@@ -82,10 +85,11 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
     let ny = (span.y / res).ceil() as usize + 1;
     if nx.saturating_mul(ny) > p.max_cells {
         return Err(PropelError::NoPath {
-            why: format!(
-                "grid of {nx} x {ny} cells exceeds max_cells {}",
-                p.max_cells
-            ),
+            fault: NoPathFault::TooManyCells {
+                nx,
+                ny,
+                max_cells: p.max_cells,
+            },
         });
     }
     let center = |i: usize| map.min + Vec2::new((i % nx) as f64 * res, (i / nx) as f64 * res);
@@ -114,16 +118,18 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
             .find(|&i| free[i])
     };
     let s = snap(start).ok_or_else(|| PropelError::NoPath {
-        why: format!(
-            "start ({:.2}, {:.2}) has no free cell near it",
-            start.x, start.y
-        ),
+        fault: NoPathFault::NoFreeCell {
+            which: "start",
+            x: start.x,
+            y: start.y,
+        },
     })?;
     let g = snap(goal).ok_or_else(|| PropelError::NoPath {
-        why: format!(
-            "goal ({:.2}, {:.2}) has no free cell near it",
-            goal.x, goal.y
-        ),
+        fault: NoPathFault::NoFreeCell {
+            which: "goal",
+            x: goal.x,
+            y: goal.y,
+        },
     })?;
     let h = |i: usize| {
         let dx = ((i % nx) as f64 - (g % nx) as f64).abs();
@@ -210,7 +216,7 @@ pub fn astar(map: &Map, start: Vec2, goal: Vec2, r_fp: f64, p: &AstarParams) -> 
     }
     if !closed[g] {
         return Err(PropelError::NoPath {
-            why: format!("goal unreachable after expanding {expanded} cells"),
+            fault: NoPathFault::Unreachable { expanded },
         });
     }
     let mut cells = vec![g];

@@ -19,6 +19,7 @@ pub mod apf;
 pub mod astar;
 mod error;
 pub mod map;
+pub mod outcome;
 pub mod path;
 pub mod plan;
 pub mod scenario;
@@ -27,8 +28,13 @@ pub mod study;
 
 pub use apf::{ApfParams, FieldKind};
 pub use astar::{astar, AstarParams, Route};
+pub use error::{NoPathFault, PoseFault};
 pub use error::{PropelError, Result};
 pub use map::{Boundary, Map, Obstacle, Shape};
+pub use outcome::{
+    reference_comparison, Failure, PlanOutcome, PlanPathSummary, ReferenceComparison,
+    DEFAULT_HEADING_TOLERANCE_DEG,
+};
 pub use path::{Direction, Leg, Path, PathPoint};
 pub use plan::{plan_path, LegStats, Plan, PlanMetrics, PlanOptions};
 pub use scenario::Scenario;

@@ -9,7 +9,7 @@ use autoshovel_core::{angle_diff, heading_vec, Pose2, Vec2};
 use serde::Serialize;
 
 use crate::apf::{descend, ApfParams, FieldKind, Target};
-use crate::error::{PropelError, Result};
+use crate::error::{PoseFault, PropelError, Result};
 use crate::map::Map;
 use crate::path::{Direction, Leg, Path, PathPoint};
 use crate::scenario::Scenario;
@@ -112,29 +112,32 @@ fn check_pose(
     motion_heading: f64,
     arriving: bool,
 ) -> Result<()> {
-    let bad = |why: String| PropelError::BadPose {
+    let bad = |fault: PoseFault| PropelError::BadPose {
         which,
         x: pose.x,
         y: pose.y,
-        why,
+        fault,
     };
     if !pose.is_finite() {
-        return Err(bad(format!("not finite (heading {})", pose.theta)));
+        return Err(bad(PoseFault::NotFinite {
+            heading_rad: pose.theta,
+        }));
     }
     let p = pose.position();
     if !map.contains(p) {
-        return Err(bad(format!(
-            "outside the site [{}, {}] x [{}, {}]",
-            map.min.x, map.max.x, map.min.y, map.max.y
-        )));
+        return Err(bad(PoseFault::OutsideSite {
+            min_m: [map.min.x, map.min.y],
+            max_m: [map.max.x, map.max.y],
+        }));
     }
     let nb = map.nearest(p);
     let c = nb.distance - r_fp;
     if c <= 0.0 {
-        return Err(bad(format!(
-            "too close to '{}': footprint clearance {c:.3} m (footprint radius {r_fp} m)",
-            map.element_name(nb.element)
-        )));
+        return Err(bad(PoseFault::TooClose {
+            element: map.element_name(nb.element).to_string(),
+            clearance_m: c,
+            footprint_radius_m: r_fp,
+        }));
     }
     // The stretch the machine must travel straight along its heading.
     let h = heading_vec(motion_heading) * if arriving { -1.0 } else { 1.0 };
@@ -142,12 +145,12 @@ fn check_pose(
         let q = p + h * (APPROACH_CHECK_M * i as f64 / 10.0);
         let nb = map.nearest(q);
         if nb.distance - r_fp <= 0.0 {
-            return Err(bad(format!(
-                "reachable only by turning on the spot: heading {:.1} deg is blocked by '{}' within {APPROACH_CHECK_M} m {}",
-                pose.theta.to_degrees(),
-                map.element_name(nb.element),
-                if arriving { "behind it" } else { "ahead of it" }
-            )));
+            return Err(bad(PoseFault::HeadingBlocked {
+                heading_deg: pose.theta.to_degrees(),
+                element: map.element_name(nb.element).to_string(),
+                within_m: APPROACH_CHECK_M,
+                arriving,
+            }));
         }
     }
     Ok(())
@@ -165,11 +168,7 @@ pub fn plan_path(scenario: &Scenario, opts: &PlanOptions) -> Result<Plan> {
     let r_fp = scenario.footprint_radius_m;
     opts.apf
         .validate()
-        .map_err(|(name, v)| PropelError::Invalid {
-            file: "<planner options>".into(),
-            line: 0,
-            what: format!("{name} = {v} is out of range"),
-        })?;
+        .map_err(|(name, value)| PropelError::BadOption { name, value })?;
     let legs_spec = scenario.legs();
     for (i, (from, to, dir)) in legs_spec.iter().enumerate() {
         let which_from = if i == 0 { "start" } else { "midpoint" };

@@ -37,9 +37,9 @@
 
 use std::path::Path as FsPath;
 
-use autoshovel_core::config::line_col;
+use autoshovel_core::config::{self, line_col, line_of_key, TomlFile};
 use autoshovel_core::{rad, Pose2, Vec2};
-use serde::Deserialize;
+use serde::{Deserialize, Serialize};
 use toml::Spanned;
 
 use crate::error::{PropelError, Result};
@@ -94,8 +94,8 @@ impl Scenario {
 
     /// A built-in scenario by name.
     pub fn builtin(name: &str) -> Option<Scenario> {
-        BUILTINS.iter().find(|(n, _)| *n == name).map(|(n, text)| {
-            Scenario::from_toml(text, &format!("<builtin {n}>"))
+        builtin_text(name).ok().map(|text| {
+            Scenario::from_toml(text, &format!("<builtin {name}>"))
                 .expect("built-in scenarios are valid")
         })
     }
@@ -111,41 +111,49 @@ impl Scenario {
         }
         Err(PropelError::UnknownScenario {
             name: name_or_path.to_string(),
-            known: BUILTINS
-                .iter()
-                .map(|(n, _)| *n)
-                .collect::<Vec<_>>()
-                .join(", "),
+            known: builtin_names(),
         })
     }
 
     /// Reads a TOML scenario file.
     pub fn load(path: &FsPath) -> Result<Scenario> {
-        let text = std::fs::read_to_string(path).map_err(|source| PropelError::Io {
+        let text = config::read(path).map_err(|source| PropelError::UnreadableScenario {
             path: path.to_path_buf(),
-            source,
+            source: Box::new(source),
         })?;
         Scenario::from_toml(&text, &path.display().to_string())
     }
 
     /// Parses and validates TOML text; `file` names it in errors.
     pub fn from_toml(text: &str, file: &str) -> Result<Scenario> {
-        let raw: ScenarioFile = toml::from_str(text).map_err(|e| {
-            let (line, column) = e.span().map(|s| line_col(text, s.start)).unwrap_or((0, 0));
-            PropelError::Parse {
-                file: file.to_string(),
-                line,
-                column,
-                message: e.message().to_string(),
-            }
-        })?;
-        raw.validate(text, file)
+        let raw: ScenarioFile = config::parse(text, file)?;
+        raw.to_scenario(text, file)
     }
 }
 
-#[derive(Debug, Deserialize)]
+/// The names of the built-in scenarios, in [`BUILTINS`] order.
+pub fn builtin_names() -> Vec<&'static str> {
+    BUILTINS.iter().map(|(n, _)| *n).collect()
+}
+
+/// The TOML text of a built-in scenario (with its comments), to print and
+/// edit; an unknown name is [`PropelError::UnknownBuiltin`] listing the names.
+pub fn builtin_text(name: &str) -> Result<&'static str> {
+    BUILTINS
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, text)| *text)
+        .ok_or_else(|| PropelError::UnknownBuiltin {
+            name: name.to_string(),
+            known: builtin_names(),
+        })
+}
+
+/// A scenario file as written (the raw layer): deserialised with spans so
+/// that [`ScenarioFile::to_scenario`] can name the line of a bad value.
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
-struct ScenarioFile {
+pub struct ScenarioFile {
     name: Option<String>,
     footprint_radius_m: Option<Spanned<f64>>,
     direction: Option<Direction>,
@@ -161,14 +169,14 @@ struct ScenarioFile {
     boundary: Vec<Spanned<BoundarySpec>>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct SiteSpec {
     min_m: [f64; 2],
     max_m: [f64; 2],
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct PoseSpec {
     x_m: f64,
@@ -176,7 +184,7 @@ struct PoseSpec {
     heading_deg: f64,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct CircleSpec {
     name: Option<String>,
@@ -184,14 +192,14 @@ struct CircleSpec {
     radius_m: f64,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct PolygonSpec {
     name: Option<String>,
     vertices_m: Vec<[f64; 2]>,
 }
 
-#[derive(Debug, Deserialize)]
+#[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct BoundarySpec {
     name: Option<String>,
@@ -201,52 +209,70 @@ struct BoundarySpec {
 /// Default footprint radius: the 1:7 prototype's half-width plus a margin [m].
 pub const DEFAULT_FOOTPRINT_RADIUS_M: f64 = 1.0;
 
+impl TomlFile for ScenarioFile {
+    type Error = PropelError;
+
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        self.to_scenario(text, file).map(drop)
+    }
+}
+
+/// Largest |coordinate| a site may have [m] (a planning site, not a globe).
+const MAX_COORDINATE_M: f64 = 1e6;
+/// Largest side of a site [m].
+const MAX_SITE_EXTENT_M: f64 = 10_000.0;
+/// Most vertices of a polygon obstacle.
+const MAX_POLYGON_VERTICES: usize = 1000;
+
 impl ScenarioFile {
-    fn validate(self, text: &str, file: &str) -> Result<Scenario> {
-        let err = |span: std::ops::Range<usize>, what: String| PropelError::Invalid {
-            file: file.to_string(),
-            line: line_col(text, span.start).0,
-            what,
-        };
-        // The line of `key` inside a table's span (the header's line if not found).
-        let key_line = |span: &std::ops::Range<usize>, key: &str| -> usize {
-            let start = span.start.min(text.len());
-            let end = span.end.min(text.len());
-            let body = &text[start..end];
-            let mut offset = start;
-            for l in body.split_inclusive('\n') {
-                let t = l.trim_start();
-                if t.starts_with(key) && t[key.len()..].trim_start().starts_with('=') {
-                    return line_col(text, offset).0;
+    /// Checks every number (finite, in range) and polygon (convex) and
+    /// builds the scenario; `text` and `file` locate a bad value.
+    pub fn to_scenario(&self, text: &str, file: &str) -> Result<Scenario> {
+        // The line a span starts on (a table's header, a top-level value).
+        let line_at = |span: std::ops::Range<usize>| line_col(text, span.start).0;
+        // Every number finite and within ±1000 km; `table` and `occurrence`
+        // locate the key, `item` names the element in the message.
+        let finite = |(table, occurrence): (&str, usize),
+                      item: &str,
+                      vals: &[(&'static str, f64)]|
+         -> Result<()> {
+            match vals
+                .iter()
+                .find(|(_, v)| !v.is_finite() || v.abs() > MAX_COORDINATE_M)
+            {
+                Some(&(key, value)) => {
+                    let line = line_of_key(text, table, occurrence, key);
+                    let (file, key) = (file.to_string(), format!("{item}: {key}"));
+                    Err(if value.is_finite() {
+                        PropelError::BeyondSite {
+                            file,
+                            line,
+                            key,
+                            value,
+                        }
+                    } else {
+                        PropelError::NonFinite {
+                            file,
+                            line,
+                            key,
+                            value,
+                        }
+                    })
                 }
-                offset += l.len();
+                None => Ok(()),
             }
-            line_col(text, start).0
         };
-        // Every number finite and within ±1000 km (a planning site, not a globe).
-        let finite =
-            |span: &std::ops::Range<usize>, what: &str, vals: &[(&str, f64)]| -> Result<()> {
-                match vals.iter().find(|(_, v)| !v.is_finite() || v.abs() > 1e6) {
-                    Some((key, v)) => Err(PropelError::Invalid {
-                        file: file.to_string(),
-                        line: key_line(span, key),
-                        what: if v.is_finite() {
-                            format!("{what}: {key} has {v:e}, beyond the ±1e6 m a site may span")
-                        } else {
-                            format!("{what}: {key} has a non-finite number ({v})")
-                        },
-                    }),
-                    None => Ok(()),
-                }
-            };
         let r_fp = match &self.footprint_radius_m {
             Some(s) => {
                 let v = *s.get_ref();
                 if !(v.is_finite() && v > 0.0 && v < 1e3) {
-                    return Err(err(
-                        s.span(),
-                        format!("footprint_radius_m = {v} must be a positive number below 1000"),
-                    ));
+                    return Err(PropelError::OutOfRange {
+                        file: file.to_string(),
+                        line: line_at(s.span()),
+                        key: "footprint_radius_m".into(),
+                        value: v,
+                        expected: "a positive number below 1000",
+                    });
                 }
                 v
             }
@@ -254,7 +280,7 @@ impl ScenarioFile {
         };
         let site = self.site.get_ref();
         finite(
-            &self.site.span(),
+            ("site", 0),
             "[site]",
             &[
                 ("min_m", site.min_m[0]),
@@ -264,20 +290,21 @@ impl ScenarioFile {
             ],
         )?;
         if !(site.max_m[0] > site.min_m[0] && site.max_m[1] > site.min_m[1]) {
-            return Err(err(
-                self.site.span(),
-                format!(
-                    "[site] max_m {:?} must exceed min_m {:?} in x and y",
-                    site.max_m, site.min_m
-                ),
-            ));
+            return Err(PropelError::SiteInverted {
+                file: file.to_string(),
+                line: line_at(self.site.span()),
+                min_m: site.min_m,
+                max_m: site.max_m,
+            });
         }
         let extent = (site.max_m[0] - site.min_m[0]).max(site.max_m[1] - site.min_m[1]);
-        if extent > 10_000.0 {
-            return Err(err(
-                self.site.span(),
-                format!("[site] spans {extent} m; planning sites are limited to 10 km"),
-            ));
+        if extent > MAX_SITE_EXTENT_M {
+            return Err(PropelError::SiteTooLarge {
+                file: file.to_string(),
+                line: line_at(self.site.span()),
+                extent_m: extent,
+                limit_m: MAX_SITE_EXTENT_M,
+            });
         }
         let mut map = Map::new(
             Vec2::new(site.min_m[0], site.min_m[1]),
@@ -286,7 +313,7 @@ impl ScenarioFile {
         let pose = |s: &Spanned<PoseSpec>, which: &str| -> Result<Pose2> {
             let p = s.get_ref();
             finite(
-                &s.span(),
+                (which, 0),
                 &format!("[{which}]"),
                 &[
                     ("x_m", p.x_m),
@@ -304,14 +331,14 @@ impl ScenarioFile {
         };
         for (i, c) in self.circle.iter().enumerate() {
             let spec = c.get_ref();
-            let what = format!(
+            let item = format!(
                 "circle #{} '{}'",
                 i + 1,
                 spec.name.as_deref().unwrap_or("circle")
             );
             finite(
-                &c.span(),
-                &what,
+                ("circle", i),
+                &item,
                 &[
                     ("center_m", spec.center_m[0]),
                     ("center_m", spec.center_m[1]),
@@ -319,10 +346,12 @@ impl ScenarioFile {
                 ],
             )?;
             if spec.radius_m <= 0.0 {
-                return Err(PropelError::Invalid {
+                return Err(PropelError::OutOfRange {
                     file: file.to_string(),
-                    line: key_line(&c.span(), "radius_m"),
-                    what: format!("{what}: radius_m = {} must be positive", spec.radius_m),
+                    line: line_of_key(text, "circle", i, "radius_m"),
+                    key: format!("{item}: radius_m"),
+                    value: spec.radius_m,
+                    expected: "positive",
                 });
             }
             map.obstacles.push(Obstacle {
@@ -338,7 +367,7 @@ impl ScenarioFile {
         }
         for (i, p) in self.polygon.iter().enumerate() {
             let spec = p.get_ref();
-            let what = format!(
+            let item = format!(
                 "polygon #{} '{}'",
                 i + 1,
                 spec.name.as_deref().unwrap_or("polygon")
@@ -349,23 +378,33 @@ impl ScenarioFile {
                 .flatten()
                 .map(|v| ("vertices_m", *v))
                 .collect();
-            finite(&p.span(), &what, &flat)?;
-            if spec.vertices_m.len() > 1000 {
-                return Err(err(
-                    p.span(),
-                    format!(
-                        "{what} has {} vertices; at most 1000",
-                        spec.vertices_m.len()
-                    ),
-                ));
+            finite(("polygon", i), &item, &flat)?;
+            if spec.vertices_m.len() > MAX_POLYGON_VERTICES {
+                return Err(PropelError::PointCount {
+                    file: file.to_string(),
+                    line: line_at(p.span()),
+                    item,
+                    count: spec.vertices_m.len(),
+                    what: "vertices",
+                    limit: "at most 1000",
+                });
             }
             let verts = spec
                 .vertices_m
                 .iter()
                 .map(|v| Vec2::new(v[0], v[1]))
                 .collect();
-            let verts =
-                convex_polygon(verts).map_err(|fault| err(p.span(), format!("{what} {fault}")))?;
+            let verts = match convex_polygon(verts) {
+                Ok(v) => v,
+                Err(fault) => {
+                    return Err(PropelError::BadPolygon {
+                        file: file.to_string(),
+                        line: line_at(p.span()),
+                        item,
+                        fault,
+                    })
+                }
+            };
             map.obstacles.push(Obstacle {
                 name: spec
                     .name
@@ -376,7 +415,7 @@ impl ScenarioFile {
         }
         for (i, b) in self.boundary.iter().enumerate() {
             let spec = b.get_ref();
-            let what = format!(
+            let item = format!(
                 "boundary #{} '{}'",
                 i + 1,
                 spec.name.as_deref().unwrap_or("boundary")
@@ -387,15 +426,16 @@ impl ScenarioFile {
                 .flatten()
                 .map(|v| ("points_m", *v))
                 .collect();
-            finite(&b.span(), &what, &flat)?;
+            finite(("boundary", i), &item, &flat)?;
             if spec.points_m.len() < 2 {
-                return Err(err(
-                    b.span(),
-                    format!(
-                        "{what} has {} points, needs at least 2",
-                        spec.points_m.len()
-                    ),
-                ));
+                return Err(PropelError::PointCount {
+                    file: file.to_string(),
+                    line: line_at(b.span()),
+                    item,
+                    count: spec.points_m.len(),
+                    what: "points",
+                    limit: "needs at least 2",
+                });
             }
             map.boundaries.push(Boundary {
                 name: spec
@@ -410,7 +450,7 @@ impl ScenarioFile {
             });
         }
         Ok(Scenario {
-            name: self.name.unwrap_or_else(|| file.to_string()),
+            name: self.name.clone().unwrap_or_else(|| file.to_string()),
             map,
             footprint_radius_m: r_fp,
             start,

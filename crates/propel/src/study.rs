@@ -3,6 +3,11 @@
 //! with the classic field, the improved field and the Theta* reference, to
 //! measure success rate, local minima, length ratio to the reference,
 //! clearance and final heading error.
+//!
+//! "Success" and the reference comparison are those of
+//! [`crate::outcome`], the same rule as `autoshovel plan-path`'s (every leg
+//! within the heading tolerance, the reference run leg by leg); the roads
+//! here have one leg, so the rule is "the final heading within tolerance".
 
 use autoshovel_core::{angle_diff, heading_vec, perp, Pose2, Vec2};
 use rand::{Rng, SeedableRng};
@@ -10,11 +15,11 @@ use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
 use crate::apf::FieldKind;
-use crate::astar::{astar, AstarParams};
-use crate::error::PropelError;
+use crate::astar::REFERENCE_PLANNER;
 use crate::map::{convex_polygon, Boundary, Map, Obstacle, Shape};
+use crate::outcome::{reference_length_m, reference_routes, PlanOutcome};
 use crate::path::Direction;
-use crate::plan::{plan_path, PlanOptions};
+use crate::plan::PlanOptions;
 use crate::scenario::Scenario;
 
 /// Parameters of the study.
@@ -42,7 +47,7 @@ impl Default for StudyParams {
             min_obstacles: 3,
             max_obstacles: 12,
             road_length_m: 60.0,
-            heading_tolerance_deg: 2.0,
+            heading_tolerance_deg: crate::outcome::DEFAULT_HEADING_TOLERANCE_DEG,
         }
     }
 }
@@ -172,54 +177,64 @@ pub struct MapRow {
     pub improved: Outcome,
 }
 
-fn outcome(scenario: &Scenario, field: FieldKind, tol_deg: f64) -> Outcome {
-    match plan_path(scenario, &PlanOptions::new(field)) {
+impl MapRow {
+    /// The outcome of one field on this map.
+    pub fn outcome(&self, field: FieldKind) -> &Outcome {
+        match field {
+            FieldKind::Classic => &self.classic,
+            FieldKind::Improved => &self.improved,
+        }
+    }
+}
+
+/// Judges one attempt with the rule of [`crate::outcome`] (the same as
+/// `plan-path`'s).
+fn outcome(attempt: &PlanOutcome, tol_deg: f64) -> Outcome {
+    let error = attempt.failure(tol_deg).map(|f| f.to_string());
+    match &attempt.plan {
         Ok(plan) => {
-            let m = plan.metrics;
+            let m = &plan.metrics;
             Outcome {
                 reached: true,
-                success: m.final_heading_error_deg <= tol_deg,
+                success: error.is_none(),
                 local_minimum: false,
                 length_m: m.length_m,
                 min_clearance_m: m.min_clearance_m,
                 final_heading_error_deg: m.final_heading_error_deg,
                 escapes: m.escapes,
                 plan_time_ms: m.plan_time_ms,
-                error: None,
+                error,
             }
         }
         Err(e) => Outcome {
             reached: false,
             success: false,
-            local_minimum: matches!(e, PropelError::LocalMinimum { .. }),
+            local_minimum: e.is_local_minimum(),
             length_m: f64::NAN,
             min_clearance_m: f64::NAN,
             final_heading_error_deg: f64::NAN,
             escapes: 0,
             plan_time_ms: f64::NAN,
-            error: Some(e.to_string()),
+            error,
         },
     }
 }
 
-/// Runs the study on map `index`.
+/// Runs the study on map `index`: the reference once (leg by leg, as
+/// `plan-path` runs it), then both fields against it.
 pub fn run_map(params: &StudyParams, index: usize) -> MapRow {
     let s = random_road(params, index);
-    let reference = astar(
-        &s.map,
-        s.start.position(),
-        s.goal.position(),
-        s.footprint_radius_m,
-        &AstarParams::default(),
-    )
-    .ok()
-    .map(|r| r.length_m);
+    let reference = reference_routes(&s);
+    let judge = |field: FieldKind| {
+        let attempt = PlanOutcome::with_reference(&s, PlanOptions::new(field), reference.clone());
+        outcome(&attempt, params.heading_tolerance_deg)
+    };
     MapRow {
         index,
         obstacles: s.map.obstacles.len(),
-        reference_length_m: reference,
-        classic: outcome(&s, FieldKind::Classic, params.heading_tolerance_deg),
-        improved: outcome(&s, FieldKind::Improved, params.heading_tolerance_deg),
+        reference_length_m: reference.as_deref().map(reference_length_m),
+        classic: judge(FieldKind::Classic),
+        improved: judge(FieldKind::Improved),
     }
 }
 
@@ -227,7 +242,7 @@ pub fn run_map(params: &StudyParams, index: usize) -> MapRow {
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Aggregate {
     /// Planner name.
-    pub planner: String,
+    pub planner: &'static str,
     /// Maps counted (those the reference solves).
     pub maps: usize,
     /// Share reaching the goal collision-free [%].
@@ -256,32 +271,35 @@ pub struct Aggregate {
     pub mean_plan_time_ms: f64,
 }
 
-/// Aggregates rows for one planner (`pick` selects its outcome).
-pub fn aggregate(rows: &[MapRow], planner: &str, pick: impl Fn(&MapRow) -> &Outcome) -> Aggregate {
+/// Aggregates rows for one field.
+pub fn aggregate(rows: &[MapRow], field: FieldKind) -> Aggregate {
+    let pick = |r: &MapRow| r.outcome(field).clone();
     let solved: Vec<&MapRow> = rows
         .iter()
         .filter(|r| r.reference_length_m.is_some())
         .collect();
     let n = solved.len().max(1) as f64;
-    let reached: Vec<(&MapRow, &Outcome)> = solved
+    let reached: Vec<(&MapRow, Outcome)> = solved
         .iter()
         .map(|r| (*r, pick(r)))
         .filter(|(_, o)| o.reached)
         .collect();
     let m = reached.len().max(1) as f64;
-    let ratio =
-        |(r, o): &(&MapRow, &Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
+    let ratio = |(r, o): &(&MapRow, Outcome)| o.length_m / r.reference_length_m.unwrap_or(f64::NAN);
     let max = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::max);
     let min = |it: &mut dyn Iterator<Item = f64>| it.fold(f64::NAN, f64::min);
     Aggregate {
-        planner: planner.to_string(),
+        planner: field.name(),
         maps: solved.len(),
         reached_pct: 100.0 * reached.len() as f64 / n,
-        success_pct: 100.0 * solved.iter().filter(|r| pick(r).success).count() as f64 / n,
-        local_minima: solved.iter().filter(|r| pick(r).local_minimum).count(),
+        success_pct: 100.0 * solved.iter().filter(|r| r.outcome(field).success).count() as f64 / n,
+        local_minima: solved
+            .iter()
+            .filter(|r| r.outcome(field).local_minimum)
+            .count(),
         other_failures: solved
             .iter()
-            .filter(|r| !pick(r).reached && !pick(r).local_minimum)
+            .filter(|r| !r.outcome(field).reached && !r.outcome(field).local_minimum)
             .count(),
         mean_length_ratio: reached.iter().map(ratio).sum::<f64>() / m,
         max_length_ratio: max(&mut reached.iter().map(ratio)),
@@ -297,6 +315,96 @@ pub fn aggregate(rows: &[MapRow], planner: &str, pick: impl Fn(&MapRow) -> &Outc
             .map(|(_, o)| o.final_heading_error_deg)),
         maps_with_escapes: reached.iter().filter(|(_, o)| o.escapes > 0).count(),
         mean_plan_time_ms: reached.iter().map(|(_, o)| o.plan_time_ms).sum::<f64>() / m,
+    }
+}
+
+/// Success rate [%] of `field` by obstacle count, over the maps the
+/// reference solves: `(obstacles, percent)` for each count in
+/// `min_obstacles..=max_obstacles` that has such maps.
+pub fn success_by_obstacles(
+    params: &StudyParams,
+    rows: &[MapRow],
+    field: FieldKind,
+) -> Vec<(usize, f64)> {
+    (params.min_obstacles..=params.max_obstacles)
+        .filter_map(|n| {
+            let sel: Vec<&MapRow> = rows
+                .iter()
+                .filter(|r| r.obstacles == n && r.reference_length_m.is_some())
+                .collect();
+            if sel.is_empty() {
+                return None;
+            }
+            let ok = sel.iter().filter(|r| r.outcome(field).success).count();
+            Some((n, 100.0 * ok as f64 / sel.len() as f64))
+        })
+        .collect()
+}
+
+/// The fields the study compares, in the order of its tables.
+pub const FIELDS: [FieldKind; 2] = [FieldKind::Classic, FieldKind::Improved];
+
+/// The reference's part of the study summary.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StudyReference {
+    /// The reference planner's name.
+    pub planner: &'static str,
+    /// Maps it solves.
+    pub solved: usize,
+    /// Share of maps it solves [%].
+    pub solved_pct: f64,
+}
+
+/// The summary of `autoshovel study-paths` (SPEC §6).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StudySummary {
+    /// Always `study-paths`.
+    pub job: &'static str,
+    /// The command that reproduces the study.
+    pub command: String,
+    /// Maps planned.
+    pub maps: usize,
+    /// Seed of the map generator.
+    pub seed: u64,
+    /// Heading tolerance of success [deg].
+    pub heading_tolerance_deg: f64,
+    /// The reference planner's record.
+    pub reference: StudyReference,
+    /// One aggregate per field, in [`FIELDS`] order.
+    pub planners: Vec<Aggregate>,
+    /// The study ran (its findings are in `planners`).
+    pub success: bool,
+}
+
+impl StudyParams {
+    /// The command line that reproduces a study with these parameters.
+    pub fn command(&self) -> String {
+        format!(
+            "autoshovel study-paths --maps {} --seed {} --min-obstacles {} --max-obstacles {}",
+            self.maps, self.seed, self.min_obstacles, self.max_obstacles
+        )
+    }
+}
+
+/// Summarises the rows of a study run with `params`.
+pub fn summarize(params: &StudyParams, rows: &[MapRow]) -> StudySummary {
+    let solved = rows
+        .iter()
+        .filter(|r| r.reference_length_m.is_some())
+        .count();
+    StudySummary {
+        job: "study-paths",
+        command: params.command(),
+        maps: params.maps,
+        seed: params.seed,
+        heading_tolerance_deg: params.heading_tolerance_deg,
+        reference: StudyReference {
+            planner: REFERENCE_PLANNER,
+            solved,
+            solved_pct: 100.0 * solved as f64 / params.maps as f64,
+        },
+        planners: FIELDS.iter().map(|f| aggregate(rows, *f)).collect(),
+        success: true,
     }
 }
 
@@ -327,8 +435,8 @@ mod tests {
             ..Default::default()
         };
         let rows: Vec<MapRow> = (0..p.maps).map(|i| run_map(&p, i)).collect();
-        let c = aggregate(&rows, "apf", |r| &r.classic);
-        let i = aggregate(&rows, "improved-apf", |r| &r.improved);
+        let c = aggregate(&rows, FieldKind::Classic);
+        let i = aggregate(&rows, FieldKind::Improved);
         assert!(c.maps > 10);
         assert!(i.success_pct > c.success_pct);
         assert!(
