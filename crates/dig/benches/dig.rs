@@ -31,7 +31,7 @@ fn whole_plan(c: &mut Criterion) {
         let params = GwoParams {
             seed: 1,
             parallel,
-            ..GwoParams::default()
+            ..autoshovel_dig::gwo_preset()
         };
         let name = if parallel { "parallel" } else { "serial" };
         g.bench_function(name, |b| b.iter(|| plan_dig(&m, &params, &[]).unwrap()));

@@ -10,19 +10,35 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod calibrate;
+pub mod compare;
 pub mod dynamics;
 mod error;
+pub mod job;
 pub mod kinematics;
+pub mod pack;
+pub mod paper;
 pub mod plan;
 pub mod profile;
+pub mod scan;
 pub mod terrain;
 pub mod trajectory;
 
 pub use autoshovel_core::config::TomlFile;
-pub use error::{DigError, Result};
+pub use compare::{
+    all_surfaces, table_summary, AllSurfaces, AllSurfacesSummary, ComparedPile, PaperPlanCheck,
+    SurfaceComparison, TableColumn, TableRow, TableSummary, TABLE_COLUMNS,
+};
+pub use error::{DigError, PackProblem, Result};
+pub use job::{
+    plan_pile, ConstraintReport, DigHeader, DigSetup, DigSummary, Pile, PlanFields, PlannedPile,
+    WarmStart, WarmStartSummary, BUILTIN_PROFILE_NAME,
+};
+pub use pack::{read_pack, write_pack, PACK_COLUMNS};
+pub use paper::{paper_row, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
+pub use scan::{cut_scan, PerceptionFacts, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
 pub use kinematics::{Joints, RopeShovel};
 pub use plan::{
-    plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace,
+    gwo_preset, plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace,
     CONSTRAINT_NAMES, CONSTRAINT_UNITS,
 };
 pub use profile::{Geometry, MachineProfile};

@@ -28,7 +28,7 @@
 //! as is, time by t_max, angles in radians, speeds, forces and powers by
 //! their ratings, heights by H_tl, stroke by L_dg) and summed.
 
-use autoshovel_optim::{minimize, Evaluation, GwoParams, GwoResult, Problem};
+use autoshovel_optim::{minimize, Constraints, Evaluation, GwoParams, GwoResult, Init, Problem};
 
 use crate::dynamics::{inverse_dynamics, Drive, MassModel};
 use crate::error::{DigError, Result};
@@ -80,6 +80,16 @@ pub enum Bound {
     Min,
     /// The quantity must be at most the limit.
     Max,
+}
+
+impl Bound {
+    /// `min` or `max`, as summaries print it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Bound::Min => "min",
+            Bound::Max => "max",
+        }
+    }
 }
 
 /// One constraint's limit.
@@ -191,6 +201,16 @@ pub enum SearchSpace {
     Bends,
     /// The paper's [a_x6, a_y6, t_d, g_x, g_y].
     Paper,
+}
+
+impl SearchSpace {
+    /// The coordinates' name as summaries print it: `bends` or `paper`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchSpace::Bends => "bends",
+            SearchSpace::Paper => "paper",
+        }
+    }
 }
 
 impl std::str::FromStr for SearchSpace {
@@ -551,6 +571,20 @@ impl Problem for DigModel {
     fn evaluate(&self, x: &[f64]) -> Evaluation {
         let out = DigModel::evaluate(self, &self.decision(x));
         Evaluation::new(out.f, out.violation)
+    }
+}
+
+/// The dig planner's Grey Wolf Optimizer setting (rope-shovel paper §4.6):
+/// 50 wolves, 100 iterations, good-point-set start ([RS eq. 36]),
+/// feasibility rules, seed 0, parallel evaluation.
+pub fn gwo_preset() -> GwoParams {
+    GwoParams {
+        population: 50,
+        iterations: 100,
+        init: Init::GoodPointSet,
+        constraints: Constraints::FeasibilityRules,
+        seed: 0,
+        parallel: true,
     }
 }
 

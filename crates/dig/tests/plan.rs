@@ -1,17 +1,10 @@
 //! The dig planner against the rope-shovel paper's Tables 4–5, and its
 //! refusals.
 
-use autoshovel_dig::{plan_dig, DigError, DigModel, DigSurface, MachineProfile, SearchSpace};
+use autoshovel_dig::{gwo_preset, plan_dig, DigError, PAPER_TABLES_4_5, DigModel, DigSurface, MachineProfile, SearchSpace};
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
 
-/// Table 5: (shape, f, f1 [J/kg], m_dig [kg], fill).
-const TABLE5: [(PileShape, f64, f64, f64, f64); 4] = [
-    (PileShape::Typical, 13.76, 17.19, 2.053, 0.9972),
-    (PileShape::Concave, 13.83, 17.22, 1.991, 0.9671),
-    (PileShape::Convex, 13.87, 17.51, 2.156, 1.047),
-    (PileShape::ConvexConcave, 12.57, 15.55, 2.045, 0.9929),
-];
 
 fn model(shape: PileShape) -> DigModel {
     let p = MachineProfile::scale_model();
@@ -21,13 +14,14 @@ fn model(shape: PileShape) -> DigModel {
 fn gwo(seed: u64) -> GwoParams {
     GwoParams {
         seed,
-        ..GwoParams::default()
+        ..gwo_preset()
     }
 }
 
 #[test]
 fn all_four_piles_reproduce_table_5() {
-    for (shape, f, f1, m_dig, _) in TABLE5 {
+    for row in &PAPER_TABLES_4_5 {
+        let (shape, f, f1, m_dig) = (row.shape, row.f, row.f1_j_per_kg, row.m_dig_kg);
         let plan = plan_dig(&model(shape), &gwo(1), &[]).unwrap();
         let o = &plan.outcome;
         assert!(o.feasible(), "{shape:?}: {:?}", o.violated());
@@ -42,7 +36,7 @@ fn all_four_piles_reproduce_table_5() {
             "{shape:?}: m_dig {} vs {m_dig}",
             o.m_dig_kg
         );
-        if shape == PileShape::Typical {
+        if row.calibrated() {
             // Calibrated here (k_F and ε of the embedded profile).
             assert!(
                 (o.f1_j_per_kg / f1 - 1.0).abs() < 0.02,

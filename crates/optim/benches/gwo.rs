@@ -47,7 +47,9 @@ fn bench_gwo(c: &mut Criterion) {
             init,
             parallel,
             seed: 1,
-            ..GwoParams::rope_shovel()
+            population: 50,
+            iterations: 100,
+            ..GwoParams::default()
         };
         group.bench_function(label, |b| {
             b.iter(|| minimize(black_box(&problem), &params, &[]).unwrap())

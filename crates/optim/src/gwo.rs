@@ -31,8 +31,20 @@ pub enum Init {
     Random,
 }
 
-/// Parameters of [`minimize`]. `Default` is the rope-shovel paper's setting
-/// (§4.6: 50 wolves, 100 iterations, good point set).
+impl Init {
+    /// The placement's name as summaries print it: `good-point-set` or `random`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Init::GoodPointSet => "good-point-set",
+            Init::Random => "random",
+        }
+    }
+}
+
+/// Parameters of [`minimize`]. `Default` is Mirjalili et al. 2014's
+/// benchmark setting ([`GwoParams::mirjalili_2014`]); an application's own
+/// preset lives with the application (the dig planner's in
+/// `autoshovel_dig::gwo_preset`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GwoParams {
     /// Number of wolves, ≥ 4 (α, β, δ and at least one ω).
@@ -54,32 +66,22 @@ pub struct GwoParams {
 
 impl Default for GwoParams {
     fn default() -> Self {
-        Self::rope_shovel()
+        Self::mirjalili_2014()
     }
 }
 
 impl GwoParams {
-    /// The rope-shovel paper's dig planner (§4.6): 50 wolves, 100
-    /// iterations, good-point-set start, feasibility rules.
-    pub fn rope_shovel() -> Self {
-        Self {
-            population: 50,
-            iterations: 100,
-            init: Init::GoodPointSet,
-            constraints: Constraints::FeasibilityRules,
-            seed: 0,
-            parallel: true,
-        }
-    }
-
     /// Mirjalili et al. 2014's benchmark setting (§4): 30 wolves, 500
-    /// iterations, random start.
+    /// iterations, random start; feasibility rules, seed 0, parallel
+    /// evaluation.
     pub fn mirjalili_2014() -> Self {
         Self {
             population: 30,
             iterations: 500,
             init: Init::Random,
-            ..Self::rope_shovel()
+            constraints: Constraints::FeasibilityRules,
+            seed: 0,
+            parallel: true,
         }
     }
 }
@@ -192,7 +194,8 @@ pub struct GwoResult {
 /// use autoshovel_optim::{benchmarks::Benchmark, minimize, GwoParams};
 ///
 /// let sphere = Benchmark::Sphere.problem(5);
-/// let res = minimize(&sphere, &GwoParams { iterations: 200, ..GwoParams::default() }, &[])?;
+/// let params = GwoParams { population: 50, iterations: 200, ..GwoParams::default() };
+/// let res = minimize(&sphere, &params, &[])?;
 /// assert!(res.best_eval.objective < 1e-12);
 /// assert_eq!(res.evaluations, 50 * 201);
 /// # Ok::<(), autoshovel_optim::OptimError>(())

@@ -21,7 +21,7 @@
 //!   results are bit-identical across runs and with parallel evaluation on
 //!   or off. GWO is biased towards the origin: pose variables on a box
 //!   centred at 0 (see [`minimize`]).
-//! - [`Init::GoodPointSet`] (default) or [`Init::Random`] places the
+//! - [`Init::GoodPointSet`] or [`Init::Random`] (the default setting's) places the
 //!   initial pack; warm-start wolves replace its first members.
 //! - [`Constraints::FeasibilityRules`] (default, Deb 2000) or
 //!   [`Constraints::Penalty`] ranks the wolves.
