@@ -217,11 +217,13 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     let sub = "plan-dig-all-surfaces";
     let dir = prepare_dir(&out.join(sub))?;
     let mut all = autoshovel_dig::all_surfaces(&setup, |_| {})?;
-    let piles = autoshovel_figures::dig::write_piles(&dir, &mut all).map_err(|e| anyhow::anyhow!(e))?;
+    let piles =
+        autoshovel_figures::dig::write_piles(&dir, &mut all).map_err(|e| anyhow::anyhow!(e))?;
     let job = crate::output::Job::finish(all.summary.clone(), Some(&dir), |dir, written| {
         written.plots.extend(piles.plots);
         written.files.extend(piles.files);
-        autoshovel_figures::dig::write_comparison(dir, &all, written).map_err(|e| anyhow::anyhow!(e))
+        autoshovel_figures::dig::write_comparison(dir, &all, written)
+            .map_err(|e| anyhow::anyhow!(e))
     })?;
     let key = "plan-dig --all-surfaces";
     if !json_only {

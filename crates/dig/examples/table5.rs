@@ -4,7 +4,9 @@
 //!
 //! `cargo run --release -p autoshovel-dig --example table5`
 
-use autoshovel_dig::{gwo_preset, plan_dig, DigModel, DigSurface, MachineProfile, PAPER_TABLES_4_5};
+use autoshovel_dig::{
+    gwo_preset, plan_dig, DigModel, DigSurface, MachineProfile, PAPER_TABLES_4_5,
+};
 use autoshovel_optim::GwoParams;
 
 fn main() {
@@ -12,7 +14,13 @@ fn main() {
     println!("| pile | f (paper) | f1 J/kg (paper) | m_dig kg (paper) | fill % (paper) | t_d s |");
     println!("|---|---|---|---|---|---|");
     for row in &PAPER_TABLES_4_5 {
-        let (shape, f, f1, m, fill) = (row.shape, row.f, row.f1_j_per_kg, row.m_dig_kg, row.fill_pct);
+        let (shape, f, f1, m, fill) = (
+            row.shape,
+            row.f,
+            row.f1_j_per_kg,
+            row.m_dig_kg,
+            row.fill_pct,
+        );
         let surface = DigSurface::from_shape(shape, profile.dipper.width_m);
         let model = DigModel::new(&profile, surface).expect("the scale model reaches the pile");
         let gwo = GwoParams {

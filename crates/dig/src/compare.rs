@@ -132,10 +132,8 @@ pub fn all_surfaces(
             p.geometry = None;
         }
         let ours = plan.plan.as_ref();
-        let rel = |v: Option<f64>, paper: f64| {
-            v.filter(|v| v.is_finite())
-                .map(|v| (v - paper) / paper)
-        };
+        let rel =
+            |v: Option<f64>, paper: f64| v.filter(|v| v.is_finite()).map(|v| (v - paper) / paper);
         let s = SurfaceComparison {
             m_dig_rel_diff: rel(ours.map(|p| p.m_dig_kg), paper.m_dig_kg),
             f_rel_diff: rel(ours.map(|p| p.f), paper.f),

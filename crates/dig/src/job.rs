@@ -227,7 +227,10 @@ pub struct ConstraintReport {
 }
 
 /// c1–c18 of `o` by name, with the limits of `model`.
-pub fn constraint_reports(model: &DigModel, o: &DigOutcome) -> BTreeMap<&'static str, ConstraintReport> {
+pub fn constraint_reports(
+    model: &DigModel,
+    o: &DigOutcome,
+) -> BTreeMap<&'static str, ConstraintReport> {
     let limits = model.constraint_limits(o.decision.gx_m);
     limits
         .iter()

@@ -1,5 +1,5 @@
 //! The warm-start pack file (`pack.csv`): the optimiser's final wolves as
-//! decisions of eq. 24 with their objective and normalised violation, best
+//! decisions of [RS eq. 24] with their objective and normalised violation, best
 //! first, so the next dig cycle can start from them ([RS eq. 37]'s pack).
 //!
 //! ```text

@@ -1,4 +1,4 @@
-//! The rope-shovel paper's Tables 4 (the optimal decision of eq. 24 on each
+//! The rope-shovel paper's Tables 4 (the optimal decision of [RS eq. 24] on each
 //! pile of Fig. 7) and 5 (what that plan achieves), as data: one table for
 //! the planner's comparison, its tests, examples and the demo.
 

@@ -54,6 +54,7 @@ pub fn cut_scan(
     floor_height_m: f64,
     profile: &MachineProfile,
 ) -> Result<ScanCut> {
+    // The fitted surface z = f(x, y) of [RS eq. 21], cut along y = dig_plane_y_m.
     let e = &fit.extent;
     let dig_plane_y_m = 0.5 * (e.y_min_m + e.y_max_m);
     let face_height_m = fit

@@ -1,10 +1,12 @@
 //! The dig planner against the rope-shovel paper's Tables 4–5, and its
 //! refusals.
 
-use autoshovel_dig::{gwo_preset, plan_dig, DigError, PAPER_TABLES_4_5, DigModel, DigSurface, MachineProfile, SearchSpace};
+use autoshovel_dig::{
+    gwo_preset, plan_dig, DigError, DigModel, DigSurface, MachineProfile, SearchSpace,
+    PAPER_TABLES_4_5,
+};
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
-
 
 fn model(shape: PileShape) -> DigModel {
     let p = MachineProfile::scale_model();
@@ -47,7 +49,7 @@ fn all_four_piles_reproduce_table_5() {
             // Predicted.
             assert!((o.f / f - 1.0).abs() <= 0.15, "{shape:?}: f {} vs {f}", o.f);
         }
-        // The mass is the swept volume times the density, and f is eq. 27.
+        // The mass is the swept volume times the density, and f is [RS eq. 27].
         assert!((o.m_dig_kg - 2540.0 * o.volume_m3).abs() < 1e-12);
         let f_27 = 0.7 * o.f1_j_per_kg + 0.3 * o.f2_s_per_kg;
         assert!((o.f - f_27).abs() < 1e-9);
@@ -73,7 +75,7 @@ fn the_same_seed_gives_the_same_plan_and_another_seed_another_search() {
     assert_ne!(a.search.best, c.search.best);
 }
 
-/// The volume of eq. 28 from the planner (cut thickness in path
+/// The volume of [RS eq. 28] from the planner (cut thickness in path
 /// coordinates) against the shoelace area of the polygon between the
 /// sampled path and the surface.
 #[test]

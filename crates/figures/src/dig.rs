@@ -14,8 +14,8 @@ use autoshovel_dig::{
     DigSample, PlannedPile, TableRow, TABLE_COLUMNS,
 };
 use autoshovel_report::{
-    markdown_table as md_table, rating_line, write_csv, write_csv_cells,
-    write_figure, write_job_summary, write_panels, Figure, Layer, Rgb, Stroke, Written,
+    markdown_table as md_table, rating_line, write_csv, write_csv_cells, write_figure,
+    write_job_summary, write_panels, Figure, Layer, Rgb, Stroke, Written,
 };
 
 use crate::shovel::{pile_layers, shovel_frame_layers, shovel_pose_layers};
@@ -311,9 +311,8 @@ pub fn write_piles(dir: &Path, all: &mut AllSurfaces) -> Result<Written, Error> 
         let mut w = Written::default();
         write_plan(&sub, &pile.planned, &mut w)?;
         write_job_summary(&sub, &pile.planned.summary, &mut w)?;
-        let prefix = |v: &[String]| -> Vec<String> {
-            v.iter().map(|p| format!("{name}/{p}")).collect()
-        };
+        let prefix =
+            |v: &[String]| -> Vec<String> { v.iter().map(|p| format!("{name}/{p}")).collect() };
         entry.files = Some(prefix(&w.all()));
         total.plots.extend(prefix(&w.plots));
         total.files.extend(prefix(&w.files));
@@ -472,4 +471,3 @@ pub fn comparison_panel(pile: &ComparedPile, s: &autoshovel_dig::SurfaceComparis
     );
     fig
 }
-

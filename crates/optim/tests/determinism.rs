@@ -1,6 +1,6 @@
 //! Reproducibility: one seeded ChaCha8 stream makes every draw in a fixed
 //! order, so a seed fixes the result bit for bit, with parallel evaluation
-//! on or off; and a plain transcription of eq. 37 (Mirjalili et al. 2014,
+//! on or off; and a plain transcription of [RS eq. 37] (Mirjalili et al. 2014,
 //! eqs. 3.3–3.7) with the documented draw order reproduces [`minimize`].
 
 use autoshovel_optim::benchmarks::Benchmark;
@@ -87,7 +87,7 @@ fn parallel_matches_serial_in_a_dedicated_pool() {
     }
 }
 
-/// Eq. 37 written out from the paper with the documented draw order and
+/// [RS eq. 37] written out from the paper with the documented draw order and
 /// leader rule (three best current wolves, best-ever kept aside), for an
 /// unconstrained problem with a random start.
 fn transcription(
