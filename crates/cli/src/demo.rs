@@ -9,7 +9,9 @@ use autoshovel_propel::{FieldKind, Scenario};
 use autoshovel_report::{write_index_html, write_summary, Section};
 use serde_json::{json, Value};
 
-use crate::output::{prepare_dir, print_json};
+use autoshovel_surface::perceive::{perceive_file, PerceiveSummary, PerceptionParams};
+
+use crate::output::{prepare_dir, print_json, Job};
 
 /// Runs the demo into `out`.
 pub fn run(out: &Path, json_only: bool) -> Result<()> {
@@ -138,25 +140,24 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         };
         let cloud = autoshovel_surface::generate_pile(&params)?;
         autoshovel_cloud::io::write(&scan, &cloud, autoshovel_cloud::io::Encoding::Binary)?;
-        let (summary, mut written) = crate::perceive::job(
-            &scan,
-            &crate::perceive::Pipeline::default(),
+        let params = PerceptionParams::default();
+        let got = perceive_file(&scan, &params, &mut |_, _| {})?;
+        let job = Job::finish(
+            PerceiveSummary::new(&scan, &params, &got),
             Some(&dir),
-            false,
+            |d, w| Ok(autoshovel_figures::perceive::write(d, &got, w)?),
         )?;
+        let mut written = job.written.clone();
         written.file(&dir, &scan);
         let key = format!("perceive {} pile", shape.name());
         if !json_only {
+            let s = &job.summary;
             crate::say!(
                 "{key:40} roll {:.3} deg (true 3), pitch {:.3} deg (true -2), R² {:.4}, {} → {} points in {:.0} ms",
-                summary["roll_deg"].as_f64().unwrap_or(f64::NAN),
-                summary["pitch_deg"].as_f64().unwrap_or(f64::NAN),
-                summary["r2"].as_f64().unwrap_or(f64::NAN),
-                summary["input_points"],
-                summary["output_points"],
-                summary["total_ms"].as_f64().unwrap_or(f64::NAN)
+                s.roll_deg, s.pitch_deg, s.r2, s.input_points, s.output_points, s.total_ms
             );
         }
+        let summary = job.json()?;
         let description = format!("A synthetic 200,000-point scan of a {} pile (Fig. 7) tilted by roll 3°, pitch −2°, then the §3 pipeline.", shape.name());
         sections.push(section(
             &key,

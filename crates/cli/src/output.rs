@@ -29,6 +29,20 @@ pub fn print_json<S: Serialize + ?Sized>(summary: &S) -> Result<()> {
     Ok(())
 }
 
+/// A progress bar drawn with `template` on stderr, or a hidden one when
+/// `show` is false (under `--json`, or in the demo).
+pub fn progress_bar(show: bool, template: &str) -> indicatif::ProgressBar {
+    if !show {
+        return indicatif::ProgressBar::hidden();
+    }
+    let bar = indicatif::ProgressBar::new(0);
+    bar.set_style(
+        indicatif::ProgressStyle::with_template(template)
+            .unwrap_or_else(|_| indicatif::ProgressStyle::default_bar()),
+    );
+    bar
+}
+
 /// A finished job: its typed summary and the files it wrote (none without
 /// an output folder).
 #[allow(dead_code)] // until every job is on it

@@ -5,8 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::{Context, Result};
 use autoshovel_cloud::io::{write, Encoding};
-use autoshovel_surface::{generate_pile, PileParams, PileShape};
-use serde_json::json;
+use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape};
 
 use crate::output::print_json;
 
@@ -85,31 +84,24 @@ pub fn run(args: &Args) -> Result<()> {
     let t1 = std::time::Instant::now();
     write(&args.out, &cloud, encoding)
         .with_context(|| format!("writing {}", args.out.display()))?;
-    let summary = json!({
-        "job": "generate-pile",
-        "shape": args.shape.name(),
-        "points": cloud.len(),
-        "roll_deg": args.roll,
-        "pitch_deg": args.pitch,
-        "scale": args.scale,
-        "seed": args.seed,
-        "file": args.out.display().to_string(),
-        "encoding": encoding.name(),
-        "generate_ms": gen_ms,
-        "write_ms": t1.elapsed().as_secs_f64() * 1e3,
-        "success": true,
-    });
+    let summary = GeneratePileSummary::new(
+        &params,
+        cloud.len(),
+        &args.out,
+        encoding.name(),
+        (gen_ms, t1.elapsed().as_secs_f64() * 1e3),
+    );
     if args.json {
         print_json(&summary)?;
     } else {
         crate::say!(
             "wrote {} points of a {} pile (roll {} deg, pitch {} deg, seed {}) to {}",
-            cloud.len(),
-            args.shape.name(),
+            summary.points,
+            summary.shape,
             args.roll,
             args.pitch,
-            args.seed,
-            args.out.display()
+            summary.seed,
+            summary.file
         );
     }
     Ok(())

@@ -12,18 +12,19 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Result};
+use anyhow::{anyhow, bail, Context as _, Result};
 use autoshovel_dig::TomlFile as _;
 use autoshovel_dig::{
-    all_surfaces, plan_pile, DigSetup, DigSummary, MachineProfile, PerceptionFacts, Pile,
+    all_surfaces, plan_pile, DigSetup, DigSummary, MachineProfile, Pile,
     SearchSpace, WarmStart, CONSTRAINT_NAMES,
 };
 use autoshovel_figures::dig as figures;
 use autoshovel_optim::Init;
 use autoshovel_surface::PileShape;
 
-use crate::output::{prepare_dir, Job};
-use crate::perceive::{load_pipeline, Pipeline};
+use autoshovel_surface::perceive::{perceive_file, PerceptionParams};
+
+use crate::output::{prepare_dir, progress_bar, Job};
 
 /// How the optimiser's first pack is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -124,8 +125,8 @@ pub fn run(args: &Args) -> Result<()> {
         setup.warm_start = Some(WarmStart::load(path)?);
     }
     let pipeline = match &args.config {
-        Some(p) => load_pipeline(p)?,
-        None => Pipeline::default(),
+        Some(p) => PerceptionParams::load(p)?,
+        None => PerceptionParams::default(),
     };
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
     if args.all_surfaces {
@@ -146,26 +147,22 @@ pub fn run(args: &Args) -> Result<()> {
     }
 }
 
-/// The pile of a scan: the `perceive` pipeline, then the dig profile cut by
-/// the library's rule.
+/// The pile of a scan: the perception pipeline, then the dig profile cut
+/// by the library's rule.
 fn load_scan(
     path: &Path,
-    pipeline: &Pipeline,
+    params: &PerceptionParams,
     profile: &MachineProfile,
     progress: bool,
 ) -> Result<Pile> {
-    let got = crate::perceive::process(path, pipeline, progress)?;
-    let facts = PerceptionFacts {
-        format: got.format.to_string(),
-        input_points: got.input_points,
-        output_points: got.cloud.len(),
-        roll_rad: got.roll_rad,
-        pitch_rad: got.pitch_rad,
-        floor_height_m: got.floor_height_m,
-        scale: got.scale,
-        perceive_ms: got.stages.iter().map(|s| s.ms).sum(),
-    };
-    Ok(Pile::scan(path, &got.fit, &facts, profile)?)
+    let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
+    let got = perceive_file(path, params, &mut |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    let got = got.with_context(|| path.display().to_string())?;
+    Ok(Pile::scan(path, &got, profile)?)
 }
 
 /// `--all-surfaces`: the four piles beside Tables 4–5.

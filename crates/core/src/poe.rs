@@ -1,5 +1,5 @@
 //! Product-of-exponentials (PoE) kinematics: unit twists and their matrix
-//! exponentials (rope-shovel paper eqs. 1–2; Murray, Li & Sastry 1994, §2.3).
+//! exponentials ([RS eq. 1]–[RS eq. 2]; Murray, Li & Sastry 1994, §2.3).
 //!
 //! A joint is a unit twist ξ = (ω, v) in the base frame at the home
 //! configuration. For a revolute joint ω is the unit axis and v = r × ω for any
@@ -7,10 +7,10 @@
 //! v is the unit direction of travel. The pose of the end frame is
 //!
 //! ```text
-//!     T(q) = e^{[ξ₁]q₁} e^{[ξ₂]q₂} ⋯ e^{[ξₙ]qₙ} T(0)          (eq. 1)
+//!     T(q) = e^{[ξ₁]q₁} e^{[ξ₂]q₂} ⋯ e^{[ξₙ]qₙ} T(0)          ([RS eq. 1])
 //! ```
 //!
-//! and each factor is eq. 2:
+//! and each factor is [RS eq. 2]:
 //!
 //! ```text
 //!     e^{[ξ]θ} = [ e^{[ω]θ}   (I − e^{[ω]θ})(ω × v) + ω ωᵀ v θ ]   (ω ≠ 0)
@@ -52,9 +52,10 @@ impl Twist {
         }
     }
 
-    /// The matrix exponential e^{[ξ]θ} of eq. 2 (θ in rad for a revolute
+    /// The matrix exponential e^{[ξ]θ} of [RS eq. 2] (θ in rad for a revolute
     /// joint, m for a prismatic one).
     pub fn exp(&self, theta: f64) -> Matrix4<f64> {
+        // [RS eq. 2]: prismatic (ω = 0) then revolute by Rodrigues.
         let mut t = Matrix4::identity();
         if self.omega.norm_squared() == 0.0 {
             t.fixed_view_mut::<3, 1>(0, 3).copy_from(&(self.v * theta));
@@ -93,6 +94,7 @@ pub fn product_of_exponentials(twists: &[Twist], q: &[f64], home: &Matrix4<f64>)
     for (xi, &qi) in twists.iter().zip(q) {
         t *= xi.exp(qi);
     }
+    // [RS eq. 1]: T(q) = e^{[ξ₁]q₁} ⋯ e^{[ξₙ]qₙ} T(0).
     t * home
 }
 

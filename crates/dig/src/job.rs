@@ -10,14 +10,15 @@ use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use autoshovel_optim::GwoParams;
-use autoshovel_surface::{PileShape, SurfaceFit};
+use autoshovel_surface::perceive::Perceived;
+use autoshovel_surface::PileShape;
 use serde::Serialize;
 
 use crate::error::{DigError, Result};
 use crate::pack::read_pack;
 use crate::plan::{gwo_preset, plan_dig, Bound, DigModel, DigOutcome, DigPlan, SearchSpace};
 use crate::profile::{Geometry, MachineProfile};
-use crate::scan::{cut_scan, PerceptionFacts, PerceptionSummary, ScanSource};
+use crate::scan::{cut_scan, PerceptionSummary, ScanSource};
 use crate::terrain::DigSurface;
 use crate::trajectory::Decision;
 
@@ -105,16 +106,13 @@ impl Pile {
         }
     }
 
-    /// A scanned pile `path`: the dig profile cut from its fitted surface
-    /// by [`cut_scan`]'s rule, with what perception made of it.
-    pub fn scan(
-        path: &Path,
-        fit: &SurfaceFit,
-        facts: &PerceptionFacts,
-        profile: &MachineProfile,
-    ) -> Result<Self> {
-        let cut = cut_scan(path, fit, facts.floor_height_m, profile)?;
-        let perception = PerceptionSummary::new(facts, fit, &cut);
+    /// The scanned pile `path` as perception saw it (`got`,
+    /// `autoshovel_surface::perceive::perceive_file`): the dig profile cut
+    /// from its fitted surface by [`cut_scan`]'s rule, with what perception
+    /// made of it.
+    pub fn scan(path: &Path, got: &Perceived, profile: &MachineProfile) -> Result<Self> {
+        let cut = cut_scan(path, &got.fit, got.floor_height_m, profile)?;
+        let perception = PerceptionSummary::new(got, &cut);
         Ok(Self {
             surface: cut.surface,
             name: "cloud".into(),

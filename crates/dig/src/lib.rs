@@ -40,6 +40,6 @@ pub use plan::{
     SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS,
 };
 pub use profile::{Geometry, MachineProfile};
-pub use scan::{cut_scan, PerceptionFacts, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
+pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
 pub use terrain::DigSurface;
 pub use trajectory::{Decision, Trajectory};

@@ -1,5 +1,6 @@
 //! A scanned pile as the dig planner sees it: the dig profile cut from a
-//! perceived scan's fitted surface z = f(x, y) ([RS eq. 21]).
+//! perceived scan's fitted surface z = f(x, y) ([RS eq. 21]), as
+//! `autoshovel_surface::perceive` returns it.
 //!
 //! The dig plane is the vertical plane through the middle of the fitted
 //! extent in y (the scanner looks along +x at the face). The face height is
@@ -16,6 +17,7 @@
 
 use std::path::Path;
 
+use autoshovel_surface::perceive::Perceived;
 use autoshovel_surface::{Extent, SurfaceFit};
 use serde::Serialize;
 
@@ -100,33 +102,11 @@ pub fn cut_scan(
     })
 }
 
-/// What perception made of a scan, as the perception pipeline reports it
-/// (the inputs of [`PerceptionSummary::new`]).
-#[derive(Debug, Clone, PartialEq)]
-pub struct PerceptionFacts {
-    /// The file format read.
-    pub format: String,
-    /// Finite points read.
-    pub input_points: usize,
-    /// Points left after filtering.
-    pub output_points: usize,
-    /// Roll used to level [rad].
-    pub roll_rad: f64,
-    /// Pitch used to level [rad].
-    pub pitch_rad: f64,
-    /// Floor height in the levelled frame [m].
-    pub floor_height_m: f64,
-    /// Length scale of the scene.
-    pub scale: f64,
-    /// Time spent in perception [ms].
-    pub perceive_ms: f64,
-}
-
 /// The `perception` object of a plan on a scan.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PerceptionSummary {
-    /// The file format read.
-    pub format: String,
+    /// The file format read (none for a cloud given in memory).
+    pub format: Option<&'static str>,
     /// Finite points read.
     pub input_points: usize,
     /// Points left after filtering.
@@ -156,23 +136,24 @@ pub struct PerceptionSummary {
 }
 
 impl PerceptionSummary {
-    /// The summary of perception `facts`, the fit and the cut made from them.
-    pub fn new(facts: &PerceptionFacts, fit: &SurfaceFit, cut: &ScanCut) -> Self {
+    /// The summary of what perception made of a scan (`got`) and of the
+    /// cut made from it.
+    pub fn new(got: &Perceived, cut: &ScanCut) -> Self {
         Self {
-            format: facts.format.clone(),
-            input_points: facts.input_points,
-            output_points: facts.output_points,
-            roll_deg: facts.roll_rad.to_degrees(),
-            pitch_deg: facts.pitch_rad.to_degrees(),
-            floor_height_m: facts.floor_height_m,
-            scale: facts.scale,
-            fit_degree: fit.degree,
-            r2: fit.r2,
-            extent: fit.extent,
+            format: got.format,
+            input_points: got.input_points,
+            output_points: got.cloud.len(),
+            roll_deg: got.roll_rad.to_degrees(),
+            pitch_deg: got.pitch_rad.to_degrees(),
+            floor_height_m: got.floor_height_m,
+            scale: got.scale,
+            fit_degree: got.fit.degree,
+            r2: got.fit.r2,
+            extent: got.fit.extent,
             dig_plane_y_m: cut.dig_plane_y_m,
             face_height_m: cut.face_height_m,
             toe_rise_m: cut.toe_rise_m,
-            perceive_ms: facts.perceive_ms,
+            perceive_ms: got.total_ms(),
         }
     }
 }

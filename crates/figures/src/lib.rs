@@ -16,3 +16,15 @@ pub mod perceive;
 pub mod shovel;
 pub mod study;
 pub mod track;
+
+/// What can go wrong while writing a job's files.
+#[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
+pub enum FiguresError {
+    /// A figure, CSV or summary could not be written (names the file).
+    #[error(transparent)]
+    Report(#[from] autoshovel_report::ReportError),
+    /// A point cloud could not be written (names the file).
+    #[error(transparent)]
+    Cloud(#[from] autoshovel_cloud::CloudError),
+}

@@ -1,19 +1,19 @@
-//! Horizontal calibration of a point cloud (rope-shovel paper §3.1, eqs. 11–12).
+//! Horizontal calibration of a point cloud (rope-shovel paper §3.1, [RS eq. 11]–[RS eq. 12]).
 //!
 //! The paper corrects a scan for the roll α and pitch β of the sensor with
 //!
 //! ```text
 //!          ⎡ cos β          0       −sin β        ⎤
-//!     T =  ⎢ sin α sin β    cos α    sin α cos β  ⎥        (eq. 11)
+//!     T =  ⎢ sin α sin β    cos α    sin α cos β  ⎥        ([RS eq. 11])
 //!          ⎣ cos α sin β   −sin α    cos α cos β  ⎦
 //!
-//!     p = T · p_s                                           (eq. 12)
+//!     p = T · p_s                                           ([RS eq. 12])
 //! ```
 //!
 //! with `p_s` a raw (sensor) point and `p` the levelled one. This module applies
-//! T exactly as printed; [`level`] is eq. 12 and [`tilt`] its inverse `Tᵀ`.
+//! T exactly as printed; [`level`] is [RS eq. 12] and [`tilt`] its inverse `Tᵀ`.
 //!
-//! # How eq. 11 reads
+//! # How [RS eq. 11] reads
 //! Multiplying out shows `T = Rx(−α) · Ry(−β)`, where `Rx`, `Ry` are the
 //! right-handed elementary rotations about x and y. So:
 //!
@@ -40,9 +40,10 @@
 use autoshovel_cloud::PointCloud;
 use nalgebra::{Matrix3, Vector3};
 
-/// The matrix T of eq. 11: `level_from_sensor` for roll α and pitch β [rad].
+/// The matrix T of [RS eq. 11]: `level_from_sensor` for roll α and pitch β [rad].
 #[rustfmt::skip]
 pub fn level_from_sensor(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
+    // [RS eq. 11]: T(α, β) as printed.
     let (sa, ca) = roll_rad.sin_cos();
     let (sb, cb) = pitch_rad.sin_cos();
     Matrix3::new(
@@ -60,6 +61,7 @@ pub fn sensor_from_level(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
 /// Eq. 12: the levelled cloud `p = T · p_s` for a sensor with roll α and
 /// pitch β [rad] (see the module docs for which way they turn).
 pub fn level(cloud: &PointCloud, roll_rad: f64, pitch_rad: f64) -> PointCloud {
+    // [RS eq. 12]: p = T · p_s.
     rotate(cloud, &level_from_sensor(roll_rad, pitch_rad))
 }
 

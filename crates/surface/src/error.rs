@@ -2,7 +2,7 @@
 
 /// Everything that can go wrong in this crate. Each variant names the value at
 /// fault and, where there is one, what to change.
-#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum SurfaceError {
     /// A parameter out of its valid range.
@@ -75,6 +75,39 @@ pub enum SurfaceError {
         /// Grid samples used.
         samples: usize,
     },
+    /// A settings file could not be read, parsed or checked (names the file, line and key).
+    #[error(transparent)]
+    Config(#[from] autoshovel_core::config::ConfigError),
+    /// A point-cloud file could not be read, or a filter refused its input.
+    #[error(transparent)]
+    Cloud(#[from] autoshovel_cloud::CloudError),
+    /// A filter stage of the perception pipeline failed.
+    #[error("{stage} filter")]
+    Filter {
+        /// The stage (ground, radius, statistical, voxel, smooth).
+        stage: &'static str,
+        /// Why.
+        #[source]
+        source: autoshovel_cloud::CloudError,
+    },
+    /// A stage of the perception pipeline failed.
+    #[error("{stage}")]
+    Stage {
+        /// What the pipeline was doing.
+        stage: &'static str,
+        /// Why.
+        #[source]
+        source: Box<SurfaceError>,
+    },
+    /// The scan holds no finite point.
+    #[error("the scan holds no finite points ({non_finite_dropped} non-finite dropped)")]
+    NoFinitePoints {
+        /// Points dropped for a NaN or infinite coordinate.
+        non_finite_dropped: usize,
+    },
+    /// The scan's points span no area in x and y, so the point spacing is unknown.
+    #[error("the scan has no horizontal extent; give spacing in the settings")]
+    NoHorizontalExtent,
 }
 
 /// Result alias of this crate.

@@ -1,4 +1,4 @@
-//! The material surface `z = f(x, y)` (rope-shovel paper §3.2, eq. 21): a
+//! The material surface `z = f(x, y)` (rope-shovel paper §3.2, [RS eq. 21]): a
 //! bivariate polynomial fitted by least squares to the 8 × 8 grid samples of
 //! [`crate::sample_grid`], accepted only when R² > 0.95.
 //!
@@ -350,7 +350,7 @@ impl SurfaceFit {
     }
 
     /// The coefficients in plain x, y [m]: `f = Σ c_ab x^a y^b`, expanded from
-    /// the normalised ones by the binomial theorem. Readable as eq. 21, but
+    /// the normalised ones by the binomial theorem. Readable as [RS eq. 21], but
     /// worse conditioned: prefer [`SurfaceFit::height`] for evaluation.
     pub fn coefficients_xy(&self) -> Vec<Term> {
         let [cx, cy] = self.centre_m;
@@ -457,6 +457,7 @@ fn design(uv: &[[f64; 2]], d: usize) -> DMatrix<f64> {
     let t = terms(d);
     DMatrix::from_fn(uv.len(), t.len(), |r, c| {
         let (i, j) = t[c];
+        // [RS eq. 21]: one monomial term of z = f(x, y) per column.
         uv[r][0].powi(i as i32) * uv[r][1].powi(j as i32)
     })
 }

@@ -1,6 +1,6 @@
 //! Roll and pitch of the sensor from the floor (SPEC §4.1: "also estimate α, β
 //! from the floor, since a user rarely knows them"), for the horizontal
-//! calibration of eqs. 11–12.
+//! calibration of [RS eq. 11]–12.
 //!
 //! 1. Candidates: the lowest [`TiltParams::floor_fraction`] of the points by
 //!    z (the floor in front of a pile is the lowest part of a scan as long as
@@ -74,9 +74,9 @@ impl TiltParams {
 /// The sensor attitude found from the floor.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TiltEstimate {
-    /// Roll α of eq. 11 [rad]: pass to [`crate::level`].
+    /// Roll α of [RS eq. 11] [rad]: pass to [`crate::level`].
     pub roll_rad: f64,
-    /// Pitch β of eq. 11 [rad]: pass to [`crate::level`].
+    /// Pitch β of [RS eq. 11] [rad]: pass to [`crate::level`].
     pub pitch_rad: f64,
     /// Height of the floor in the levelled cloud [m] (negative the sensor's
     /// height above the floor for a sensor-centred scan).
@@ -93,7 +93,7 @@ pub struct TiltEstimate {
     pub iterations: usize,
 }
 
-/// Estimate roll α and pitch β of eq. 11 from the floor of a raw scan (see
+/// Estimate roll α and pitch β of [RS eq. 11] from the floor of a raw scan (see
 /// the module docs). Same seed, same estimate.
 ///
 /// ```

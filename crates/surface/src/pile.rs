@@ -1,6 +1,6 @@
 //! Synthetic LiDAR scans of a muck pile (SPEC §4.1), in the four shapes of the
 //! rope-shovel paper's Fig. 7: typical (a 40° face), concave, convex and
-//! convex–concave — so calibration, filtering and the surface fit of eq. 21
+//! convex–concave — so calibration, filtering and the surface fit of [RS eq. 21]
 //! can run without a LiDAR.
 //!
 //! # Scene (level frame, before the sensor tilt)
@@ -244,9 +244,9 @@ pub struct PileParams {
     /// Share of the outliers that are isolated points far from the surface
     /// (the rest hover above it), in [0, 1]. Default 0.2.
     pub isolated_share: f64,
-    /// Sensor roll α of eq. 11 [rad]. Default 3°.
+    /// Sensor roll α of [RS eq. 11] [rad]. Default 3°.
     pub roll_rad: f64,
-    /// Sensor pitch β of eq. 11 [rad]. Default −2°.
+    /// Sensor pitch β of [RS eq. 11] [rad]. Default −2°.
     pub pitch_rad: f64,
     /// Seed of the ChaCha8 generator. Default 1.
     pub seed: u64,
@@ -713,5 +713,61 @@ mod tests {
             PileShape::ConvexConcave
         );
         assert!("wavy".parse::<PileShape>().is_err());
+    }
+}
+
+/// The summary of `autoshovel generate-pile` (SPEC §6): what was generated
+/// and where it was written.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct GeneratePileSummary {
+    /// "generate-pile".
+    pub job: &'static str,
+    /// Shape name (Fig. 7).
+    pub shape: &'static str,
+    /// Points written.
+    pub points: usize,
+    /// Sensor roll α [deg].
+    pub roll_deg: f64,
+    /// Sensor pitch β [deg].
+    pub pitch_deg: f64,
+    /// Length scale (1 = a 10 m face).
+    pub scale: f64,
+    /// Seed of the noise and sampling.
+    pub seed: u64,
+    /// The file written.
+    pub file: String,
+    /// Its encoding.
+    pub encoding: &'static str,
+    /// Time to generate [ms].
+    pub generate_ms: f64,
+    /// Time to write [ms].
+    pub write_ms: f64,
+    /// Always true (a failed run is an error).
+    pub success: bool,
+}
+
+impl GeneratePileSummary {
+    /// The summary of `points` generated with `p` and written to `file`.
+    pub fn new(
+        p: &PileParams,
+        points: usize,
+        file: &std::path::Path,
+        encoding: &'static str,
+        (generate_ms, write_ms): (f64, f64),
+    ) -> Self {
+        Self {
+            job: "generate-pile",
+            shape: p.shape.name(),
+            points,
+            roll_deg: p.roll_rad.to_degrees(),
+            pitch_deg: p.pitch_rad.to_degrees(),
+            scale: p.scale,
+            seed: p.seed,
+            file: file.display().to_string(),
+            encoding,
+            generate_ms,
+            write_ms,
+            success: true,
+        }
     }
 }

@@ -1,6 +1,6 @@
 //! Plane fitting by RANSAC (Fischler & Bolles 1981) with least-squares
 //! refinement — the tool behind the floor estimate of [`crate::estimate_tilt`]
-//! (SPEC §4.1: estimate the α, β of eqs. 11–12 from the floor).
+//! (SPEC §4.1: estimate the α, β of [RS eq. 11]–[RS eq. 12] from the floor).
 //!
 //! 1. Hypotheses: planes through three points drawn at random (seeded
 //!    ChaCha8) from at most [`RansacParams::max_scored_points`] points; each is

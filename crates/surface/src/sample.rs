@@ -1,7 +1,7 @@
 //! The 8 × 8 sample grid of the rope-shovel paper §3.2: "eight points with
 //! equal intervals were selected in the X axial direction of the point cloud
 //! and another eight points with equal intervals in the Y axial direction",
-//! 64 points for the fit of eq. 21.
+//! 64 points for the fit of [RS eq. 21].
 //!
 //! The paper does not say how a grid node gets its height; this is the
 //! documented choice:

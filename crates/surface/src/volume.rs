@@ -1,6 +1,6 @@
 //! Volume between a fitted surface and a horizontal plane, for the excavated
-//! volume of SPEC §4.3 (rope-shovel paper eq. 28 integrates the material
-//! between the surface of eq. 21 and the swept dipper numerically).
+//! volume of SPEC §4.3 ([RS eq. 28] integrates the material
+//! between the surface of [RS eq. 21] and the swept dipper numerically).
 //!
 //! `V = ∫∫_R max(f(x, y) − z₀, 0) dx dy` over the rectangle R, by the
 //! composite midpoint rule on an n × n grid: exact for a plane lying wholly

@@ -3,72 +3,44 @@
 //! pipeline — horizontal calibration from the floor (eqs. 11–12), pass-through
 //! of the floor, radius and statistical outlier removal (eqs. 13–16), voxel
 //! grid (eqs. 17–18), bilateral smoothing (eqs. 19–20) and the 8 × 8 surface
-//! fit (eq. 21) — gives back the sensor tilt within 0.2° and R² > 0.95.
+//! fit (eq. 21) — gives back the sensor tilt within 0.2° and R² > 0.95, with
+//! the pipeline's one set of defaults as `autoshovel perceive` uses them.
 
-use autoshovel_cloud::{filter, PointCloud};
+use autoshovel_surface::perceive::{perceive, PerceptionParams};
 use autoshovel_surface::{
-    estimate_tilt, fit_surface, generate_pile, level, FitParams, PileParams, PileShape, SurfaceFit,
-    TiltEstimate, TiltParams,
+    estimate_tilt, generate_pile, PileParams, PileShape, SurfaceFit, TiltParams,
 };
 
 /// Tilt recovery tolerance of the issue [deg].
 const TILT_TOL_DEG: f64 = 0.2;
 
 struct Outcome {
-    tilt: TiltEstimate,
+    roll_rad: f64,
+    pitch_rad: f64,
     fit: SurfaceFit,
     stages: Vec<(&'static str, usize)>,
 }
 
-/// The pipeline, with filter parameters scaled to the point spacing of the
-/// scan (about sqrt(area / N): 8 cm at 100 k points, 2.6 cm at 1 M).
+/// The pipeline exactly as `autoshovel perceive` runs it: the library's
+/// `perceive` with its one set of defaults ([`PerceptionParams::default`],
+/// filter lengths in point spacings, the scale found from the scan).
 fn pipeline(p: &PileParams) -> Outcome {
     let raw = generate_pile(p).expect("scan");
-    let tilt = estimate_tilt(&raw, &TiltParams::for_scale(p.scale)).expect("floor");
-    let flat = level(&raw, tilt.roll_rad, tilt.pitch_rad);
-    let area_m2 = 670.0 * p.scale * p.scale;
-    let spacing = (area_m2 / p.points as f64).sqrt();
+    let got = perceive(&raw, &PerceptionParams::default()).expect("perceive");
     let mut stages = vec![("raw", raw.len())];
-    let floor_cut = tilt.floor_height_m + 0.2 * p.scale;
-    let mut cloud: PointCloud =
-        filter::pass_through(&flat, &filter::PassThroughParams::ground_removal(floor_cut))
-            .expect("pass-through");
-    stages.push(("pass-through", cloud.len()));
-    let radius = filter::RadiusOutlierParams {
-        radius_m: 3.0 * spacing,
-        min_neighbors: 3,
-    };
-    cloud = filter::radius_outlier_removal(&cloud, &radius).expect("radius");
-    stages.push(("radius outlier", cloud.len()));
-    let stat = filter::StatisticalOutlierParams {
-        mean_k: 20,
-        std_mul: 2.0,
-    };
-    cloud = filter::statistical_outlier_removal(&cloud, &stat).expect("statistical");
-    stages.push(("statistical outlier", cloud.len()));
-    cloud = filter::voxel_grid(
-        &cloud,
-        &filter::VoxelGridParams::cube(spacing.max(0.05 * p.scale)),
-    )
-    .expect("voxel");
-    stages.push(("voxel grid", cloud.len()));
-    let r = 3.0 * spacing;
-    let smooth = filter::BilateralParams {
-        radius_m: r,
-        sigma_d_m: r / 2.0,
-        sigma_n_m: 0.03 * p.scale,
-        iterations: 1,
-    };
-    cloud = filter::bilateral_normal_smoothing(&cloud, &smooth).expect("bilateral");
-    stages.push(("bilateral", cloud.len()));
-    let fit = fit_surface(&cloud, &FitParams::default()).expect("R² > 0.95");
-    Outcome { tilt, fit, stages }
+    stages.extend(got.stages.iter().map(|s| (s.stage, s.points)));
+    Outcome {
+        roll_rad: got.roll_rad,
+        pitch_rad: got.pitch_rad,
+        fit: got.fit,
+        stages,
+    }
 }
 
 fn check(p: &PileParams) {
     let o = pipeline(p);
-    let d_roll = (o.tilt.roll_rad - p.roll_rad).to_degrees();
-    let d_pitch = (o.tilt.pitch_rad - p.pitch_rad).to_degrees();
+    let d_roll = (o.roll_rad - p.roll_rad).to_degrees();
+    let d_pitch = (o.pitch_rad - p.pitch_rad).to_degrees();
     println!(
         "{:>15} N={} seed={} scale={:.4}: roll err {d_roll:+.4}°, pitch err {d_pitch:+.4}°, degree {}, {} samples, \
          R² {:.4} (adj {:.4}, all points {:.4}), rms {:.3} m; stages {:?}",

@@ -1,4 +1,4 @@
-//! Bilateral smoothing along normals (rope-shovel paper eqs. 19–20): each
+//! Bilateral smoothing along normals ([RS eq. 19]–[RS eq. 20]): each
 //! point moves along its unit normal n_P by
 //!
 //! ```text
@@ -33,7 +33,7 @@ use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "bilateral normal smoothing";
 
-/// Parameters of [`bilateral_normal_smoothing`] (eqs. 19–20).
+/// Parameters of [`bilateral_normal_smoothing`] ([RS eq. 19]–[RS eq. 20]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct BilateralParams {
     /// The neighbourhood radius r of N_r(P) [m], inclusive.
@@ -81,14 +81,14 @@ impl BilateralParams {
     }
 }
 
-/// The cloud smoothed by eqs. 19–20, point for point in input order
+/// The cloud smoothed by [RS eq. 19]–[RS eq. 20], point for point in input order
 /// (non-finite points are dropped, as by every filter here).
 ///
 /// ```
 /// use autoshovel_cloud::{filter, PointCloud};
 /// // A flat 11 × 11 grid of 1 cm spacing with its centre raised by 5 mm:
 /// // with its 4 neighbours at 1 cm (r = 1.2 cm) the centre returns to the
-/// // plane (closed form of eq. 20: every offset is −5 mm, so δ = −5 mm).
+/// // plane (closed form of [RS eq. 20]: every offset is −5 mm, so δ = −5 mm).
 /// let mut points: Vec<[f32; 3]> =
 ///     (0..121).map(|i| [(i % 11) as f32 * 0.01, (i / 11) as f32 * 0.01, 0.0]).collect();
 /// points[60][2] = 0.005;
@@ -131,11 +131,13 @@ pub fn bilateral_normal_smoothing(
                 let d = [0, 1, 2].map(|a| f64::from(current[q as usize][a]) - pf[a]);
                 let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+                // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩).
                 let w = (-dist2 * inv_2sd2).exp() * (-h * h * inv_2sn2).exp();
                 num += w * h;
                 den += w;
             }
             if den > 0.0 {
+                // [RS eq. 20]: δ = Σ w·h / Σ w, the point moved along its normal.
                 let delta = num / den;
                 [0, 1, 2].map(|a| (pf[a] + delta * n[a]) as f32)
             } else {

@@ -1,15 +1,15 @@
 //! The filters of the rope-shovel paper's combined filtering process (§3.2,
-//! eqs. 13–20), with PCL's semantics where PCL has the filter, so that a
+//! [RS eq. 13]–[RS eq. 20]), with PCL's semantics where PCL has the filter, so that a
 //! cloud filtered here keeps exactly the points PCL 1.13 keeps:
 //!
 //! | step | function | paper | PCL / Open3D counterpart |
 //! |---|---|---|---|
 //! | ground removal | [`pass_through`] | §3.2, first step | `pcl::PassThrough` |
-//! | radius outlier removal | [`radius_outlier_removal`] | eq. 13 | `pcl::RadiusOutlierRemoval` |
-//! | statistical outlier removal | [`statistical_outlier_removal`] | eqs. 14–16 | `pcl::StatisticalOutlierRemoval` |
-//! | down-sampling to voxel centroids | [`voxel_grid`] | eqs. 17–18 | `pcl::VoxelGrid` |
-//! | normals by PCA | [`estimate_normals`] | §3.2, before eq. 19 | `pcl::NormalEstimation` |
-//! | bilateral smoothing along normals | [`bilateral_normal_smoothing`] | eqs. 19–20 | none in PCL's filters or in Open3D |
+//! | radius outlier removal | [`radius_outlier_removal`] | [RS eq. 13] | `pcl::RadiusOutlierRemoval` |
+//! | statistical outlier removal | [`statistical_outlier_removal`] | [RS eq. 14]–[RS eq. 16] | `pcl::StatisticalOutlierRemoval` |
+//! | down-sampling to voxel centroids | [`voxel_grid`] | [RS eq. 17]–[RS eq. 18] | `pcl::VoxelGrid` |
+//! | normals by PCA | [`estimate_normals`] | §3.2, before [RS eq. 19] | `pcl::NormalEstimation` |
+//! | bilateral smoothing along normals | [`bilateral_normal_smoothing`] | [RS eq. 19]–[RS eq. 20] | none in PCL's filters or in Open3D |
 //!
 //! Every filter is a free function taking the cloud and a plain parameter
 //! struct with a `Default`; the removal filters also come as `*_indices`

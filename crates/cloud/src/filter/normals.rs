@@ -1,7 +1,7 @@
 //! Normals by principal component analysis of each point's neighbourhood,
 //! the first half of the rope-shovel paper's bilateral smoothing (§3.2, "the
 //! unit normal vector of point P is first calculated using the points within
-//! the neighborhood range of point P", before eq. 19).
+//! the neighborhood range of point P", before [RS eq. 19]).
 //!
 //! The normal is the eigenvector of the smallest eigenvalue of the
 //! neighbourhood's covariance matrix (the point itself included, as in PCL's

@@ -1,7 +1,7 @@
 //! Pass-through filter: keep the points whose coordinate on one axis lies in
 //! `[min, max]` (or outside it). The rope-shovel paper (§3.2, first step of
 //! the combined filtering process) uses it to strip the ground after the
-//! horizontal calibration of eqs. 11–12: a point with z below the height
+//! horizontal calibration of [RS eq. 11]–[RS eq. 12]: a point with z below the height
 //! threshold is ground and is discarded, one with z at or above it is kept.
 //!
 //! Semantics of PCL 1.13's `pcl::PassThrough<PointT>::applyFilterIndices`
@@ -34,7 +34,7 @@ pub enum Axis {
     X,
     /// y.
     Y,
-    /// z (up after the calibration of eqs. 11–12).
+    /// z (up after the calibration of [RS eq. 11]–[RS eq. 12]).
     #[default]
     Z,
 }

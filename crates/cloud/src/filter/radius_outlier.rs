@@ -1,4 +1,4 @@
-//! Radius outlier removal (rope-shovel paper eq. 13): a point is kept when
+//! Radius outlier removal ([RS eq. 13]): a point is kept when
 //! at least `min_neighbors` other points lie within the Euclidean distance
 //! `K_s` (`radius_m`) of it, d(p_i, p_j) ≤ K_s.
 //!
@@ -43,7 +43,7 @@ use crate::{PointCloud, Result};
 
 const FILTER: &str = "radius outlier removal";
 
-/// Parameters of [`radius_outlier_removal`] (eq. 13).
+/// Parameters of [`radius_outlier_removal`] ([RS eq. 13]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct RadiusOutlierParams {
     /// The search radius K_s [m], inclusive.
@@ -103,7 +103,7 @@ pub fn radius_outlier_removal_indices(
     Ok(kept)
 }
 
-/// The points kept by radius outlier removal (eq. 13), in input order.
+/// The points kept by radius outlier removal ([RS eq. 13]), in input order.
 ///
 /// ```
 /// use autoshovel_cloud::{filter, PointCloud};
@@ -125,6 +125,7 @@ pub fn radius_outlier_removal(
 
 /// The kept indices of `points` (all finite, not empty).
 fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<usize> {
+    // [RS eq. 13]: kept when at least min_neighbors others lie within the radius.
     let wanted = params.min_neighbors + 1; // the point itself comes first
     if params.min_neighbors == 0 {
         return (0..points.len()).collect();

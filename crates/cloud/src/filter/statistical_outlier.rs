@@ -1,7 +1,7 @@
-//! Statistical outlier removal (rope-shovel paper eqs. 14–16): each point's
+//! Statistical outlier removal ([RS eq. 14]–[RS eq. 16]): each point's
 //! mean distance d̄_i to its k nearest neighbours; their global mean d̄ and
-//! sample standard deviation δ (eq. 14, with n − 1); d̄_i ~ N(d̄, δ²) (eq. 15);
-//! a point is noise when d̄_i − d̄ > α·δ (eq. 16, one-sided as in PCL).
+//! sample standard deviation δ ([RS eq. 14], with n − 1); d̄_i ~ N(d̄, δ²) ([RS eq. 15]);
+//! a point is noise when d̄_i − d̄ > α·δ ([RS eq. 16], one-sided as in PCL).
 //!
 //! Semantics of PCL 1.13.0's `pcl::StatisticalOutlierRemoval<PointT>`, followed
 //! to the bit (`filters/include/pcl/filters/impl/statistical_outlier_removal.hpp`,
@@ -46,13 +46,13 @@ use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "statistical outlier removal";
 
-/// Parameters of [`statistical_outlier_removal`] (eqs. 14–16).
+/// Parameters of [`statistical_outlier_removal`] ([RS eq. 14]–[RS eq. 16]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct StatisticalOutlierParams {
     /// The number k of neighbours (not counting the point) whose mean
     /// distance d̄_i is taken (PCL's `mean_k_`, `-mean_k`).
     pub mean_k: usize,
-    /// The threshold factor α of eq. 16 (PCL's `std_mul_`, `-std_dev_mul`).
+    /// The threshold factor α of [RS eq. 16] (PCL's `std_mul_`, `-std_dev_mul`).
     pub std_mul: f64,
 }
 
@@ -101,7 +101,7 @@ pub fn statistical_outlier_removal_indices(
     Ok(kept)
 }
 
-/// The points kept by statistical outlier removal (eqs. 14–16), in input order.
+/// The points kept by statistical outlier removal ([RS eq. 14]–[RS eq. 16]), in input order.
 ///
 /// ```
 /// use autoshovel_cloud::{filter, PointCloud};
@@ -156,10 +156,12 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
         sq_sum += f64::from(d * d);
     }
     let n = distances.len() as f64;
+    // [RS eq. 14]: the mean d̄ and standard deviation δ (n − 1) of the mean distances;
     let mean = sum / n;
     let variance = (sq_sum - sum * sum / n) / (n - 1.0);
+    // [RS eq. 15]: d̄_i ~ N(d̄, δ²), so the cut sits at d̄ + α·δ.
     let threshold = mean + params.std_mul * variance.sqrt();
-    // Eq. 16: removed when d̄_i > threshold; a NaN threshold removes nothing.
+    // [RS eq. 16]: removed when d̄_i > threshold; a NaN threshold removes nothing.
     Ok(distances
         .iter()
         .enumerate()

@@ -1,6 +1,6 @@
-//! Voxel-grid down-sampling (rope-shovel paper eqs. 17–18): the bounding box
-//! of the cloud (l_x, l_y, l_z = max − min, eq. 17) is cut into voxels of edge
-//! r (D = l / r voxels per axis, eq. 18), and the points of each occupied
+//! Voxel-grid down-sampling ([RS eq. 17]–[RS eq. 18]): the bounding box
+//! of the cloud (l_x, l_y, l_z = max − min, [RS eq. 17]) is cut into voxels of edge
+//! r (D = l / r voxels per axis, [RS eq. 18]), and the points of each occupied
 //! voxel are replaced by their centroid.
 //!
 //! Voxels are PCL 1.13's (`filters/include/pcl/filters/impl/voxel_grid.hpp`):
@@ -32,7 +32,7 @@ use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "voxel grid";
 
-/// Parameters of [`voxel_grid`] (eqs. 17–18).
+/// Parameters of [`voxel_grid`] ([RS eq. 17]–[RS eq. 18]).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct VoxelGridParams {
     /// The voxel edge r along x, y and z [m].
@@ -99,7 +99,7 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
         return Err(empty_input(FILTER));
     }
     let points = &cloud.points;
-    // The voxel of a finite point (eq. 18 per point), checked.
+    // The voxel of a finite point ([RS eq. 18] per point), checked.
     let cell = |p: &Point| -> Result<[i64; 3]> {
         let mut c = [0_i64; 3];
         for a in 0..3 {
@@ -117,7 +117,7 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
         }
         Ok(c)
     };
-    // Bounds in voxels (eq. 17), in one parallel pass.
+    // Bounds in voxels ([RS eq. 17]), in one parallel pass.
     let none = || ([i64::MAX; 3], [i64::MIN; 3]);
     let (lo, hi) = points
         .par_chunks(1 << 14)

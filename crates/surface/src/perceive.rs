@@ -1,0 +1,858 @@
+//! The rope-shovel paper's combined filtering process (§3, SPEC §4.1) as one
+//! call: level (`[RS eq. 11]`–`[RS eq. 12]`, roll and pitch given or
+//! estimated from the floor by RANSAC) → pass-through floor removal →
+//! radius outlier removal (`[RS eq. 13]`) → statistical outlier removal
+//! (`[RS eq. 14]`–`[RS eq. 16]`) → voxel grid (`[RS eq. 17]`–`[RS eq. 18]`)
+//! → normal-based bilateral smoothing (`[RS eq. 19]`–`[RS eq. 20]`) →
+//! surface fit on the 8 × 8 grid (`[RS eq. 21]`) with R². Every stage is
+//! counted and timed.
+//!
+//! The paper gives no filter parameters. Filter lengths are given in units of
+//! the scan's mean point spacing (`spacing = "auto"`: √(horizontal extent
+//! area / points)), so the same settings serve a 100 k-point and a 10 M-point
+//! scan; the floor margin, the RANSAC inlier threshold and the smoothing's
+//! σ_n are given at the scale of a full-size 10 m face and multiplied by
+//! `scale` (`"auto"`: the larger horizontal extent over 30 m, so the paper's
+//! 1:30 model gets 1:30). [`PerceptionParams::default`] is the one set of
+//! defaults; `tests/pipeline.rs` checks it on the four pile shapes of Fig. 7.
+//!
+//! ```
+//! use autoshovel_surface::perceive::PerceptionParams;
+//!
+//! // The settings file of `autoshovel perceive --config`: any key may be left out.
+//! let toml = "[statistical]\nmean_k = 30\n";
+//! let p: PerceptionParams = autoshovel_core::config::TomlFile::from_toml(toml, "my.toml").unwrap();
+//! assert_eq!(p.statistical.mean_k, 30);
+//! assert_eq!(p.voxel, PerceptionParams::default().voxel);
+//! // A bad value is refused naming the file, the line and the key.
+//! let err = <PerceptionParams as autoshovel_core::config::TomlFile>::from_toml(
+//!     "[voxel]\nleaf_spacings = -1\n", "my.toml").unwrap_err();
+//! assert!(err.to_string().starts_with("my.toml:2: [voxel] leaf_spacings = -1"), "{err}");
+//! ```
+
+use std::collections::BTreeMap;
+use std::path::Path;
+use std::time::Instant;
+
+use autoshovel_cloud::filter::{
+    bilateral_normal_smoothing, pass_through, radius_outlier_removal, statistical_outlier_removal,
+    voxel_grid, BilateralParams, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
+    VoxelGridParams,
+};
+use autoshovel_cloud::PointCloud;
+use autoshovel_core::config::{self, TomlFile};
+use serde::{Deserialize, Serialize};
+
+use crate::calibrate::level;
+use crate::error::{Result, SurfaceError};
+use crate::fit::{fit_surface, FitParams, SurfaceFit, Term};
+use crate::floor::{estimate_tilt, TiltParams};
+
+/// How the scan is levelled.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum LevelMode {
+    /// Estimate roll and pitch from the floor (RANSAC plane).
+    Estimate,
+    /// Use the given roll and pitch.
+    Given,
+    /// The scan is level already.
+    None,
+}
+
+/// A length scale: a number, or "auto" (from the scan).
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[serde(untagged)]
+pub enum ScaleSetting {
+    /// A fixed value.
+    Factor(f64),
+    /// "auto".
+    Word(AutoWord),
+}
+
+/// The word "auto".
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum AutoWord {
+    /// From the scan's extent.
+    Auto,
+}
+
+/// The settings of [`perceive`] (the TOML of `autoshovel perceive --config`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct PerceptionParams {
+    /// Length scale of the scene: a number, or "auto" (larger horizontal extent / 30 m).
+    pub scale: ScaleSetting,
+    /// Mean point spacing [m]: a number, or "auto" (√(area / points)).
+    pub spacing: ScaleSetting,
+    /// Levelling.
+    pub level: LevelStage,
+    /// Floor removal.
+    pub ground: GroundStage,
+    /// Radius outlier removal.
+    pub radius: RadiusStage,
+    /// Statistical outlier removal.
+    pub statistical: StatisticalStage,
+    /// Voxel grid.
+    pub voxel: VoxelStage,
+    /// Bilateral smoothing.
+    pub smooth: SmoothStage,
+    /// Surface fit.
+    pub fit: FitStage,
+}
+
+/// Levelling settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct LevelStage {
+    /// estimate, given or none.
+    pub mode: LevelMode,
+    /// Roll α [deg] when given.
+    pub roll_deg: f64,
+    /// Pitch β [deg] when given.
+    pub pitch_deg: f64,
+    /// Share of the lowest points searched for the floor.
+    pub floor_fraction: f64,
+}
+
+/// Floor removal settings.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct GroundStage {
+    /// Keep points this far above the floor and higher [m at scale 1].
+    pub margin_m: f64,
+}
+
+/// Radius outlier removal settings (`[RS eq. 13]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RadiusStage {
+    /// Run it.
+    pub enabled: bool,
+    /// Search radius K_s [point spacings].
+    pub radius_spacings: f64,
+    /// Fewest neighbours to keep a point.
+    pub min_neighbors: usize,
+}
+
+/// Statistical outlier removal settings (`[RS eq. 14]`–`[RS eq. 16]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StatisticalStage {
+    /// Run it.
+    pub enabled: bool,
+    /// Neighbours k.
+    pub mean_k: usize,
+    /// Threshold factor α of `[RS eq. 16]`.
+    pub std_mul: f64,
+}
+
+/// Voxel grid settings (`[RS eq. 17]`–`[RS eq. 18]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct VoxelStage {
+    /// Run it.
+    pub enabled: bool,
+    /// Leaf size r [point spacings].
+    pub leaf_spacings: f64,
+}
+
+/// Bilateral smoothing settings (`[RS eq. 19]`–`[RS eq. 20]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct SmoothStage {
+    /// Run it.
+    pub enabled: bool,
+    /// Neighbourhood radius [point spacings].
+    pub radius_spacings: f64,
+    /// σ of w_d [point spacings].
+    pub sigma_d_spacings: f64,
+    /// σ of w_n [m at scale 1].
+    pub sigma_n_m: f64,
+    /// Passes.
+    pub iterations: usize,
+}
+
+/// Surface fit settings (`[RS eq. 21]`).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct FitStage {
+    /// Refuse a fit with R² at or under this (0 to accept any).
+    pub r2_threshold: f64,
+    /// Highest total polynomial degree tried.
+    pub max_degree: usize,
+}
+
+impl Default for PerceptionParams {
+    fn default() -> Self {
+        Self {
+            scale: ScaleSetting::Word(AutoWord::Auto),
+            spacing: ScaleSetting::Word(AutoWord::Auto),
+            level: LevelStage::default(),
+            ground: GroundStage::default(),
+            radius: RadiusStage::default(),
+            statistical: StatisticalStage::default(),
+            voxel: VoxelStage::default(),
+            smooth: SmoothStage::default(),
+            fit: FitStage::default(),
+        }
+    }
+}
+impl Default for LevelStage {
+    fn default() -> Self {
+        Self {
+            mode: LevelMode::Estimate,
+            roll_deg: 0.0,
+            pitch_deg: 0.0,
+            floor_fraction: TiltParams::default().floor_fraction,
+        }
+    }
+}
+impl Default for GroundStage {
+    fn default() -> Self {
+        Self { margin_m: 0.2 }
+    }
+}
+// The paper gives no filter settings. These (in point spacings) are checked
+// on the four synthetic pile shapes at full size and at 1:30 in
+// tests/pipeline.rs: the tilt comes back within 0.2° and R² > 0.95.
+impl Default for RadiusStage {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            radius_spacings: 3.0,
+            min_neighbors: 3,
+        }
+    }
+}
+impl Default for StatisticalStage {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            mean_k: 20,
+            std_mul: 2.0,
+        }
+    }
+}
+impl Default for VoxelStage {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            leaf_spacings: 2.0,
+        }
+    }
+}
+impl Default for SmoothStage {
+    fn default() -> Self {
+        Self {
+            enabled: true,
+            radius_spacings: 6.0,
+            sigma_d_spacings: 3.0,
+            sigma_n_m: 0.02,
+            iterations: 1,
+        }
+    }
+}
+impl Default for FitStage {
+    fn default() -> Self {
+        let p = FitParams::default();
+        Self {
+            r2_threshold: p.r2_threshold.unwrap_or(0.95),
+            max_degree: p.max_degree,
+        }
+    }
+}
+
+impl TomlFile for PerceptionParams {
+    type Error = SurfaceError;
+
+    /// Every number in range, named by its TOML key.
+    fn check(&self, text: &str, file: &str) -> Result<()> {
+        for (key, s) in [("scale", self.scale), ("spacing", self.spacing)] {
+            if let ScaleSetting::Factor(v) = s {
+                if !(v.is_finite() && v > 0.0) {
+                    return Err(config::invalid(
+                        text,
+                        file,
+                        ("", 0),
+                        key,
+                        v,
+                        "a finite value > 0 or \"auto\"",
+                    )
+                    .into());
+                }
+            }
+        }
+        config::check_each(
+            text,
+            file,
+            &[
+                ("radius", "radius_spacings", self.radius.radius_spacings),
+                ("voxel", "leaf_spacings", self.voxel.leaf_spacings),
+                ("smooth", "radius_spacings", self.smooth.radius_spacings),
+                ("smooth", "sigma_d_spacings", self.smooth.sigma_d_spacings),
+                ("smooth", "sigma_n_m", self.smooth.sigma_n_m),
+                ("statistical", "std_mul", self.statistical.std_mul),
+            ],
+            config::POSITIVE,
+        )?;
+        let finite: (fn(f64) -> bool, &str) = (|v: f64| v.is_finite(), "a finite number");
+        config::check_each(
+            text,
+            file,
+            &[
+                ("level", "roll_deg", self.level.roll_deg),
+                ("level", "pitch_deg", self.level.pitch_deg),
+                ("ground", "margin_m", self.ground.margin_m),
+            ],
+            finite,
+        )?;
+        let checks: [(&str, &str, f64, bool, &str); 4] = [
+            (
+                "level",
+                "floor_fraction",
+                self.level.floor_fraction,
+                self.level.floor_fraction > 0.0 && self.level.floor_fraction <= 1.0,
+                "a share in (0, 1]",
+            ),
+            (
+                "level",
+                "roll_deg",
+                self.level.roll_deg,
+                self.level.roll_deg.abs() < 90.0,
+                "an angle within ±90°",
+            ),
+            (
+                "level",
+                "pitch_deg",
+                self.level.pitch_deg,
+                self.level.pitch_deg.abs() < 90.0,
+                "an angle within ±90°",
+            ),
+            (
+                "fit",
+                "r2_threshold",
+                self.fit.r2_threshold,
+                (0.0..1.0).contains(&self.fit.r2_threshold),
+                "a value in [0, 1) (0 accepts any fit)",
+            ),
+        ];
+        for (table, key, v, ok, expected) in checks {
+            if !ok {
+                return Err(config::invalid(text, file, (table, 0), key, v, expected).into());
+            }
+        }
+        let counts = [
+            ("radius", "min_neighbors", self.radius.min_neighbors, 1),
+            ("statistical", "mean_k", self.statistical.mean_k, 1),
+            ("smooth", "iterations", self.smooth.iterations, 1),
+            ("fit", "max_degree", self.fit.max_degree, 1),
+        ];
+        for (table, key, v, min) in counts {
+            if v < min {
+                return Err(config::invalid(
+                    text,
+                    file,
+                    (table, 0),
+                    key,
+                    v,
+                    format!("at least {min}"),
+                )
+                .into());
+            }
+        }
+        if self.fit.max_degree > 8 {
+            return Err(config::invalid(
+                text,
+                file,
+                ("fit", 0),
+                "max_degree",
+                self.fit.max_degree,
+                "at most 8",
+            )
+            .into());
+        }
+        Ok(())
+    }
+}
+
+impl PerceptionParams {
+    /// Reads and checks a settings file (errors name the file, line and key).
+    pub fn load(path: &Path) -> Result<Self> {
+        <Self as TomlFile>::load(path)
+    }
+
+    /// The settings as TOML (`autoshovel perceive --print-config`).
+    pub fn to_toml(&self) -> String {
+        <Self as TomlFile>::to_toml(self)
+    }
+}
+
+/// One stage's record: its name, the points after it and its wall time.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageRecord {
+    /// Stage name: read, level, ground, radius, statistical, voxel, smooth, fit.
+    pub stage: &'static str,
+    /// Points after it (grid samples for the fit).
+    pub points: usize,
+    /// Wall-clock time [ms].
+    pub ms: f64,
+}
+
+/// What the pipeline made of a scan: the cleaned cloud and the fitted
+/// surface in the levelled frame, with every stage's count and time.
+#[derive(Debug, Clone)]
+pub struct Perceived {
+    /// The cleaned, levelled cloud.
+    pub cloud: PointCloud,
+    /// The fitted surface z = f(x, y) (`[RS eq. 21]`), levelled frame.
+    pub fit: SurfaceFit,
+    /// Floor height in the levelled frame [m].
+    pub floor_height_m: f64,
+    /// Roll α used to level [rad].
+    pub roll_rad: f64,
+    /// Pitch β used to level [rad].
+    pub pitch_rad: f64,
+    /// Length scale of the scene.
+    pub scale: f64,
+    /// Mean point spacing [m].
+    pub spacing_m: f64,
+    /// Every stage run, in order.
+    pub stages: Vec<StageRecord>,
+    /// Finite points given (read).
+    pub input_points: usize,
+    /// The file format read (`None` for a cloud given in memory).
+    pub format: Option<&'static str>,
+    /// Non-finite points dropped while reading.
+    pub non_finite_dropped: usize,
+}
+
+impl Perceived {
+    /// Wall time of every stage [ms].
+    pub fn total_ms(&self) -> f64 {
+        self.stages.iter().map(|s| s.ms).sum()
+    }
+}
+
+fn ms(t: Instant) -> f64 {
+    t.elapsed().as_secs_f64() * 1e3
+}
+
+/// Reads `path` (any format of `autoshovel_cloud::io::read`, with
+/// `progress(done, total)` in bytes while reading) and runs [`perceive`]
+/// on it; the read is the first stage.
+pub fn perceive_file(
+    path: &Path,
+    params: &PerceptionParams,
+    progress: &mut dyn FnMut(u64, u64),
+) -> Result<Perceived> {
+    let t = Instant::now();
+    let report = autoshovel_cloud::io::read(path, progress)?;
+    let read = StageRecord {
+        stage: "read",
+        points: report.cloud.len(),
+        ms: ms(t),
+    };
+    if report.cloud.is_empty() {
+        return Err(SurfaceError::NoFinitePoints {
+            non_finite_dropped: report.non_finite_dropped,
+        });
+    }
+    let mut got = perceive(&report.cloud, params)?;
+    got.stages.insert(0, read);
+    got.format = Some(report.format);
+    got.non_finite_dropped = report.non_finite_dropped;
+    Ok(got)
+}
+
+/// The scale and point spacing of `cloud` as `params` asks (numbers, or
+/// "auto" from the horizontal extent).
+pub fn scale_and_spacing(cloud: &PointCloud, params: &PerceptionParams) -> Result<(f64, f64)> {
+    let (lo, hi) = cloud.bounds().ok_or(SurfaceError::NoFinitePoints {
+        non_finite_dropped: 0,
+    })?;
+    let scale = match params.scale {
+        ScaleSetting::Factor(s) if s.is_finite() && s > 0.0 => s,
+        ScaleSetting::Factor(s) => {
+            return Err(SurfaceError::BadParameter {
+                name: "scale",
+                value: s,
+                expected: "a finite value > 0 or \"auto\"",
+            })
+        }
+        ScaleSetting::Word(AutoWord::Auto) => {
+            let extent = f64::from((hi[0] - lo[0]).max(hi[1] - lo[1]));
+            (extent / 30.0).clamp(0.01, 10.0)
+        }
+    };
+    let spacing = match params.spacing {
+        ScaleSetting::Factor(s) if s.is_finite() && s > 0.0 => s,
+        ScaleSetting::Factor(s) => {
+            return Err(SurfaceError::BadParameter {
+                name: "spacing",
+                value: s,
+                expected: "a finite value > 0 or \"auto\"",
+            })
+        }
+        ScaleSetting::Word(AutoWord::Auto) => {
+            let area = f64::from(hi[0] - lo[0]) * f64::from(hi[1] - lo[1]);
+            let s = (area / cloud.len() as f64).sqrt();
+            if !(s.is_finite() && s > 0.0) {
+                return Err(SurfaceError::NoHorizontalExtent);
+            }
+            s
+        }
+    };
+    Ok((scale, spacing))
+}
+
+/// The paper's pipeline on `cloud` (module docs): level, remove the floor,
+/// radius and statistical outliers, voxel grid, bilateral smoothing, fit.
+/// A stage's failure names the stage.
+pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceived> {
+    let p = params;
+    let input_points = cloud.len();
+    if input_points == 0 {
+        return Err(SurfaceError::NoFinitePoints {
+            non_finite_dropped: 0,
+        });
+    }
+    let (scale, spacing) = scale_and_spacing(cloud, p)?;
+    let mut stages: Vec<StageRecord> = Vec::new();
+    let in_stage = |stage: &'static str| {
+        move |source: SurfaceError| SurfaceError::Stage {
+            stage,
+            source: Box::new(source),
+        }
+    };
+    // Level [RS eq. 11]–[RS eq. 12].
+    let t = Instant::now();
+    let mut tilt_params = TiltParams::for_scale(scale);
+    tilt_params.floor_fraction = p.level.floor_fraction;
+    let (cloud, roll, pitch) = match p.level.mode {
+        LevelMode::Estimate => {
+            let est = estimate_tilt(cloud, &tilt_params)
+                .map_err(in_stage("estimating roll and pitch from the floor"))?;
+            (
+                level(cloud, est.roll_rad, est.pitch_rad),
+                est.roll_rad,
+                est.pitch_rad,
+            )
+        }
+        LevelMode::Given => {
+            let (r, q) = (
+                p.level.roll_deg.to_radians(),
+                p.level.pitch_deg.to_radians(),
+            );
+            if !(r.is_finite() && q.is_finite()) {
+                return Err(SurfaceError::BadParameter {
+                    name: "level.roll_deg / level.pitch_deg",
+                    value: if r.is_finite() { q } else { r },
+                    expected: "finite angles",
+                });
+            }
+            (level(cloud, r, q), r, q)
+        }
+        LevelMode::None => (cloud.clone(), 0.0, 0.0),
+    };
+    // The floor after levelling (for the pass-through threshold).
+    let floor = estimate_tilt(&cloud, &tilt_params)
+        .map_err(in_stage("finding the floor after levelling"))?;
+    stages.push(StageRecord {
+        stage: "level",
+        points: cloud.len(),
+        ms: ms(t),
+    });
+    // The filter stages, in the paper's order; each timed and counted.
+    type Filter<'a> = Box<dyn Fn(&PointCloud) -> autoshovel_cloud::Result<PointCloud> + 'a>;
+    let filters: [(&'static str, bool, Filter); 5] = [
+        (
+            "ground",
+            true,
+            Box::new(|c: &PointCloud| {
+                pass_through(
+                    c,
+                    &PassThroughParams::ground_removal(
+                        floor.floor_height_m + p.ground.margin_m * scale,
+                    ),
+                )
+            }),
+        ),
+        (
+            "radius",
+            p.radius.enabled,
+            // [RS eq. 13]
+            Box::new(|c: &PointCloud| {
+                radius_outlier_removal(
+                    c,
+                    &RadiusOutlierParams {
+                        radius_m: p.radius.radius_spacings * spacing,
+                        min_neighbors: p.radius.min_neighbors,
+                    },
+                )
+            }),
+        ),
+        (
+            "statistical",
+            p.statistical.enabled,
+            // [RS eq. 14]–[RS eq. 16]
+            Box::new(|c: &PointCloud| {
+                statistical_outlier_removal(
+                    c,
+                    &StatisticalOutlierParams {
+                        mean_k: p.statistical.mean_k,
+                        std_mul: p.statistical.std_mul,
+                    },
+                )
+            }),
+        ),
+        (
+            "voxel",
+            p.voxel.enabled,
+            // [RS eq. 17]–[RS eq. 18]
+            Box::new(|c: &PointCloud| {
+                voxel_grid(c, &VoxelGridParams::cube(p.voxel.leaf_spacings * spacing))
+            }),
+        ),
+        (
+            "smooth",
+            p.smooth.enabled,
+            // [RS eq. 19]–[RS eq. 20]
+            Box::new(|c: &PointCloud| {
+                let params = BilateralParams {
+                    radius_m: p.smooth.radius_spacings * spacing,
+                    sigma_d_m: p.smooth.sigma_d_spacings * spacing,
+                    sigma_n_m: p.smooth.sigma_n_m * scale,
+                    iterations: p.smooth.iterations,
+                };
+                bilateral_normal_smoothing(c, &params)
+            }),
+        ),
+    ];
+    let mut cloud = cloud;
+    for (stage, enabled, run) in filters {
+        if enabled {
+            let t = Instant::now();
+            cloud = run(&cloud).map_err(|source| SurfaceError::Filter { stage, source })?;
+            stages.push(StageRecord {
+                stage,
+                points: cloud.len(),
+                ms: ms(t),
+            });
+        }
+    }
+    // Fit [RS eq. 21].
+    let t = Instant::now();
+    let fit_params = FitParams {
+        max_degree: p.fit.max_degree,
+        r2_threshold: (p.fit.r2_threshold > 0.0).then_some(p.fit.r2_threshold),
+        ..FitParams::default()
+    };
+    let fit = fit_surface(&cloud, &fit_params).map_err(in_stage("fitting the surface"))?;
+    stages.push(StageRecord {
+        stage: "fit",
+        points: fit.samples.len(),
+        ms: ms(t),
+    });
+    Ok(Perceived {
+        cloud,
+        fit,
+        floor_height_m: floor.floor_height_m,
+        roll_rad: roll,
+        pitch_rad: pitch,
+        scale,
+        spacing_m: spacing,
+        stages,
+        input_points,
+        format: None,
+        non_finite_dropped: 0,
+    })
+}
+
+/// The fit part of a perception summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct FitSummary {
+    /// Total degree chosen.
+    pub degree: usize,
+    /// R² on the grid samples.
+    pub r2: f64,
+    /// Adjusted R².
+    pub adjusted_r2: f64,
+    /// RMS residual on the samples [m].
+    pub rms_residual_m: f64,
+    /// R² on every cleaned point.
+    pub r2_all_points: f64,
+    /// RMS residual on every cleaned point [m].
+    pub rms_all_points_m: f64,
+    /// Grid samples used.
+    pub samples: usize,
+    /// The polynomial's terms.
+    pub coefficients: Vec<Term>,
+}
+
+/// The summary of `autoshovel perceive` (SPEC §6).
+#[derive(Debug, Clone, Serialize)]
+pub struct PerceiveSummary {
+    /// "perceive".
+    pub job: &'static str,
+    /// The scan file.
+    pub input: String,
+    /// The format read.
+    pub format: Option<&'static str>,
+    /// Finite points read.
+    pub input_points: usize,
+    /// Non-finite points dropped while reading.
+    pub non_finite_dropped: usize,
+    /// Points of the cleaned cloud.
+    pub output_points: usize,
+    /// Points after each stage, by stage name.
+    pub stage_points: BTreeMap<&'static str, usize>,
+    /// Every stage, in order.
+    pub stages: Vec<StageRecord>,
+    /// Roll α used to level [deg].
+    pub roll_deg: f64,
+    /// Pitch β used to level [deg].
+    pub pitch_deg: f64,
+    /// Floor height, levelled frame [m].
+    pub floor_height_m: f64,
+    /// Length scale used.
+    pub scale: f64,
+    /// Point spacing used [m].
+    pub spacing_m: f64,
+    /// R² of the fit on the grid samples.
+    pub r2: f64,
+    /// Wall time of each stage [ms].
+    pub timings_ms: BTreeMap<&'static str, f64>,
+    /// Wall time of all stages [ms].
+    pub total_ms: f64,
+    /// The fit.
+    pub fit: FitSummary,
+    /// The settings used.
+    pub pipeline: PerceptionParams,
+    /// Always true (a failed run is an error).
+    pub success: bool,
+}
+
+impl PerceiveSummary {
+    /// The summary of `got`, read from `input` with `params`.
+    pub fn new(input: &Path, params: &PerceptionParams, got: &Perceived) -> Self {
+        let fit = &got.fit;
+        Self {
+            job: "perceive",
+            input: input.display().to_string(),
+            format: got.format,
+            input_points: got.input_points,
+            non_finite_dropped: got.non_finite_dropped,
+            output_points: got.cloud.len(),
+            stage_points: got.stages.iter().map(|s| (s.stage, s.points)).collect(),
+            stages: got.stages.clone(),
+            roll_deg: got.roll_rad.to_degrees(),
+            pitch_deg: got.pitch_rad.to_degrees(),
+            floor_height_m: got.floor_height_m,
+            scale: got.scale,
+            spacing_m: got.spacing_m,
+            r2: fit.r2,
+            timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
+            total_ms: got.total_ms(),
+            fit: FitSummary {
+                degree: fit.degree,
+                r2: fit.r2,
+                adjusted_r2: fit.adjusted_r2,
+                rms_residual_m: fit.rms_residual_m,
+                r2_all_points: fit.r2_all_points,
+                rms_all_points_m: fit.rms_all_points_m,
+                samples: fit.samples.len(),
+                coefficients: fit.coefficients_xy(),
+            },
+            pipeline: params.clone(),
+            success: true,
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::{generate_pile, PileParams};
+
+    #[test]
+    fn the_defaults_print_and_load_back_equal() {
+        let d = PerceptionParams::default();
+        let back: PerceptionParams = TomlFile::from_toml(&d.to_toml(), "printed").unwrap();
+        assert_eq!(back, d);
+    }
+
+    #[test]
+    fn bad_values_name_their_key_and_line() {
+        for (text, key, line) in [
+            ("scale = -2\n", "scale", 1),
+            (
+                "\n[level]\nfloor_fraction = 1.5\n",
+                "[level] floor_fraction",
+                3,
+            ),
+            ("[fit]\nr2_threshold = nan\n", "[fit] r2_threshold", 2),
+            ("[statistical]\nstd_mul = -2\n", "[statistical] std_mul", 2),
+            ("[smooth]\niterations = 0\n", "[smooth] iterations", 2),
+            ("[level]\nroll_deg = 1e308\n", "[level] roll_deg", 2),
+        ] {
+            let err = <PerceptionParams as TomlFile>::from_toml(text, "p.toml").unwrap_err();
+            let msg = err.to_string();
+            assert!(
+                msg.starts_with(&format!("p.toml:{line}: {key} = ")),
+                "{text:?}: {msg}"
+            );
+        }
+    }
+
+    #[test]
+    fn every_stage_is_counted_in_order_and_counts_never_grow() {
+        let scan = generate_pile(&PileParams {
+            points: 20_000,
+            ..PileParams::default()
+        })
+        .unwrap();
+        let got = perceive(&scan, &PerceptionParams::default()).unwrap();
+        let names: Vec<_> = got.stages.iter().map(|s| s.stage).collect();
+        assert_eq!(
+            names,
+            [
+                "level",
+                "ground",
+                "radius",
+                "statistical",
+                "voxel",
+                "smooth",
+                "fit"
+            ]
+        );
+        let filtered = &got.stages[..6];
+        assert!(filtered.windows(2).all(|w| w[1].points <= w[0].points));
+        assert_eq!(got.stages[5].points, got.cloud.len());
+        assert_eq!(got.input_points, scan.len());
+    }
+
+    #[test]
+    fn a_disabled_stage_is_skipped_and_a_failing_one_is_named() {
+        let scan = generate_pile(&PileParams {
+            points: 20_000,
+            ..PileParams::default()
+        })
+        .unwrap();
+        let mut p = PerceptionParams::default();
+        p.smooth.enabled = false;
+        p.voxel.enabled = false;
+        let got = perceive(&scan, &p).unwrap();
+        assert!(got
+            .stages
+            .iter()
+            .all(|s| s.stage != "smooth" && s.stage != "voxel"));
+        p.ground.margin_m = 1e6; // removes every point
+        let err = perceive(&scan, &p).unwrap_err();
+        assert!(
+            err.to_string().contains("fitting the surface") || err.to_string().contains("filter"),
+            "{err}"
+        );
+    }
+}
