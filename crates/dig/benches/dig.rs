@@ -1,5 +1,5 @@
-//! Criterion benchmarks of the dig planner: one objective evaluation ([RS eqs.
-//! 22–35] on 121 samples) and one whole plan (50 wolves × 100 iterations).
+//! Criterion benchmarks of the dig planner: one objective evaluation ([RS eqs. 22–35]
+//! on 121 samples) and one whole plan (50 wolves × 100 iterations).
 
 use autoshovel_dig::{plan_dig, Decision, DigModel, DigSurface, MachineProfile};
 use autoshovel_optim::GwoParams;

@@ -1,9 +1,17 @@
 //! Rope-shovel dig planning (rope-shovel paper §2 and §4; SPEC §4.2–4.3):
 //! product-of-exponentials kinematics of the 1R-1P dipper ([`kinematics`],
-//! [RS eqs. 1–8]), Lagrange dynamics with digging resistance ([`dynamics`], [RS eq. 10]), the 6th-order tooth path ([`trajectory`], [RS eqs. 22–24]), the pile as
-//! the planner sees it ([`terrain`], [RS eq. 21] and [RS eq. 28]), and the planner that
-//! puts them under the 18 constraints and the Grey Wolf Optimizer ([`plan`],
-//! [RS eqs. 25–37]). The machine is a [`MachineProfile`] read from TOML.
+//! [RS eqs. 1–8]), Lagrange dynamics with digging resistance
+//! ([`dynamics`], [RS eq. 10]), the 6th-order tooth path ([`trajectory`],
+//! [RS eqs. 22–24]), the pile as the planner sees it ([`terrain`],
+//! [RS eq. 21] and [RS eq. 28]), and the planner that puts them under the
+//! 18 constraints and the Grey Wolf Optimizer ([`plan`], [RS eqs. 25–37]).
+//! The machine is a [`MachineProfile`] read from TOML.
+//!
+//! The `plan-dig` job lives here too: [`job`] (setup, pile, [`plan_pile`]
+//! and its typed [`DigSummary`]), [`compare`] (the four piles beside the
+//! paper's Tables 4–5, [`all_surfaces`]), [`paper`] (those tables as data),
+//! [`pack`] (the warm-start `pack.csv`) and [`scan`] (the dig profile cut
+//! from a perceived scan).
 
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]

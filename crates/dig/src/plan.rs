@@ -1,7 +1,7 @@
-//! The dig-planning model of the rope-shovel paper §4: objective ([RS eqs.
-//! 25–27]), excavated volume ([RS eq. 28]), the 18 constraints ([RS eqs.
-//! 29–35]), the optimisation model ([RS eq. 36]) and its solution by the
-//! Grey Wolf Optimizer ([RS eq. 37]).
+//! The dig-planning model of the rope-shovel paper §4: objective
+//! ([RS eqs. 25–27]), excavated volume ([RS eq. 28]), the 18 constraints
+//! ([RS eqs. 29–35]), the optimisation model ([RS eq. 36]) and its solution
+//! by the Grey Wolf Optimizer ([RS eq. 37]).
 //!
 //! One evaluation samples the trajectory of [RS eq. 22] at `numerics.samples`
 //! instants, solves the inverse kinematics ([RS eqs. 7–8]) and the inverse
@@ -605,7 +605,8 @@ pub struct DigPlan {
     pub search: GwoResult,
 }
 
-/// Plan a dig ([RS eq. 36] solved by [RS eq. 37]): minimise f over the search box with the Grey Wolf Optimizer,
+/// Plan a dig ([RS eq. 36] solved by [RS eq. 37]): minimise f over the
+/// search box with the Grey Wolf Optimizer,
 /// starting from `warm_start` wolves (e.g. the previous cycle's
 /// `search.population`) plus the initial pack of `gwo`. A best plan that
 /// still violates a constraint is an error naming the binding constraints.

@@ -269,7 +269,8 @@ impl DigSurface {
     }
 }
 
-/// Area swept per unit path length (the integrand of [RS eq. 28]) by a cut of normal thickness `c` on a
+/// Area swept per unit path length (the integrand of [RS eq. 28]) by a
+/// cut of normal thickness `c` on a
 /// path of signed curvature `kappa` (positive when it bends towards the
 /// material, i.e. to the left of travel): the strip between the path and the
 /// surface in path coordinates has area element (1 − κλ) dλ ds, so
