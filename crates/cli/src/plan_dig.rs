@@ -15,8 +15,8 @@ use std::path::{Path, PathBuf};
 use anyhow::{anyhow, bail, Context as _, Result};
 use autoshovel_dig::TomlFile as _;
 use autoshovel_dig::{
-    all_surfaces, plan_pile, DigSetup, DigSummary, MachineProfile, Pile,
-    SearchSpace, WarmStart, CONSTRAINT_NAMES,
+    all_surfaces, plan_pile, DigSetup, DigSummary, MachineProfile, Pile, SearchSpace, WarmStart,
+    CONSTRAINT_NAMES,
 };
 use autoshovel_figures::dig as figures;
 use autoshovel_optim::Init;
