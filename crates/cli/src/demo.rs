@@ -177,33 +177,34 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         summaries.insert(key, summary);
     }
     // Dig planning: the typical pile, then all four beside the paper's Tables 4–5.
-    let setup = crate::plan_dig::Setup::new(
-        None,
-        1,
-        crate::plan_dig::SearchArg::Bends,
-        crate::plan_dig::InitArg::GoodPointSet,
-    )?;
+    let setup = autoshovel_dig::DigSetup::scale_model(1);
     let sub = "plan-dig-typical";
     let dir = prepare_dir(&out.join(sub))?;
-    let pile = crate::plan_dig::Pile::shape(autoshovel_surface::PileShape::Typical, &setup.profile);
-    let job = crate::plan_dig::job(&pile, &setup, Some(&dir))?;
+    let typical = autoshovel_dig::paper_row(autoshovel_surface::PileShape::Typical);
+    let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile);
+    let planned = autoshovel_dig::plan_pile(&pile, &setup)?;
+    let job = crate::output::Job::finish(planned.summary.clone(), Some(&dir), |dir, written| {
+        autoshovel_figures::dig::write_plan(dir, &planned, written).map_err(|e| anyhow::anyhow!(e))
+    })?;
     let key = "plan-dig typical";
     if !json_only {
         let s = &job.summary;
-        let g = |k: &str| s[k].as_f64().unwrap_or(f64::NAN);
-        match &job.error {
-            None => crate::say!(
-                "{key:40} ok: m_dig {:.3} kg (paper 2.053), fill {:.1} %, t_d {:.2} s, f {:.2} (paper 13.76), {:.0} ms",
-                g("m_dig_kg"),
-                100.0 * g("fill_factor"),
-                g("td_s"),
-                g("f"),
-                g("plan_time_ms")
+        match (&s.error, &s.plan) {
+            (None, Some(p)) => crate::say!(
+                "{key:40} ok: m_dig {:.3} kg (paper {}), fill {:.1} %, t_d {:.2} s, f {:.2} (paper {}), {:.0} ms",
+                p.m_dig_kg,
+                typical.m_dig_kg,
+                100.0 * p.fill_factor,
+                p.td_s,
+                p.f,
+                typical.f,
+                s.plan_time_ms
             ),
-            Some(e) => crate::say!("{key:40} FAILED: {e}"),
+            (e, _) => crate::say!("{key:40} FAILED: {}", e.as_deref().unwrap_or("no plan")),
         }
     }
-    let mut shown = job.summary.clone();
+    let summary = job.json()?;
+    let mut shown = summary.clone();
     if let Some(o) = shown.as_object_mut() {
         o.remove("geometry");
         if let Some(cs) = o.get_mut("constraints").and_then(Value::as_object_mut) {
@@ -220,37 +221,54 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         &job.written.plots,
         &job.written.files,
     ));
-    summaries.insert(key.into(), job.summary);
+    summaries.insert(key.into(), summary);
     let sub = "plan-dig-all-surfaces";
     let dir = prepare_dir(&out.join(sub))?;
-    let all = crate::plan_dig::all_surfaces(&setup, Some(&dir), false)?;
+    let mut all = autoshovel_dig::all_surfaces(&setup, |_| {})?;
+    let piles =
+        autoshovel_figures::dig::write_piles(&dir, &mut all).map_err(|e| anyhow::anyhow!(e))?;
+    let job = crate::output::Job::finish(all.summary.clone(), Some(&dir), |dir, written| {
+        written.plots.extend(piles.plots);
+        written.files.extend(piles.files);
+        autoshovel_figures::dig::write_comparison(dir, &all, written)
+            .map_err(|e| anyhow::anyhow!(e))
+    })?;
     let key = "plan-dig --all-surfaces";
     if !json_only {
-        crate::say!("{}", all.table);
-        if let Some(e) = &all.error {
+        crate::say!("{}", autoshovel_figures::dig::markdown_table(&job.summary));
+        if let Some(e) = job.summary.error() {
             crate::say!("{key:40} FAILED: {e}");
         }
     }
+    let calibrated: Vec<&str> = autoshovel_dig::PAPER_TABLES_4_5
+        .iter()
+        .filter(|r| r.calibrated())
+        .map(|r| r.shape.name())
+        .collect();
+    let description = format!(
+        "The four piles of Fig. 7 in Table 5's order, each planned with the same profile and seed, beside the paper's Tables 4–5 (paper values and the relative difference of m_dig and f). The profile's digging resistance is calibrated on the {} pile (SPEC §4.2); the other three piles are predictions. Each pile's full outputs are in its own folder.",
+        calibrated.join(", ")
+    );
     sections.push(section(
         key,
-        "The four piles of Fig. 7 in Table 5's order, each planned with the same profile and seed, beside the paper's Tables 4–5 (paper values and the relative difference of m_dig and f). The profile's digging resistance is calibrated on the typical pile (SPEC §4.2); the other three piles are predictions. Each pile's full outputs are in its own folder.",
-        &crate::plan_dig::table_summary(&all.summary),
+        &description,
+        &serde_json::to_value(autoshovel_dig::table_summary(&job.summary))?,
         sub,
         // The comparison and each pile's path; the other plots are in the pile folders.
-        &all.written
+        &job.written
             .plots
             .iter()
             .filter(|p| p.ends_with("paths.svg") || p.ends_with("dig_path.svg"))
             .cloned()
             .collect::<Vec<_>>(),
-        &all.written
+        &job.written
             .files
             .iter()
             .filter(|f| !f.contains('/') || f.ends_with("summary.json"))
             .cloned()
             .collect::<Vec<_>>(),
     ));
-    summaries.insert(key.into(), all.summary);
+    summaries.insert(key.into(), job.json()?);
     // Hydraulic excavator: the paper's §3 case passed over and under, then two boulders in one dig.
     let excavate_runs: [(&str, &str); 3] = [
         ("paper-over", "The hydraulic-excavator paper's §3 case (Fig. 5): 0.9 m³ from (7, 0) at 0.7 m depth; the descending tooth meets a 0.5 m boulder it did not know about on its upper part, γ ∈ (0°, 180°), so it passes over; the boulder counts as dug and the rest is re-planned (paper: 0.909 m³, contact at 1.6 s)."),

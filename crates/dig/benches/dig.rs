@@ -1,5 +1,5 @@
-//! Criterion benchmarks of the dig planner: one objective evaluation (eqs.
-//! 22–35 on 121 samples) and one whole plan (50 wolves × 100 iterations).
+//! Criterion benchmarks of the dig planner: one objective evaluation ([RS eqs. 22–35]
+//! on 121 samples) and one whole plan (50 wolves × 100 iterations).
 
 use autoshovel_dig::{plan_dig, Decision, DigModel, DigSurface, MachineProfile};
 use autoshovel_optim::GwoParams;
@@ -31,7 +31,7 @@ fn whole_plan(c: &mut Criterion) {
         let params = GwoParams {
             seed: 1,
             parallel,
-            ..GwoParams::default()
+            ..autoshovel_dig::gwo_preset()
         };
         let name = if parallel { "parallel" } else { "serial" };
         g.bench_function(name, |b| b.iter(|| plan_dig(&m, &params, &[]).unwrap()));

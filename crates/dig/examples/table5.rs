@@ -4,27 +4,28 @@
 //!
 //! `cargo run --release -p autoshovel-dig --example table5`
 
-use autoshovel_dig::{plan_dig, DigModel, DigSurface, MachineProfile};
+use autoshovel_dig::{
+    gwo_preset, plan_dig, DigModel, DigSurface, MachineProfile, PAPER_TABLES_4_5,
+};
 use autoshovel_optim::GwoParams;
-use autoshovel_surface::PileShape;
 
 fn main() {
-    // Table 5: f, f1 [J/kg], f2 [s/kg], m_dig [kg], fill [%].
-    let paper = [
-        (13.76, 17.19, 5.771, 2.053, 99.72),
-        (13.83, 17.22, 5.925, 1.991, 96.71),
-        (13.87, 17.51, 5.367, 2.156, 104.7),
-        (12.57, 15.55, 5.625, 2.045, 99.29),
-    ];
     let profile = MachineProfile::scale_model();
     println!("| pile | f (paper) | f1 J/kg (paper) | m_dig kg (paper) | fill % (paper) | t_d s |");
     println!("|---|---|---|---|---|---|");
-    for (shape, (f, f1, _f2, m, fill)) in PileShape::ALL.into_iter().zip(paper) {
+    for row in &PAPER_TABLES_4_5 {
+        let (shape, f, f1, m, fill) = (
+            row.shape,
+            row.f,
+            row.f1_j_per_kg,
+            row.m_dig_kg,
+            row.fill_pct,
+        );
         let surface = DigSurface::from_shape(shape, profile.dipper.width_m);
         let model = DigModel::new(&profile, surface).expect("the scale model reaches the pile");
         let gwo = GwoParams {
             seed: 1,
-            ..GwoParams::default()
+            ..gwo_preset()
         };
         let plan = plan_dig(&model, &gwo, &[]).expect("a feasible plan");
         let o = &plan.outcome;

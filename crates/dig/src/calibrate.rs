@@ -38,11 +38,12 @@ pub struct CalibrationTarget {
 }
 
 impl CalibrationTarget {
-    /// Table 5, typical surface.
+    /// Table 5, typical surface ([`crate::paper::PAPER_TABLES_4_5`]).
     pub fn table5_typical() -> Self {
+        let row = crate::paper::paper_row(crate::paper::CALIBRATION_PILE);
         Self {
-            f1_j_per_kg: 17.19,
-            fill_factor: 0.9972,
+            f1_j_per_kg: row.f1_j_per_kg,
+            fill_factor: row.fill_factor(),
         }
     }
 }

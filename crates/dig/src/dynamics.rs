@@ -1,5 +1,5 @@
 //! Lagrange dynamics of the handle and dipper (rope-shovel paper §2.3,
-//! eqs. 9–10) and the digging resistance (SPEC §4.2).
+//! [RS eqs. 9–10]) and the digging resistance (SPEC §4.2).
 //!
 //! # Model
 //! Generalised coordinates θ₁ and the extension D = d₂ + d₂₀ (the paper's d).
@@ -14,11 +14,11 @@
 //!     M(D) = [ I(D)     −m_c e ]      I(D) = m_d((D − L_d/2)² + L_d²/12)
 //!            [ −m_c e   m_d+m_c ]            + m_c((D − L_c/2)² + e²) + I_c
 //!     I(D) θ̈ − m_c e D̈ + I′(D) Ḋ θ̇ + ∂P/∂θ = Q_θ
-//!     −m_c e θ̈ + (m_d+m_c) D̈ − ½ I′(D) θ̇² + ∂P/∂D = Q_D                 (eq. 10)
+//!     −m_c e θ̈ + (m_d+m_c) D̈ − ½ I′(D) θ̇² + ∂P/∂D = Q_D                 ([RS eq. 10])
 //! ```
 //!
 //! With e = 0 and the dipper as a rod from D to D + L_c this is exactly the
-//! printed eq. 10 (whose gravity term says L_d/2 where the rod's own L_c/2
+//! printed [RS eq. 10] (whose gravity term says L_d/2 where the rod's own L_c/2
 //! belongs; the test `reduces_to_printed_eq_10` checks the reduction).
 //! Generalised forces come from virtual work, Q = Jᵀ F at each point of
 //! application: the hoist rope tension F_h at the bail pin C along the rope,
@@ -112,7 +112,7 @@ impl MassModel {
     }
 }
 
-/// The pieces of eq. 10 at one configuration.
+/// The pieces of [RS eq. 10] at one configuration.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct LagrangeTerms {
     /// M₁₁ = I(D).
@@ -159,7 +159,7 @@ impl Drive {
     }
 }
 
-/// Inverse dynamics: the hoist and crowd forces that drive the joint state
+/// Inverse dynamics ([RS eqs. 9–10]): the hoist and crowd forces that drive the joint state
 /// `js` against gravity, inertia and a digging resistance `f_tau` (with
 /// normal ratio `psi`), for `m_load` kg in the dipper. The tip velocity
 /// `tip_v` orients the resistance. `None` where the rope has no moment arm
@@ -179,6 +179,7 @@ pub fn inverse_dynamics(
     let (u, n) = (js.u, js.n);
     let t = mass.terms_sc(u[0], n[0], d, m_load);
     let (th_dot, d_dot) = (js.theta1_dot, js.d2_dot);
+    // [RS eq. 9]–[RS eq. 10]: the generalised forces of the Lagrange equations.
     let q_theta =
         t.m11 * js.theta1_ddot + t.m12 * js.d2_ddot + t.inertia_d * d_dot * th_dot + t.dp_dtheta;
     let q_d =
@@ -240,7 +241,7 @@ mod tests {
     #[test]
     fn reduces_to_printed_eq_10() {
         // e = 0, dipper rod from D to D + L_c: shift the centroid by using
-        // −L_c as the "length" (centroid D + L_c/2) and compare with eq. 10's
+        // −L_c as the "length" (centroid D + L_c/2) and compare with [RS eq. 10]'s
         // inertia and Coriolis coefficients as printed.
         let m = MassModel {
             handle_mass: 0.5,

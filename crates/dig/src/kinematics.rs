@@ -1,5 +1,5 @@
 //! 1R-1P dipper kinematics of the rope shovel (rope-shovel paper §2.2,
-//! eqs. 1–8), in the dig frame {Oo}: x from the toe into the pile, y up.
+//! [RS eqs. 1–8]), in the dig frame {Oo}: x from the toe into the pile, y up.
 //!
 //! Joint 1 turns the handle about the saddle centre O = (l₁, l₂) by θ₁, the
 //! angle of the handle from the downward vertical (counter-clockwise, towards
@@ -7,12 +7,12 @@
 //! u = (sin θ₁, −cos θ₁) and its normal n = (cos θ₁, sin θ₁), the tooth tip is
 //!
 //! ```text
-//!     p = O + l₃ n + (d₂ + d₂₀) u                                  (eq. 6)
+//!     p = O + l₃ n + (d₂ + d₂₀) u                                  ([RS eq. 6])
 //! ```
 //!
-//! which [`RopeShovel::forward_poe`] builds as eq. 1, e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T(0),
+//! which [`RopeShovel::forward_poe`] builds as [RS eq. 1], e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T(0),
 //! from the twists ξ₁ (revolute about z through O) and ξ₂ (prismatic along
-//! the handle at home, −y). The inverse is closed form (eqs. 7–8, with atan2
+//! the handle at home, −y). The inverse is closed form ([RS eqs. 7–8], with atan2
 //! so that every quadrant is right):
 //!
 //! ```text
@@ -20,7 +20,7 @@
 //!                                              (p_x − l₁) l₃ − (p_y − l₂) D)
 //! ```
 //!
-//! Rates follow from the derivatives of eq. 6 in the (n, u) basis:
+//! Rates follow from the derivatives of [RS eq. 6] in the (n, u) basis:
 //! ṗ_n = D θ̇₁, ṗ_u = Ḋ − l₃ θ̇₁, and
 //! p̈_n = D θ̈₁ + 2 θ̇₁ Ḋ − l₃ θ̇₁², p̈_u = D̈ − l₃ θ̈₁ − D θ̇₁² (D = d₂ + d₂₀).
 
@@ -29,7 +29,7 @@ use nalgebra::{Matrix4, Vector3};
 
 use crate::profile::Geometry;
 
-/// Joint values: handle angle θ₁ [rad] and extension d₂ [m] (eq. 1).
+/// Joint values: handle angle θ₁ [rad] and extension d₂ [m] ([RS eq. 1]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Joints {
     /// θ₁: handle angle from the downward vertical, counter-clockwise [rad].
@@ -78,16 +78,16 @@ impl RopeShovel {
         Self { geometry }
     }
 
-    /// Eq. 6: the tooth tip for joint values (closed form).
+    /// [RS eq. 6]: the tooth tip for joint values (closed form).
     #[inline]
     pub fn forward(&self, q: Joints) -> [f64; 2] {
         let g = &self.geometry;
         let (u, n) = handle_axes(q.theta1);
         let d = q.d2 + g.d20;
-        [g.l1 + g.l3 * n[0] + d * u[0], g.l2 + g.l3 * n[1] + d * u[1]]
+        [g.l1 + g.l3 * n[0] + d * u[0], g.l2 + g.l3 * n[1] + d * u[1]] // [RS eq. 6]
     }
 
-    /// Eq. 1: the full tip pose T_BW(q) = e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T_BW(0) by PoE
+    /// [RS eq. 1]: the full tip pose T_BW(q) = e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T_BW(0) by PoE
     /// (z out of the dig plane). Its translation equals [`RopeShovel::forward`].
     pub fn forward_poe(&self, q: Joints) -> Matrix4<f64> {
         let g = &self.geometry;
@@ -96,10 +96,10 @@ impl RopeShovel {
         let mut home = Matrix4::identity();
         home[(0, 3)] = g.l1 + g.l3;
         home[(1, 3)] = g.l2 - g.d20;
-        product_of_exponentials(&[xi1, xi2], &[q.theta1, q.d2], &home)
+        product_of_exponentials(&[xi1, xi2], &[q.theta1, q.d2], &home) // [RS eq. 1]
     }
 
-    /// Eqs. 7–8: joint values putting the tip at `p`, or `None` when `p` is
+    /// [RS eqs. 7–8]: joint values putting the tip at `p`, or `None` when `p` is
     /// closer to O than l₃ (no handle extension reaches it). The returned d₂
     /// may be negative or beyond the stroke; limits are the planner's business.
     #[inline]
@@ -110,8 +110,8 @@ impl RopeShovel {
         if dd.is_nan() || dd <= 0.0 {
             return None;
         }
-        let d = dd.sqrt();
-        let theta1 = (dy * g.l3 + dx * d).atan2(dx * g.l3 - dy * d);
+        let d = dd.sqrt(); // [RS eq. 8]: D = d₂ + d₂₀
+        let theta1 = (dy * g.l3 + dx * d).atan2(dx * g.l3 - dy * d); // [RS eq. 7]
         Some(Joints {
             theta1,
             d2: d - g.d20,
@@ -120,7 +120,7 @@ impl RopeShovel {
 
     /// Joint state from the tip's position, velocity and acceleration
     /// (inverse of the rate relations in the module docs). sin θ₁ and cos θ₁
-    /// come from eq. 7's numerator and denominator over l₃² + D², so no
+    /// come from [RS eq. 7]'s numerator and denominator over l₃² + D², so no
     /// trigonometric call is made but the atan2 for θ₁ itself.
     #[inline]
     pub fn joint_state(&self, p: [f64; 2], v: [f64; 2], a: [f64; 2]) -> Option<JointState> {
@@ -132,7 +132,7 @@ impl RopeShovel {
             return None;
         }
         let d = dd.sqrt();
-        let (num, den) = (dy * g.l3 + dx * d, dx * g.l3 - dy * d);
+        let (num, den) = (dy * g.l3 + dx * d, dx * g.l3 - dy * d); // [RS eq. 7]
         let (sn, cs) = (num / r2, den / r2);
         let (u, n) = ([sn, -cs], [cs, sn]);
         let (vn, vu) = (v[0] * n[0] + v[1] * n[1], v[0] * u[0] + v[1] * u[1]);
@@ -210,7 +210,7 @@ mod tests {
             let p = s.forward(q);
             assert_relative_eq!(t[(0, 3)], p[0], epsilon = 1e-14);
             assert_relative_eq!(t[(1, 3)], p[1], epsilon = 1e-14);
-            // Rotation part of eq. 3: rot_z(θ₁).
+            // Rotation part of [RS eq. 3]: rot_z(θ₁).
             assert_relative_eq!(t[(0, 0)], theta1.cos(), epsilon = 1e-14);
             assert_relative_eq!(t[(1, 0)], theta1.sin(), epsilon = 1e-14);
         }

@@ -1,30 +1,53 @@
 //! Rope-shovel dig planning (rope-shovel paper §2 and §4; SPEC §4.2–4.3):
 //! product-of-exponentials kinematics of the 1R-1P dipper ([`kinematics`],
-//! eqs. 1–8), Lagrange dynamics with digging resistance ([`dynamics`], eq.
-//! 10), the 6th-order tooth path ([`trajectory`], eqs. 22–24), the pile as
-//! the planner sees it ([`terrain`], eqs. 21 and 28), and the planner that
-//! puts them under the 18 constraints and the Grey Wolf Optimizer ([`plan`],
-//! eqs. 25–37). The machine is a [`MachineProfile`] read from TOML.
+//! [RS eqs. 1–8]), Lagrange dynamics with digging resistance
+//! ([`dynamics`], [RS eq. 10]), the 6th-order tooth path ([`trajectory`],
+//! [RS eqs. 22–24]), the pile as the planner sees it ([`terrain`],
+//! [RS eq. 21] and [RS eq. 28]), and the planner that puts them under the
+//! 18 constraints and the Grey Wolf Optimizer ([`plan`], [RS eqs. 25–37]).
+//! The machine is a [`MachineProfile`] read from TOML.
+//!
+//! The `plan-dig` job lives here too: [`job`] (setup, pile, [`plan_pile`]
+//! and its typed [`DigSummary`]), [`compare`] (the four piles beside the
+//! paper's Tables 4–5, [`all_surfaces`]), [`paper`] (those tables as data),
+//! [`pack`] (the warm-start `pack.csv`) and [`scan`] (the dig profile cut
+//! from a perceived scan).
 
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod calibrate;
+pub mod compare;
 pub mod dynamics;
 mod error;
+pub mod job;
 pub mod kinematics;
+pub mod pack;
+pub mod paper;
 pub mod plan;
 pub mod profile;
+pub mod scan;
 pub mod terrain;
 pub mod trajectory;
 
 pub use autoshovel_core::config::TomlFile;
-pub use error::{DigError, Result};
+pub use compare::{
+    all_surfaces, table_summary, AllSurfaces, AllSurfacesSummary, ComparedPile, PaperPlanCheck,
+    SurfaceComparison, TableColumn, TableRow, TableSummary, TABLE_COLUMNS,
+};
+pub use error::{DigError, PackProblem, Result};
+pub use job::{
+    plan_pile, ConstraintReport, DigHeader, DigSetup, DigSummary, Pile, PlanFields, PlannedPile,
+    WarmStart, WarmStartSummary, BUILTIN_PROFILE_NAME,
+};
 pub use kinematics::{Joints, RopeShovel};
+pub use pack::{read_pack, write_pack, PACK_COLUMNS};
+pub use paper::{paper_row, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
 pub use plan::{
-    plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample, SearchSpace,
-    CONSTRAINT_NAMES, CONSTRAINT_UNITS,
+    gwo_preset, plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample,
+    SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS,
 };
 pub use profile::{Geometry, MachineProfile};
+pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
 pub use terrain::DigSurface;
 pub use trajectory::{Decision, Trajectory};

@@ -1,11 +1,12 @@
-//! The dig-planning model of the rope-shovel paper §4: objective (eqs.
-//! 25–27), excavated volume (eq. 28), the 18 constraints (eqs. 29–35) and
-//! their optimisation by the Grey Wolf Optimizer (eq. 37).
+//! The dig-planning model of the rope-shovel paper §4: objective
+//! ([RS eqs. 25–27]), excavated volume ([RS eq. 28]), the 18 constraints
+//! ([RS eqs. 29–35]), the optimisation model ([RS eq. 36]) and its solution
+//! by the Grey Wolf Optimizer ([RS eq. 37]).
 //!
-//! One evaluation samples the trajectory of eq. 22 at `numerics.samples`
-//! instants, solves the inverse kinematics (eqs. 7–8) and the inverse
-//! dynamics (eq. 10) at each, accumulates the material swept (eq. 28) and the
-//! energy of the hoist and crowd (eq. 25), and returns f and every c_i.
+//! One evaluation samples the trajectory of [RS eq. 22] at `numerics.samples`
+//! instants, solves the inverse kinematics ([RS eqs. 7–8]) and the inverse
+//! dynamics ([RS eq. 10]) at each, accumulates the material swept ([RS eq. 28]) and the
+//! energy of the hoist and crowd ([RS eq. 25]), and returns f and every c_i.
 //!
 //! # Constraints (value ≤ 0 is satisfied; time-varying ones take the worst instant)
 //! | c | eq. | value |
@@ -28,7 +29,7 @@
 //! as is, time by t_max, angles in radians, speeds, forces and powers by
 //! their ratings, heights by H_tl, stroke by L_dg) and summed.
 
-use autoshovel_optim::{minimize, Evaluation, GwoParams, GwoResult, Problem};
+use autoshovel_optim::{minimize, Constraints, Evaluation, GwoParams, GwoResult, Init, Problem};
 
 use crate::dynamics::{inverse_dynamics, Drive, MassModel};
 use crate::error::{DigError, Result};
@@ -62,7 +63,7 @@ pub const CONSTRAINT_NAMES: [&str; 18] = [
 ];
 
 /// c7 and c9 allow a reversal of this share of the rated speed: at the
-/// ends of the dig both speeds are zero by eq. 23, and their sign in the
+/// ends of the dig both speeds are zero by [RS eq. 23], and their sign in the
 /// last microseconds is rounding, not motion.
 pub const SPEED_TOLERANCE: f64 = 1e-3;
 
@@ -80,6 +81,16 @@ pub enum Bound {
     Min,
     /// The quantity must be at most the limit.
     Max,
+}
+
+impl Bound {
+    /// `min` or `max`, as summaries print it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Bound::Min => "min",
+            Bound::Max => "max",
+        }
+    }
 }
 
 /// One constraint's limit.
@@ -119,17 +130,17 @@ pub struct DigSample {
 pub struct DigOutcome {
     /// The decision evaluated.
     pub decision: Decision,
-    /// f of eq. 27.
+    /// f of [RS eq. 27].
     pub f: f64,
-    /// f1 of eq. 25: energy per kilogram [J/kg].
+    /// f1 of [RS eq. 25]: energy per kilogram [J/kg].
     pub f1_j_per_kg: f64,
-    /// f2 of eq. 26: time per kilogram [s/kg].
+    /// f2 of [RS eq. 26]: time per kilogram [s/kg].
     pub f2_s_per_kg: f64,
     /// ∫ v_h F_h dt [J].
     pub hoist_energy_j: f64,
     /// ∫ v_c F_c dt [J].
     pub crowd_energy_j: f64,
-    /// V of eq. 28 [m³].
+    /// V of [RS eq. 28] [m³].
     pub volume_m3: f64,
     /// m_dig = ρV [kg].
     pub m_dig_kg: f64,
@@ -191,6 +202,16 @@ pub enum SearchSpace {
     Bends,
     /// The paper's [a_x6, a_y6, t_d, g_x, g_y].
     Paper,
+}
+
+impl SearchSpace {
+    /// The coordinates' name as summaries print it: `bends` or `paper`.
+    pub fn name(self) -> &'static str {
+        match self {
+            SearchSpace::Bends => "bends",
+            SearchSpace::Paper => "paper",
+        }
+    }
 }
 
 impl std::str::FromStr for SearchSpace {
@@ -339,7 +360,7 @@ impl DigModel {
         }
     }
 
-    /// The limits of c1–c18 (the table in the module docs); c15's depends on
+    /// The limits of c1–c18 ([RS eqs. 29–35]; the table in the module docs); c15's depends on
     /// where the path ends, `gx_m`.
     pub fn constraint_limits(&self, gx_m: f64) -> [ConstraintLimit; 18] {
         use Bound::{Max, Min};
@@ -347,23 +368,23 @@ impl DigModel {
         let l = &p.limits;
         let g = &self.shovel.geometry;
         let values = [
-            (l.fill_min, Min),
+            (l.fill_min, Min), // [RS eq. 29]
             (l.fill_max, Max),
-            (l.time_min_s, Min),
+            (l.time_min_s, Min), // [RS eq. 30]
             (l.time_max_s, Max),
-            (l.back_angle_min_deg.to_radians(), Min),
+            (l.back_angle_min_deg.to_radians(), Min), // [RS eq. 31]
             (l.back_angle_max_deg.to_radians(), Max),
-            (-SPEED_TOLERANCE * l.hoist_speed_max_m_s, Min),
+            (-SPEED_TOLERANCE * l.hoist_speed_max_m_s, Min), // [RS eq. 32]
             (l.hoist_speed_max_m_s, Max),
             (-SPEED_TOLERANCE * l.crowd_speed_max_m_s, Min),
             (l.crowd_speed_max_m_s, Max),
-            (l.hoist_force_max_n, Max),
+            (l.hoist_force_max_n, Max), // [RS eq. 33]
             (l.crowd_force_max_n, Max),
             (l.hoist_power_max_w, Max),
             (l.crowd_power_max_w, Max),
-            (self.surface.height(gx_m), Min),
+            (self.surface.height(gx_m), Min), // [RS eq. 34]
             (l.hopper_height_m + p.dipper.height_m, Min),
-            (g.handle_length, Max),
+            (g.handle_length, Max), // [RS eq. 35]
             (g.sheave_top_height, Max),
         ];
         std::array::from_fn(|i| ConstraintLimit {
@@ -411,7 +432,7 @@ impl DigModel {
 
         for i in 0..n {
             let t = i as f64 * dt;
-            let tip = traj.at(t);
+            let tip = traj.at(t); // [RS eq. 22]
             let speed = (tip.v[0] * tip.v[0] + tip.v[1] * tip.v[1]).sqrt();
             // Cut thickness along the left normal; at rest (the ends) the
             // direction of the limit is the direction of the acceleration.
@@ -431,9 +452,10 @@ impl DigModel {
             let swept = swept_width(c, kappa).max(0.0);
             if let Some((sw0, _, _, p0)) = prev {
                 let ds = ((tip.p[0] - p0[0]).powi(2) + (tip.p[1] - p0[1]).powi(2)).sqrt();
-                area += 0.5 * (swept + sw0) * ds;
+                area += 0.5 * (swept + sw0) * ds; // [RS eq. 28], per unit width
             }
             let load = rho * b * area;
+            // [RS eqs. 7–8] and their rates.
             let Some(js) = self.shovel.joint_state(tip.p, tip.v, tip.a) else {
                 reachable = false;
                 prev = Some((swept, 0.0, 0.0, tip.p));
@@ -446,6 +468,7 @@ impl DigModel {
             } else {
                 0.0
             };
+            // [RS eq. 10]: the hoist and crowd forces.
             let Some(drive) =
                 inverse_dynamics(&self.shovel, &self.mass, &js, tip.v, f_tau, psi, load)
             else {
@@ -455,8 +478,8 @@ impl DigModel {
             };
             let (ph, pc) = (drive.hoist_power_w(), drive.crowd_power_w());
             if let Some((_, ph0, pc0, _)) = prev {
-                e_h += 0.5 * (ph + ph0) * dt;
-                e_c += 0.5 * (pc + pc0) * dt;
+                e_h += 0.5 * (ph + ph0) * dt; // [RS eq. 25]: ∫ v_h F_h dt
+                e_c += 0.5 * (pc + pc0) * dt; // [RS eq. 25]: ∫ v_c F_c dt
             }
             prev = Some((swept, ph, pc, tip.p));
 
@@ -494,13 +517,14 @@ impl DigModel {
             });
         }
 
-        let volume = b * area;
+        let volume = b * area; // [RS eq. 28]
         let m_dig = rho * volume;
-        let fill = volume / p.dipper.capacity_m3;
+        let fill = volume / p.dipper.capacity_m3; // V/V_cd of [RS eq. 29]
         let measured = [
             fill, fill, x.td_s, x.td_s, beta_min, beta_max, v_h_min, v_h_max, v_c_min, v_c_max,
             f_h_max, f_c_max, p_h_max, p_c_max, x.gy_m, x.gy_m, d_max, y_max,
         ];
+        // c1–c18: [RS eq. 29] … [RS eq. 35].
         let limits = self.constraint_limits(x.gx_m);
         let mut constraints = [0.0; 18];
         for (c, (m, lim)) in constraints.iter_mut().zip(measured.iter().zip(&limits)) {
@@ -519,9 +543,9 @@ impl DigModel {
         }
         let energy = e_h + e_c;
         let (f1, f2, f) = if m_dig > 1e-9 && energy.is_finite() {
-            let f1 = energy / m_dig;
-            let f2 = x.td_s / m_dig;
-            (f1, f2, p.objective.k1 * f1 + p.objective.k2 * f2)
+            let f1 = energy / m_dig; // [RS eq. 25]
+            let f2 = x.td_s / m_dig; // [RS eq. 26]
+            (f1, f2, p.objective.k1 * f1 + p.objective.k2 * f2) // [RS eq. 27]
         } else {
             (f64::INFINITY, f64::INFINITY, f64::INFINITY)
         };
@@ -548,9 +572,25 @@ impl Problem for DigModel {
         &self.bounds
     }
 
+    /// f(x) under c_i ≤ 0 of [RS eq. 36], the violations normalised and summed.
     fn evaluate(&self, x: &[f64]) -> Evaluation {
+        // [RS eq. 36]
         let out = DigModel::evaluate(self, &self.decision(x));
         Evaluation::new(out.f, out.violation)
+    }
+}
+
+/// The dig planner's Grey Wolf Optimizer setting (rope-shovel paper §4.6):
+/// 50 wolves, 100 iterations, good-point-set start (§4.5),
+/// feasibility rules, seed 0, parallel evaluation.
+pub fn gwo_preset() -> GwoParams {
+    GwoParams {
+        population: 50,
+        iterations: 100,
+        init: Init::GoodPointSet,
+        constraints: Constraints::FeasibilityRules,
+        seed: 0,
+        parallel: true,
     }
 }
 
@@ -565,12 +605,13 @@ pub struct DigPlan {
     pub search: GwoResult,
 }
 
-/// Plan a dig: minimise f over the search box with the Grey Wolf Optimizer,
+/// Plan a dig ([RS eq. 36] solved by [RS eq. 37]): minimise f over the
+/// search box with the Grey Wolf Optimizer,
 /// starting from `warm_start` wolves (e.g. the previous cycle's
 /// `search.population`) plus the initial pack of `gwo`. A best plan that
 /// still violates a constraint is an error naming the binding constraints.
 pub fn plan_dig(model: &DigModel, gwo: &GwoParams, warm_start: &[Vec<f64>]) -> Result<DigPlan> {
-    let search = minimize(model, gwo, warm_start)?;
+    let search = minimize(model, gwo, warm_start)?; // [RS eq. 37]
     let decision = model.decision(&search.best);
     let (outcome, samples) = model.simulate(&decision);
     if !outcome.feasible() {

@@ -1,5 +1,5 @@
 //! The machine profile: the geometry of Table 1, masses, the material, the
-//! limits of the 18 constraints (eqs. 29–35), the objective weights (Table 3)
+//! limits of the 18 constraints ([RS eqs. 29–35]), the objective weights (Table 3)
 //! and the search box — one TOML file the user can replace.
 //!
 //! The default is the paper's 1:30 scale model (`profiles/scale-model.toml`,
@@ -21,7 +21,7 @@
 //! ```
 //!
 //! The dig frame {Oo} has its origin at the toe (SPEC §1), so the paper's l₁, l₂
-//! (eq. 3: the saddle centre's horizontal and vertical offsets from the origin)
+//! ([RS eq. 3]: the saddle centre's horizontal and vertical offsets from the origin)
 //! are `l₁ = −toe_distance`, `l₂ = H`. By default the toe is where the tip
 //! meets the floor with the handle retracted, which puts it 65.5 mm in front
 //! of O with the handle 5.6° behind the vertical.
@@ -108,7 +108,7 @@ pub struct MaterialSpec {
     pub fill_resistance_ratio: f64,
 }
 
-/// Limits of the constraints c1–c18 (eqs. 29–35).
+/// Limits of the constraints c1–c18 ([RS eqs. 29–35]).
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct LimitsSpec {
@@ -140,7 +140,7 @@ pub struct LimitsSpec {
     pub hopper_height_m: f64,
 }
 
-/// Weights of eq. 27 (Table 3).
+/// Weights of [RS eq. 27] (Table 3).
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectiveSpec {

@@ -1,8 +1,8 @@
-//! The pile as the dig planner sees it: the surface z = f(x, y) of eq. 21,
+//! The pile as the dig planner sees it: the surface z = f(x, y) of [RS eq. 21],
 //! averaged across the dipper width and tabulated along the dig plane, in the
 //! dig frame {Oo} (origin at the toe, x into the pile, y up).
 //!
-//! Eq. 28 integrates f(x, y) − g(x, y) over the strip the dipper sweeps. The
+//! [RS eq. 28] integrates f(x, y) − g(x, y) over the strip the dipper sweeps. The
 //! tooth path does not vary across the dipper, so the double integral is
 //! exactly b·∫(f̄(x) − g(x)) dx with f̄ the mean of f across the width b:
 //! [`DigSurface`] stores f̄ on a 1 mm grid (5-point Gauss–Legendre across the
@@ -85,7 +85,7 @@ impl DigSurface {
         )
     }
 
-    /// A fitted surface (eq. 21) in the levelled sensor frame, with the floor
+    /// A fitted surface ([RS eq. 21]) in the levelled sensor frame, with the floor
     /// at height `floor_z`: the dig plane is y = `y_line`. The toe is where
     /// the width-averaged profile climbs out of the floor: the last sample at
     /// most `toe_rise_m` above it before the climb to the top, moved back
@@ -100,7 +100,7 @@ impl DigSurface {
     ) -> Result<Self> {
         let (x_lo, x_hi) = (fit.extent.x_min_m, fit.extent.x_max_m);
         let raw = Self::from_fn(
-            |x, y| fit.height(x, y_line + y) - floor_z,
+            |x, y| fit.height(x, y_line + y) - floor_z, // [RS eq. 21]
             width_m,
             x_lo,
             x_hi,
@@ -269,14 +269,15 @@ impl DigSurface {
     }
 }
 
-/// Area swept per unit path length by a cut of normal thickness `c` on a
+/// Area swept per unit path length (the integrand of [RS eq. 28]) by a
+/// cut of normal thickness `c` on a
 /// path of signed curvature `kappa` (positive when it bends towards the
 /// material, i.e. to the left of travel): the strip between the path and the
 /// surface in path coordinates has area element (1 − κλ) dλ ds, so
 /// dA/ds = c − κc²/2. Exact for κc < 1.
 #[inline]
 pub fn swept_width(c: f64, kappa: f64) -> f64 {
-    c - 0.5 * kappa * c * c
+    c - 0.5 * kappa * c * c // the integrand of [RS eq. 28] per unit width
 }
 
 #[cfg(test)]

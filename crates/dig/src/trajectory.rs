@@ -1,9 +1,9 @@
-//! The tooth-tip trajectory of eqs. 22–24: two 6th-order polynomials in time
+//! The tooth-tip trajectory of [RS eqs. 22–24]: two 6th-order polynomials in time
 //! from the toe (0, 0) to (g_x, g_y) in t_d seconds, at rest with zero
-//! acceleration at both ends (eq. 23).
+//! acceleration at both ends ([RS eq. 23]).
 //!
-//! Eq. 23 fixes a₀ = a₁ = a₂ = 0 and three of a₃…a₆; what remains is the
-//! decision vector x = [a_x6, a_y6, t_d, g_x, g_y]. The printed eq. 24 is
+//! [RS eq. 23] fixes a₀ = a₁ = a₂ = 0 and three of a₃…a₆; what remains is the
+//! decision vector x = [a_x6, a_y6, t_d, g_x, g_y]. The printed [RS eq. 24] is
 //! garbled; its content (SPEC §4.3) is, per axis,
 //!
 //! ```text
@@ -14,7 +14,7 @@
 //! The first term is the minimum-jerk straight line; a₆ bends the path by
 //! −a₆(t_d/2)⁶ at mid-dig (a few centimetres for Table 4's values).
 
-/// The decision vector of eq. 24.
+/// The decision vector of [RS eq. 24].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Decision {
     /// a_x6 [m/s⁶].
@@ -78,7 +78,7 @@ impl Decision {
     }
 }
 
-/// One axis of eq. 22: g(t) = Σ aᵢ tⁱ, i = 0…6.
+/// One axis of [RS eq. 22]: g(t) = Σ aᵢ tⁱ, i = 0…6.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Sextic {
     /// a₀ … a₆.
@@ -86,17 +86,18 @@ pub struct Sextic {
 }
 
 impl Sextic {
-    /// Eq. 24: from 0 to `end` in `td` seconds, at rest at both ends, with
+    /// [RS eq. 24]: from 0 to `end` in `td` seconds, at rest at both ends, with
     /// the free coefficient a₆.
     pub fn rest_to_rest(end: f64, a6: f64, td: f64) -> Self {
         let (t2, t3) = (td * td, td * td * td);
         let (t4, t5) = (t2 * t2, t2 * t3);
         Self {
+            // a₀ = a₁ = a₂ = 0 and the three below: at rest at both ends ([RS eq. 23]).
             coefficients: [
                 0.0,
                 0.0,
                 0.0,
-                10.0 * end / t3 - a6 * t3,
+                10.0 * end / t3 - a6 * t3, // [RS eq. 24]
                 -15.0 * end / t4 + 3.0 * a6 * t2,
                 6.0 * end / t5 - 3.0 * a6 * td,
                 a6,
@@ -108,6 +109,7 @@ impl Sextic {
     #[inline]
     pub fn eval(&self, t: f64) -> [f64; 3] {
         let a = &self.coefficients;
+        // [RS eq. 22] and its derivatives.
         let p = ((((((a[6] * t + a[5]) * t + a[4]) * t + a[3]) * t + a[2]) * t + a[1]) * t) + a[0];
         let v = (((((6.0 * a[6] * t + 5.0 * a[5]) * t + 4.0 * a[4]) * t + 3.0 * a[3]) * t
             + 2.0 * a[2])
@@ -119,7 +121,7 @@ impl Sextic {
     }
 }
 
-/// The tip trajectory of eq. 22.
+/// The tip trajectory of [RS eq. 22].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Trajectory {
     /// g_x(t).
@@ -144,7 +146,7 @@ pub struct TipState {
 }
 
 impl Trajectory {
-    /// The tip at time t.
+    /// The tip at time t ([RS eq. 22]).
     #[inline]
     pub fn at(&self, t: f64) -> TipState {
         let [x, vx, ax] = self.x.eval(t);

@@ -1,17 +1,12 @@
 //! The dig planner against the rope-shovel paper's Tables 4–5, and its
 //! refusals.
 
-use autoshovel_dig::{plan_dig, DigError, DigModel, DigSurface, MachineProfile, SearchSpace};
+use autoshovel_dig::{
+    gwo_preset, plan_dig, DigError, DigModel, DigSurface, MachineProfile, SearchSpace,
+    PAPER_TABLES_4_5,
+};
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
-
-/// Table 5: (shape, f, f1 [J/kg], m_dig [kg], fill).
-const TABLE5: [(PileShape, f64, f64, f64, f64); 4] = [
-    (PileShape::Typical, 13.76, 17.19, 2.053, 0.9972),
-    (PileShape::Concave, 13.83, 17.22, 1.991, 0.9671),
-    (PileShape::Convex, 13.87, 17.51, 2.156, 1.047),
-    (PileShape::ConvexConcave, 12.57, 15.55, 2.045, 0.9929),
-];
 
 fn model(shape: PileShape) -> DigModel {
     let p = MachineProfile::scale_model();
@@ -21,13 +16,14 @@ fn model(shape: PileShape) -> DigModel {
 fn gwo(seed: u64) -> GwoParams {
     GwoParams {
         seed,
-        ..GwoParams::default()
+        ..gwo_preset()
     }
 }
 
 #[test]
 fn all_four_piles_reproduce_table_5() {
-    for (shape, f, f1, m_dig, _) in TABLE5 {
+    for row in &PAPER_TABLES_4_5 {
+        let (shape, f, f1, m_dig) = (row.shape, row.f, row.f1_j_per_kg, row.m_dig_kg);
         let plan = plan_dig(&model(shape), &gwo(1), &[]).unwrap();
         let o = &plan.outcome;
         assert!(o.feasible(), "{shape:?}: {:?}", o.violated());
@@ -42,7 +38,7 @@ fn all_four_piles_reproduce_table_5() {
             "{shape:?}: m_dig {} vs {m_dig}",
             o.m_dig_kg
         );
-        if shape == PileShape::Typical {
+        if row.calibrated() {
             // Calibrated here (k_F and ε of the embedded profile).
             assert!(
                 (o.f1_j_per_kg / f1 - 1.0).abs() < 0.02,
@@ -53,7 +49,7 @@ fn all_four_piles_reproduce_table_5() {
             // Predicted.
             assert!((o.f / f - 1.0).abs() <= 0.15, "{shape:?}: f {} vs {f}", o.f);
         }
-        // The mass is the swept volume times the density, and f is eq. 27.
+        // The mass is the swept volume times the density, and f is [RS eq. 27].
         assert!((o.m_dig_kg - 2540.0 * o.volume_m3).abs() < 1e-12);
         let f_27 = 0.7 * o.f1_j_per_kg + 0.3 * o.f2_s_per_kg;
         assert!((o.f - f_27).abs() < 1e-9);
@@ -79,7 +75,7 @@ fn the_same_seed_gives_the_same_plan_and_another_seed_another_search() {
     assert_ne!(a.search.best, c.search.best);
 }
 
-/// The volume of eq. 28 from the planner (cut thickness in path
+/// The volume of [RS eq. 28] from the planner (cut thickness in path
 /// coordinates) against the shoelace area of the polygon between the
 /// sampled path and the surface.
 #[test]

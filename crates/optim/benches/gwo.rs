@@ -1,5 +1,5 @@
 //! Criterion benchmarks of the Grey Wolf Optimizer (Mirjalili et al. 2014;
-//! rope-shovel paper eq. 37): one full run of each benchmark function in
+//! rope-shovel paper [RS eq. 37]): one full run of each benchmark function in
 //! the paper's setting (30-D, 30 wolves × 500 iterations, random start),
 //! serial and parallel, and a 5-D sphere run with 50 wolves × 100
 //! iterations (the dig planner's size), where the function costs almost
@@ -47,7 +47,9 @@ fn bench_gwo(c: &mut Criterion) {
             init,
             parallel,
             seed: 1,
-            ..GwoParams::rope_shovel()
+            population: 50,
+            iterations: 100,
+            ..GwoParams::default()
         };
         group.bench_function(label, |b| {
             b.iter(|| minimize(black_box(&problem), &params, &[]).unwrap())

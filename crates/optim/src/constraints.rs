@@ -27,6 +27,15 @@ pub enum Constraints {
 }
 
 impl Constraints {
+    /// The rule's name as summaries print it: `feasibility rules (Deb 2000)`
+    /// or `static penalty`.
+    pub fn name(&self) -> &'static str {
+        match self {
+            Constraints::FeasibilityRules => "feasibility rules (Deb 2000)",
+            Constraints::Penalty { .. } => "static penalty",
+        }
+    }
+
     /// Compares `a` with `b`: `Less` when `a` is better. NaN never reaches
     /// here ([`crate::minimize`] rejects it); infinities order as usual.
     pub fn compare(&self, a: &Evaluation, b: &Evaluation) -> Ordering {

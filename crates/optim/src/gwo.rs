@@ -1,6 +1,6 @@
 //! The Grey Wolf Optimizer (Mirjalili, Mirjalili & Lewis 2014, "Grey Wolf
 //! Optimizer", Adv. Eng. Softw. 69:46–61, eqs. 3.1–3.7; rope-shovel paper
-//! §4.5, eq. 37), seeded and deterministic, with good-point-set or random
+//! §4.5, [RS eq. 37]), seeded and deterministic, with good-point-set or random
 //! initialisation, warm starts, Deb's feasibility rules or a penalty for
 //! constraints, and optional parallel evaluation.
 //!
@@ -31,8 +31,20 @@ pub enum Init {
     Random,
 }
 
-/// Parameters of [`minimize`]. `Default` is the rope-shovel paper's setting
-/// (§4.6: 50 wolves, 100 iterations, good point set).
+impl Init {
+    /// The placement's name as summaries print it: `good-point-set` or `random`.
+    pub fn name(self) -> &'static str {
+        match self {
+            Init::GoodPointSet => "good-point-set",
+            Init::Random => "random",
+        }
+    }
+}
+
+/// Parameters of [`minimize`]. `Default` is Mirjalili et al. 2014's
+/// benchmark setting ([`GwoParams::mirjalili_2014`]); an application's own
+/// preset lives with the application (the dig planner's in
+/// `autoshovel_dig::gwo_preset`).
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
 pub struct GwoParams {
     /// Number of wolves, ≥ 4 (α, β, δ and at least one ω).
@@ -54,32 +66,22 @@ pub struct GwoParams {
 
 impl Default for GwoParams {
     fn default() -> Self {
-        Self::rope_shovel()
+        Self::mirjalili_2014()
     }
 }
 
 impl GwoParams {
-    /// The rope-shovel paper's dig planner (§4.6): 50 wolves, 100
-    /// iterations, good-point-set start, feasibility rules.
-    pub fn rope_shovel() -> Self {
-        Self {
-            population: 50,
-            iterations: 100,
-            init: Init::GoodPointSet,
-            constraints: Constraints::FeasibilityRules,
-            seed: 0,
-            parallel: true,
-        }
-    }
-
     /// Mirjalili et al. 2014's benchmark setting (§4): 30 wolves, 500
-    /// iterations, random start.
+    /// iterations, random start; feasibility rules, seed 0, parallel
+    /// evaluation.
     pub fn mirjalili_2014() -> Self {
         Self {
             population: 30,
             iterations: 500,
             init: Init::Random,
-            ..Self::rope_shovel()
+            constraints: Constraints::FeasibilityRules,
+            seed: 0,
+            parallel: true,
         }
     }
 }
@@ -116,7 +118,7 @@ pub struct GwoResult {
     pub population: Vec<(Vec<f64>, Evaluation)>,
 }
 
-/// Minimises `problem` with the Grey Wolf Optimizer.
+/// Minimises `problem` with the Grey Wolf Optimizer ([RS eq. 37]).
 ///
 /// `warm_start` wolves (clamped to the bounds) replace the first members of
 /// the initial pack; the rest come from [`GwoParams::init`]. Everything is
@@ -133,7 +135,7 @@ pub struct GwoResult {
 ///     A = 2a·r1 − a,  C = 2·r2                (eqs. 3.3–3.4)
 ///     D_L = |C·X_L,j − X_j|                   (eq. 3.5)
 ///     X_L' = X_L,j − A·D_L                    (eq. 3.6)
-/// X_j ← clamp((X_α' + X_β' + X_δ') / 3, lower_j, upper_j)   (eq. 3.7 = eq. 37)
+/// X_j ← clamp((X_α' + X_β' + X_δ') / 3, lower_j, upper_j)   (eq. 3.7 = [RS eq. 37])
 /// ```
 ///
 /// then every wolf is evaluated and the leaders are chosen again.
@@ -161,7 +163,7 @@ pub struct GwoResult {
 ///
 /// # Origin bias: put the box around 0
 ///
-/// Eq. 37 is equivariant under scaling about the origin but not under
+/// [RS eq. 37] is equivariant under scaling about the origin but not under
 /// translation: C·X_L scales the leader about 0, so the steps stay
 /// proportional to |X_L| rather than to the distance to the optimum. GWO
 /// therefore excels when the optimum is at the origin (all four classic
@@ -192,7 +194,8 @@ pub struct GwoResult {
 /// use autoshovel_optim::{benchmarks::Benchmark, minimize, GwoParams};
 ///
 /// let sphere = Benchmark::Sphere.problem(5);
-/// let res = minimize(&sphere, &GwoParams { iterations: 200, ..GwoParams::default() }, &[])?;
+/// let params = GwoParams { population: 50, iterations: 200, ..GwoParams::default() };
+/// let res = minimize(&sphere, &params, &[])?;
 /// assert!(res.best_eval.objective < 1e-12);
 /// assert_eq!(res.evaluations, 50 * 201);
 /// # Ok::<(), autoshovel_optim::OptimError>(())
@@ -253,9 +256,10 @@ pub fn minimize<P: Problem + ?Sized>(
                     let big_a = 2.0 * a * r1 - a;
                     let c = 2.0 * r2;
                     let leader = lead_x[l * d + j];
+                    // D_L and X_L' of [RS eq. 37] (Mirjalili eqs. 3.5–3.6).
                     sum += leader - big_a * (c * leader - *xj).abs();
                 }
-                *xj = (sum / 3.0).clamp(lo, hi);
+                *xj = (sum / 3.0).clamp(lo, hi); // [RS eq. 37]: the mean of X_1, X_2, X_3
             }
         }
         evaluate(problem, &x, d, &mut evals, params.parallel, t + 1)?;

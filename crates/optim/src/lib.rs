@@ -1,7 +1,7 @@
 //! A generic, seeded Grey Wolf Optimizer (Mirjalili, Mirjalili & Lewis
 //! 2014, "Grey Wolf Optimizer", Adv. Eng. Softw. 69:46–61) for box-bounded
 //! problems with constraints, as the rope-shovel dig planner uses it
-//! (rope-shovel paper §4.5: eq. 37 and good-point-set initialisation).
+//! (rope-shovel paper §4.5: [RS eq. 37] and good-point-set initialisation).
 //!
 //! ```
 //! use autoshovel_optim::{minimize, Evaluation, FnProblem, GwoParams};
@@ -16,12 +16,12 @@
 //! # Ok::<(), autoshovel_optim::OptimError>(())
 //! ```
 //!
-//! - [`minimize`] runs eq. 37 with the leader rule and draw order
+//! - [`minimize`] runs [RS eq. 37] with the leader rule and draw order
 //!   documented on it; one seeded ChaCha8 stream makes every draw, so
 //!   results are bit-identical across runs and with parallel evaluation on
 //!   or off. GWO is biased towards the origin: pose variables on a box
 //!   centred at 0 (see [`minimize`]).
-//! - [`Init::GoodPointSet`] (default) or [`Init::Random`] places the
+//! - [`Init::GoodPointSet`] or [`Init::Random`] (the default setting's) places the
 //!   initial pack; warm-start wolves replace its first members.
 //! - [`Constraints::FeasibilityRules`] (default, Deb 2000) or
 //!   [`Constraints::Penalty`] ranks the wolves.

@@ -25,7 +25,7 @@ fn feasibility_rules_find_the_kkt_point() {
             &disc_above_line(),
             &GwoParams {
                 seed,
-                ..GwoParams::default()
+                ..gwo_50x100()
             },
             &[],
         )
@@ -61,7 +61,7 @@ fn penalty_lands_where_the_penalty_optimum_is() {
             &GwoParams {
                 constraints: Constraints::Penalty { weight: w },
                 seed: 3,
-                ..GwoParams::default()
+                ..gwo_50x100()
             },
             &[],
         )
@@ -83,7 +83,7 @@ fn product_under_a_budget_line() {
             &p,
             &GwoParams {
                 seed,
-                ..GwoParams::default()
+                ..gwo_50x100()
             },
             &[],
         )
@@ -91,5 +91,16 @@ fn product_under_a_budget_line() {
         assert!(res.best_eval.is_feasible());
         assert!(res.best_eval.objective >= -2.0 - 1e-12);
         assert_abs_diff_eq!(res.best_eval.objective, -2.0, epsilon = 5e-3);
+    }
+}
+
+/// The pack these tests were tuned on (the old default): 50 wolves, 100
+/// iterations, good-point-set start.
+fn gwo_50x100() -> GwoParams {
+    GwoParams {
+        population: 50,
+        iterations: 100,
+        init: autoshovel_optim::Init::GoodPointSet,
+        ..GwoParams::default()
     }
 }

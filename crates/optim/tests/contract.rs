@@ -23,7 +23,7 @@ fn counts_history_and_final_pack() {
         population: 12,
         iterations: 40,
         seed: 2,
-        ..GwoParams::default()
+        ..gwo_50x100()
     };
     let res = minimize(&p, &params, &[]).unwrap();
     assert_eq!(res.evaluations, 12 * 41);
@@ -77,7 +77,7 @@ fn warm_start_from_a_near_optimal_wolf_never_returns_worse() {
                     iterations: 10,
                     init,
                     seed,
-                    ..GwoParams::default()
+                    ..gwo_50x100()
                 };
                 let cold = minimize(&problem, &params, &[]).unwrap();
                 let warm = minimize(&problem, &params, std::slice::from_ref(&near)).unwrap();
@@ -109,7 +109,7 @@ fn warm_start_replaces_the_first_wolves_and_is_clamped() {
         population: 6,
         iterations: 1,
         parallel: false,
-        ..GwoParams::default()
+        ..gwo_50x100()
     };
     let warm = vec![vec![0.25, -3.0], vec![7.0, 4.5]];
     minimize(&p, &params, &warm).unwrap();
@@ -122,7 +122,7 @@ fn warm_start_replaces_the_first_wolves_and_is_clamped() {
 
 #[test]
 fn returns_errors_for_bad_inputs() {
-    let ok = GwoParams::default();
+    let ok = gwo_50x100();
     let sphere = |b: Vec<(f64, f64)>| FnProblem::new(b, |x: &[f64]| Evaluation::feasible(x[0]));
     let err = |p: &dyn Fn() -> Result<(), OptimError>| p().unwrap_err();
     let run = |b: Vec<(f64, f64)>, params: GwoParams, warm: Vec<Vec<f64>>| {
@@ -221,7 +221,7 @@ fn nan_from_the_problem_names_wolf_and_iteration() {
             &p,
             &GwoParams {
                 parallel,
-                ..GwoParams::default()
+                ..gwo_50x100()
             },
             &[],
         )
@@ -244,7 +244,7 @@ fn nan_from_the_problem_names_wolf_and_iteration() {
         let q = FnProblem::new(vec![(0.0, 1.0); 2], move |_: &[f64]| {
             Evaluation::new(0.0, v)
         });
-        let e = minimize(&q, &GwoParams::default(), &[]).unwrap_err();
+        let e = minimize(&q, &gwo_50x100(), &[]).unwrap_err();
         assert!(
             matches!(
                 e,
@@ -256,5 +256,16 @@ fn nan_from_the_problem_names_wolf_and_iteration() {
             ),
             "{e}"
         );
+    }
+}
+
+/// The pack these tests were tuned on (the old default): 50 wolves, 100
+/// iterations, good-point-set start.
+fn gwo_50x100() -> GwoParams {
+    GwoParams {
+        population: 50,
+        iterations: 100,
+        init: autoshovel_optim::Init::GoodPointSet,
+        ..GwoParams::default()
     }
 }
