@@ -9,9 +9,9 @@ use autoshovel_propel::{FieldKind, Scenario};
 use autoshovel_report::{write_index_html, write_summary, Section};
 use serde_json::{json, Value};
 
-use autoshovel_surface::perceive::{perceive_file, PerceiveSummary, PerceptionParams};
+use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{prepare_dir, print_json, Job};
+use crate::output::{prepare_dir, print_json};
 
 /// Runs the demo into `out`.
 pub fn run(out: &Path, json_only: bool) -> Result<()> {
@@ -31,7 +31,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let key = format!("plan-path {name} {}", field.name());
         let sub = format!("plan-path-{name}-{}", field.name());
         let dir = prepare_dir(&out.join(&sub))?;
-        let job = crate::plan_path::job(
+        let job = crate::jobs::plan_path(
             &scenario,
             field,
             autoshovel_propel::DEFAULT_HEADING_TOLERANCE_DEG,
@@ -109,7 +109,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
             format!("track-{name}-fuzzy")
         };
         let dir = prepare_dir(&out.join(&sub))?;
-        let job = crate::track::job(&scenario, ctl, compare, Some(&dir))?;
+        let job = crate::jobs::track(&scenario, ctl, compare, Some(&dir))?;
         if !json_only {
             let m = &job.summary.run.metrics;
             crate::say!(
@@ -147,13 +147,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         };
         let cloud = autoshovel_surface::generate_pile(&params)?;
         autoshovel_cloud::io::write(&scan, &cloud, autoshovel_cloud::io::Encoding::Binary)?;
-        let params = PerceptionParams::default();
-        let got = perceive_file(&scan, &params, &mut |_, _| {})?;
-        let job = Job::finish(
-            PerceiveSummary::new(&scan, &params, &got),
-            Some(&dir),
-            |d, w| Ok(autoshovel_figures::perceive::write(d, &got, w)?),
-        )?;
+        let job = crate::jobs::perceive(&scan, &PerceptionParams::default(), Some(&dir), false)?;
         let mut written = job.written.clone();
         written.file(&dir, &scan);
         let key = format!("perceive {} pile", shape.name());
@@ -182,10 +176,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     let dir = prepare_dir(&out.join(sub))?;
     let typical = autoshovel_dig::paper_row(autoshovel_surface::PileShape::Typical);
     let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile);
-    let planned = autoshovel_dig::plan_pile(&pile, &setup)?;
-    let job = crate::output::Job::finish(planned.summary.clone(), Some(&dir), |dir, written| {
-        autoshovel_figures::dig::write_plan(dir, &planned, written).map_err(|e| anyhow::anyhow!(e))
-    })?;
+    let job = crate::jobs::plan_dig(&pile, &setup, Some(&dir))?;
     let key = "plan-dig typical";
     if !json_only {
         let s = &job.summary;
@@ -224,15 +215,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     summaries.insert(key.into(), summary);
     let sub = "plan-dig-all-surfaces";
     let dir = prepare_dir(&out.join(sub))?;
-    let mut all = autoshovel_dig::all_surfaces(&setup, |_| {})?;
-    let piles =
-        autoshovel_figures::dig::write_piles(&dir, &mut all).map_err(|e| anyhow::anyhow!(e))?;
-    let job = crate::output::Job::finish(all.summary.clone(), Some(&dir), |dir, written| {
-        written.plots.extend(piles.plots);
-        written.files.extend(piles.files);
-        autoshovel_figures::dig::write_comparison(dir, &all, written)
-            .map_err(|e| anyhow::anyhow!(e))
-    })?;
+    let job = crate::jobs::plan_dig_all_surfaces(&setup, Some(&dir), |_| {})?;
     let key = "plan-dig --all-surfaces";
     if !json_only {
         crate::say!("{}", autoshovel_figures::dig::markdown_table(&job.summary));
@@ -279,7 +262,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let setup = autoshovel_excavate::Setup::load(name, None)?;
         let sub = format!("plan-excavate-{name}");
         let dir = prepare_dir(&out.join(&sub))?;
-        let job = crate::plan_excavate::job(&setup, Some(&dir))?;
+        let job = crate::jobs::plan_excavate(&setup, Some(&dir))?;
         let key = format!("plan-excavate {name}");
         if !json_only {
             let s = &job.summary;
@@ -324,7 +307,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     };
     let sub = "study-paths";
     let dir = prepare_dir(&out.join(sub))?;
-    let job = crate::study::study(&params, Some(&dir), !json_only)?;
+    let job = crate::jobs::study(&params, Some(&dir), !json_only)?;
     if !json_only {
         crate::say!(
             "{}",

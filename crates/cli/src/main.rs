@@ -15,6 +15,7 @@ macro_rules! say {
 pub(crate) use say;
 
 mod demo;
+mod jobs;
 mod output;
 mod perceive;
 mod pile;

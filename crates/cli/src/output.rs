@@ -45,7 +45,6 @@ pub fn progress_bar(show: bool, template: &str) -> indicatif::ProgressBar {
 
 /// A finished job: its typed summary and the files it wrote (none without
 /// an output folder).
-#[allow(dead_code)] // until every job is on it
 #[derive(Debug, Clone)]
 pub struct Job<S> {
     /// The job's summary, as its library crate made it.
@@ -56,7 +55,6 @@ pub struct Job<S> {
     pub out: Option<PathBuf>,
 }
 
-#[allow(dead_code)]
 impl<S: Serialize> Job<S> {
     /// Writes the job's files into `out` (when given) with `write`, then
     /// `summary.json` listing them all.
@@ -100,46 +98,4 @@ impl<S: Serialize> Job<S> {
         }
         Ok(())
     }
-}
-
-// ---- Value-based glue of the jobs not yet on typed summaries; removed as
-// each job moves to a [`Job`] of its library's summary type.
-
-/// Reports a finished job: the summary alone on stdout under `--json`,
-/// otherwise the `human` report and the folder written to.
-pub fn report(
-    summary: &serde_json::Value,
-    json: bool,
-    out: Option<&std::path::Path>,
-    human: impl FnOnce(&serde_json::Value),
-) -> Result<()> {
-    if json {
-        print_json(summary)?;
-    } else {
-        human(summary);
-        if let Some(dir) = out {
-            crate::say!("wrote {}", dir.display());
-        }
-    }
-    Ok(())
-}
-
-/// A finite f64 or JSON null (JSON has no NaN).
-pub fn num(v: f64) -> serde_json::Value {
-    if v.is_finite() {
-        serde_json::json!(v)
-    } else {
-        serde_json::Value::Null
-    }
-}
-
-/// Lists every file a job wrote in its summary (`files`) and writes
-/// `summary.json` into `dir`.
-pub fn write_job_summary(
-    dir: &Path,
-    summary: &mut serde_json::Value,
-    written: &mut Written,
-) -> Result<()> {
-    *summary = autoshovel_report::write_job_summary(dir, summary, written)?;
-    Ok(())
 }

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use autoshovel_surface::perceive::{perceive_file, PerceiveSummary, Perceived, PerceptionParams};
+use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{prepare_dir, Job};
+use crate::output::prepare_dir;
 
 /// Arguments of `perceive`.
 #[derive(Debug, clap::Args)]
@@ -46,7 +46,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let input = args.input.as_deref().context("--input is required")?;
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    let job = job(input, &params, out.as_deref(), !args.json)?;
+    let job = crate::jobs::perceive(input, &params, out.as_deref(), !args.json)?;
     job.report(args.json, |s| {
         crate::say!("perceive {}", s.input);
         for st in &s.stages {
@@ -65,35 +65,5 @@ pub fn run(args: &Args) -> Result<()> {
             s.r2,
             s.fit.r2_all_points
         );
-    })
-}
-
-/// Reads `input` with a progress bar (when `progress`) and perceives it.
-pub fn perceive_with_progress(
-    input: &Path,
-    params: &PerceptionParams,
-    progress: bool,
-) -> Result<Perceived> {
-    let bar =
-        crate::output::progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
-    let got = perceive_file(input, params, &mut |done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    });
-    bar.finish_and_clear();
-    got.with_context(|| input.display().to_string())
-}
-
-/// Runs the pipeline on `input`; writes its files into `out` if given.
-pub fn job(
-    input: &Path,
-    params: &PerceptionParams,
-    out: Option<&Path>,
-    progress: bool,
-) -> Result<Job<PerceiveSummary>> {
-    let got = perceive_with_progress(input, params, progress)?;
-    let summary = PerceiveSummary::new(input, params, &got);
-    Job::finish(summary, out, |dir, written| {
-        Ok(autoshovel_figures::perceive::write(dir, &got, written)?)
     })
 }

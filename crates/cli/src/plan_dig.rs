@@ -12,19 +12,18 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{anyhow, bail, Context as _, Result};
+use anyhow::{bail, Result};
 use autoshovel_dig::TomlFile as _;
 use autoshovel_dig::{
-    all_surfaces, plan_pile, DigSetup, DigSummary, MachineProfile, Pile, SearchSpace, WarmStart,
-    CONSTRAINT_NAMES,
+    DigSetup, DigSummary, MachineProfile, Pile, SearchSpace, WarmStart, CONSTRAINT_NAMES,
 };
 use autoshovel_figures::dig as figures;
 use autoshovel_optim::Init;
 use autoshovel_surface::PileShape;
 
-use autoshovel_surface::perceive::{perceive_file, PerceptionParams};
+use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{prepare_dir, progress_bar, Job};
+use crate::output::prepare_dir;
 
 /// How the optimiser's first pack is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -133,13 +132,10 @@ pub fn run(args: &Args) -> Result<()> {
         return run_all_surfaces(&setup, out.as_deref(), args.json);
     }
     let pile = match &args.cloud {
-        Some(path) => load_scan(path, &pipeline, &setup.profile, !args.json)?,
+        Some(path) => crate::jobs::scan_pile(path, &pipeline, &setup.profile, !args.json)?,
         None => Pile::shape(args.surface.unwrap_or_default(), &setup.profile),
     };
-    let planned = plan_pile(&pile, &setup)?;
-    let job = Job::finish(planned.summary.clone(), out.as_deref(), |dir, written| {
-        figures::write_plan(dir, &planned, written).map_err(|e| anyhow!(e))
-    })?;
+    let job = crate::jobs::plan_dig(&pile, &setup, out.as_deref())?;
     job.report(args.json, print_human)?;
     match &job.summary.error {
         Some(e) => bail!("{e}"),
@@ -147,27 +143,9 @@ pub fn run(args: &Args) -> Result<()> {
     }
 }
 
-/// The pile of a scan: the perception pipeline, then the dig profile cut
-/// by the library's rule.
-fn load_scan(
-    path: &Path,
-    params: &PerceptionParams,
-    profile: &MachineProfile,
-    progress: bool,
-) -> Result<Pile> {
-    let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
-    let got = perceive_file(path, params, &mut |done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    });
-    bar.finish_and_clear();
-    let got = got.with_context(|| path.display().to_string())?;
-    Ok(Pile::scan(path, &got, profile)?)
-}
-
 /// `--all-surfaces`: the four piles beside Tables 4–5.
 fn run_all_surfaces(setup: &DigSetup, out: Option<&Path>, json: bool) -> Result<()> {
-    let mut all = all_surfaces(setup, |s| {
+    let job = crate::jobs::plan_dig_all_surfaces(setup, out, |s| {
         if !json {
             crate::say!(
                 "planned the {} pile: {} ({:.0} ms)",
@@ -180,15 +158,6 @@ fn run_all_surfaces(setup: &DigSetup, out: Option<&Path>, json: bool) -> Result<
                 s.plan.plan_time_ms
             );
         }
-    })?;
-    let piles = match out {
-        Some(dir) => figures::write_piles(dir, &mut all).map_err(|e| anyhow!(e))?,
-        None => Default::default(),
-    };
-    let job = Job::finish(all.summary.clone(), out, |dir, written| {
-        written.plots.extend(piles.plots);
-        written.files.extend(piles.files);
-        figures::write_comparison(dir, &all, written).map_err(|e| anyhow!(e))
     })?;
     job.report(json, |s| crate::say!("{}", figures::markdown_table(s)))?;
     match job.summary.error() {

@@ -6,12 +6,10 @@
 //! arguments, loads, runs and writes. A plan that fails is an error naming
 //! the reason; no summary is written for it.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use autoshovel_excavate::{ExcavateSummary, Excavation, Setup};
-
-use crate::output::{prepare_dir, Job};
+use anyhow::Result;
+use autoshovel_excavate::{ExcavateSummary, Setup};
 
 /// Arguments of `plan-excavate`.
 #[derive(Debug, clap::Args)]
@@ -53,37 +51,12 @@ pub fn run(args: &Args) -> Result<()> {
             anyhow::bail!("--out {}: exists and is not a directory", dir.display());
         }
     }
-    let ex = plan(&setup)?;
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    finish(&setup, &ex, out.as_deref())?.report(args.json, print_human)
+    crate::jobs::plan_excavate(&setup, args.out.as_deref())?.report(args.json, print_human)
 }
 
 fn print_raw(text: &str) {
     use std::io::Write as _;
     let _ = write!(std::io::stdout().lock(), "{text}");
-}
-
-/// Plans and executes the dig; an impossible dig is an error naming the scenario.
-fn plan(setup: &Setup) -> Result<Excavation> {
-    setup.run().with_context(|| {
-        format!(
-            "plan-excavate {} ({})",
-            setup.scenario.name, setup.scenario_source
-        )
-    })
-}
-
-/// Plans `setup` and writes into `out` if given.
-pub fn job(setup: &Setup, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
-    finish(setup, &plan(setup)?, out)
-}
-
-fn finish(setup: &Setup, ex: &Excavation, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
-    Job::finish(ExcavateSummary::new(setup, ex), out, |dir, written| {
-        Ok(autoshovel_figures::excavate::write(
-            dir, setup, ex, written,
-        )?)
-    })
 }
 
 /// "(x, y)" to the millimetre; + 0.0 turns −0 into 0.

@@ -1,12 +1,12 @@
 //! `autoshovel plan-path`: travel planning with the classic or improved
 //! potential field on a built-in or user scenario (SPEC §2, §6).
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::Result;
-use autoshovel_propel::{FieldKind, PlanOutcome, PlanPathSummary, Scenario};
+use autoshovel_propel::{PlanPathSummary, Scenario};
 
-use crate::output::{prepare_dir, Job};
+use crate::output::prepare_dir;
 use crate::PlannerArg;
 
 /// Arguments of `plan-path`.
@@ -39,7 +39,7 @@ pub fn run(args: &Args) -> Result<()> {
             args.heading_tolerance_deg
         );
     }
-    let job = job(
+    let job = crate::jobs::plan_path(
         &scenario,
         args.planner.into(),
         args.heading_tolerance_deg,
@@ -83,20 +83,4 @@ fn print_human(s: &PlanPathSummary) {
     crate::say!("  max curvature     {} 1/m", f(s.max_curvature_per_m));
     crate::say!("  escapes           {}", s.escapes);
     crate::say!("  plan time         {} ms", f(s.plan_time_ms));
-}
-
-/// Plans one scenario, writes the outputs into `out` if given, and returns the job.
-pub fn job(
-    scenario: &Scenario,
-    field: FieldKind,
-    heading_tolerance_deg: f64,
-    out: Option<&Path>,
-) -> Result<Job<PlanPathSummary>> {
-    let outcome = PlanOutcome::plan(scenario, field);
-    let summary = outcome.summary(scenario, heading_tolerance_deg);
-    Job::finish(summary, out, |dir, written| {
-        Ok(autoshovel_figures::map::write_plan_path(
-            dir, scenario, &outcome, written,
-        )?)
-    })
 }

@@ -2,13 +2,13 @@
 //! fuzzy tracker, PID or pure pursuit (SPEC §3, §6), and `--compare` to run
 //! every controller on the same scenario and seed.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
-use anyhow::{Context, Result};
-use autoshovel_track::scenario::{resolve, Noise, TrackScenario};
-use autoshovel_track::{track, ControllerKind, RunSummary, TrackSummary};
+use anyhow::Result;
+use autoshovel_track::scenario::{resolve, Noise};
+use autoshovel_track::{ControllerKind, RunSummary, TrackSummary};
 
-use crate::output::{prepare_dir, Job};
+use crate::output::prepare_dir;
 
 /// Controller choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -74,7 +74,7 @@ pub fn run(args: &Args) -> Result<()> {
     });
     let scenario = resolve(&args.scenario, noise, args.seed)?;
     let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    let job = job(
+    let job = crate::jobs::track(
         &scenario,
         args.controller.into(),
         args.compare,
@@ -89,20 +89,6 @@ pub fn run(args: &Args) -> Result<()> {
         Some(e) => Err(e.into()),
         None => Ok(()),
     }
-}
-
-/// Runs one scenario with one controller (or all with `compare`), writing into `out`.
-pub fn job(
-    scenario: &TrackScenario,
-    controller: ControllerKind,
-    compare: bool,
-    out: Option<&Path>,
-) -> Result<Job<TrackSummary>> {
-    let tracking = track(scenario, controller, compare);
-    Job::finish(tracking.summary(scenario), out, |dir, written| {
-        autoshovel_figures::track::write(dir, scenario, &tracking, written)
-            .context("writing the track figures")
-    })
 }
 
 fn print_human(s: &TrackSummary) {

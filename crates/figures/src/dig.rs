@@ -21,7 +21,7 @@ use autoshovel_report::{
 use crate::shovel::{pile_layers, shovel_frame_layers, shovel_pose_layers};
 
 /// Errors of the writers here: a report file or the pack file.
-pub type Error = Box<dyn std::error::Error + Send + Sync>;
+pub type Error = crate::FiguresError;
 
 /// Writes the files of one planned pile into `dir` (nothing but the
 /// summary's own file, which the caller writes, when no plan came out).
@@ -306,8 +306,10 @@ pub fn write_piles(dir: &Path, all: &mut AllSurfaces) -> Result<Written, Error> 
     for (pile, entry) in all.piles.iter().zip(all.summary.surfaces.iter_mut()) {
         let name = pile.paper.shape.name();
         let sub = dir.join(name);
-        std::fs::create_dir_all(&sub)
-            .map_err(|e| format!("cannot create output directory {}: {e}", sub.display()))?;
+        std::fs::create_dir_all(&sub).map_err(|source| crate::FiguresError::CreateDir {
+            path: sub.clone(),
+            source,
+        })?;
         let mut w = Written::default();
         write_plan(&sub, &pile.planned, &mut w)?;
         write_job_summary(&sub, &pile.planned.summary, &mut w)?;

@@ -27,4 +27,15 @@ pub enum FiguresError {
     /// A point cloud could not be written (names the file).
     #[error(transparent)]
     Cloud(#[from] autoshovel_cloud::CloudError),
+    /// A dig file (the warm-start pack) could not be written.
+    #[error(transparent)]
+    Dig(#[from] autoshovel_dig::DigError),
+    /// An output folder could not be created.
+    #[error("cannot create output directory {}: {source}", path.display())]
+    CreateDir {
+        /// The folder.
+        path: std::path::PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
 }

@@ -1,0 +1,171 @@
+//! One call per job, shared by its subcommand and the demo: the library
+//! call, then [`Job::finish`] with the figures crate's writer. Subcommand
+//! modules and the demo import this module, never each other.
+
+use std::path::Path;
+
+use anyhow::{bail, Context, Result};
+use autoshovel_dig::{
+    all_surfaces, plan_pile, AllSurfaces, AllSurfacesSummary, DigSetup, DigSummary, MachineProfile,
+    Pile, PlannedPile, SurfaceComparison,
+};
+use autoshovel_excavate::{ExcavateSummary, Setup};
+use autoshovel_figures as figures;
+use autoshovel_propel::study::{run_map, summarize, MapRow, StudyParams, StudySummary};
+use autoshovel_propel::{FieldKind, PlanOutcome, PlanPathSummary, Scenario};
+use autoshovel_surface::perceive::{perceive_file, PerceiveSummary, Perceived, PerceptionParams};
+use autoshovel_track::scenario::TrackScenario;
+use autoshovel_track::{ControllerKind, TrackSummary};
+use indicatif::ParallelProgressIterator;
+use rayon::prelude::*;
+
+use crate::output::{prepare_dir, progress_bar, Job};
+
+/// `plan-path`: plan `scenario` with `field`; success within
+/// `heading_tolerance_deg` of every leg's heading.
+pub fn plan_path(
+    scenario: &Scenario,
+    field: FieldKind,
+    heading_tolerance_deg: f64,
+    out: Option<&Path>,
+) -> Result<Job<PlanPathSummary>> {
+    let outcome = PlanOutcome::plan(scenario, field);
+    let summary = outcome.summary(scenario, heading_tolerance_deg);
+    Job::finish(summary, out, |dir, written| {
+        Ok(figures::map::write_plan_path(
+            dir, scenario, &outcome, written,
+        )?)
+    })
+}
+
+/// `study-paths`: the seeded random-road study, maps in parallel (with a
+/// progress bar when `progress`).
+pub fn study(
+    params: &StudyParams,
+    out: Option<&Path>,
+    progress: bool,
+) -> Result<Job<StudySummary>> {
+    if params.maps == 0 || params.maps > 100_000 {
+        bail!("--maps {} must be between 1 and 100000", params.maps);
+    }
+    if params.min_obstacles > params.max_obstacles || params.max_obstacles > 60 {
+        bail!(
+            "--min-obstacles {} and --max-obstacles {} must satisfy min <= max <= 60",
+            params.min_obstacles,
+            params.max_obstacles
+        );
+    }
+    let bar = progress_bar(progress, "{msg} [{bar:40}] {pos}/{len} maps, {eta} left");
+    bar.set_length(params.maps as u64);
+    bar.set_message("planning");
+    let rows: Vec<MapRow> = (0..params.maps)
+        .into_par_iter()
+        .progress_with(bar.clone())
+        .map(|i| run_map(params, i))
+        .collect();
+    bar.finish_and_clear();
+    Job::finish(summarize(params, &rows), out, |dir, written| {
+        Ok(figures::study::write_study(dir, params, &rows, written)?)
+    })
+}
+
+/// `track`: drive `scenario` with `controller` (all three with `compare`).
+pub fn track(
+    scenario: &TrackScenario,
+    controller: ControllerKind,
+    compare: bool,
+    out: Option<&Path>,
+) -> Result<Job<TrackSummary>> {
+    let tracking = autoshovel_track::track(scenario, controller, compare);
+    Job::finish(tracking.summary(scenario), out, |dir, written| {
+        figures::track::write(dir, scenario, &tracking, written)
+            .context("writing the track figures")
+    })
+}
+
+/// Reads `input` (with a progress bar when `progress`) and perceives it;
+/// errors name the file.
+pub fn read_and_perceive(
+    input: &Path,
+    params: &PerceptionParams,
+    progress: bool,
+) -> Result<Perceived> {
+    let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
+    let got = perceive_file(input, params, &mut |done, total| {
+        bar.set_length(total);
+        bar.set_position(done);
+    });
+    bar.finish_and_clear();
+    got.with_context(|| input.display().to_string())
+}
+
+/// `perceive`: the §3 pipeline on `input`.
+pub fn perceive(
+    input: &Path,
+    params: &PerceptionParams,
+    out: Option<&Path>,
+    progress: bool,
+) -> Result<Job<PerceiveSummary>> {
+    let got = read_and_perceive(input, params, progress)?;
+    let summary = PerceiveSummary::new(input, params, &got);
+    Job::finish(summary, out, |dir, written| {
+        Ok(figures::perceive::write(dir, &got, written)?)
+    })
+}
+
+/// The pile of a scan for `plan-dig --cloud`: the perception pipeline, then
+/// the dig profile cut by the library's rule.
+pub fn scan_pile(
+    path: &Path,
+    params: &PerceptionParams,
+    profile: &MachineProfile,
+    progress: bool,
+) -> Result<Pile> {
+    let got = read_and_perceive(path, params, progress)?;
+    Ok(Pile::scan(path, &got, profile)?)
+}
+
+/// `plan-dig`: one plan on `pile` (a summary with `error` set when no
+/// feasible plan came out).
+pub fn plan_dig(pile: &Pile, setup: &DigSetup, out: Option<&Path>) -> Result<Job<DigSummary>> {
+    let planned: PlannedPile = plan_pile(pile, setup)?;
+    Job::finish(planned.summary.clone(), out, |dir, written| {
+        Ok(figures::dig::write_plan(dir, &planned, written)?)
+    })
+}
+
+/// `plan-dig --all-surfaces`: the four piles beside Tables 4–5, each in
+/// its own folder under `out`; `on_pile` hears of each plan as it ends.
+pub fn plan_dig_all_surfaces(
+    setup: &DigSetup,
+    out: Option<&Path>,
+    on_pile: impl FnMut(&SurfaceComparison),
+) -> Result<Job<AllSurfacesSummary>> {
+    let mut all: AllSurfaces = all_surfaces(setup, on_pile)?;
+    let piles = match out {
+        Some(dir) => figures::dig::write_piles(dir, &mut all)?,
+        None => Default::default(),
+    };
+    Job::finish(all.summary.clone(), out, |dir, written| {
+        written.plots.extend(piles.plots);
+        written.files.extend(piles.files);
+        Ok(figures::dig::write_comparison(dir, &all, written)?)
+    })
+}
+
+/// `plan-excavate`: plan and execute the dig of `setup`; an impossible dig
+/// is an error naming the scenario. `out` is created only for a plan.
+pub fn plan_excavate(setup: &Setup, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
+    let ex = setup.run().with_context(|| {
+        format!(
+            "plan-excavate {} ({})",
+            setup.scenario.name, setup.scenario_source
+        )
+    })?;
+    let out = out.map(prepare_dir).transpose()?;
+    Job::finish(
+        ExcavateSummary::new(setup, &ex),
+        out.as_deref(),
+        |dir, written| Ok(figures::excavate::write(dir, setup, &ex, written)?),
+    )
+}
