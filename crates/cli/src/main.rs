@@ -73,9 +73,9 @@ enum Command {
 /// Field choice on the command line.
 #[derive(Debug, Clone, Copy, ValueEnum)]
 pub enum PlannerArg {
-    /// Classic artificial potential field (eqs. 1–5), the baseline.
+    /// Classic artificial potential field ([W eq. 1]–[W eq. 5]), the baseline.
     Apf,
-    /// Improved artificial potential field (eqs. 6–15).
+    /// Improved artificial potential field ([W eq. 6]–[W eq. 15]).
     ImprovedApf,
 }
 

@@ -97,7 +97,7 @@ fn check_plan(s: &Value, profile: &str) {
     let td = f64_field(s, "td_s");
     assert!((0.9..=1.1).contains(&fill), "fill {fill}");
     assert!((9.0..=15.0).contains(&td), "t_d {td}");
-    // The identities of eqs. 25–29 on the numbers the summary reports.
+    // The identities of [RS eq. 25]–[RS eq. 29] on the numbers the summary reports.
     let (m, v) = (f64_field(s, "m_dig_kg"), f64_field(s, "volume_m3"));
     let close = |a: f64, b: f64, what: &str| {
         assert!(

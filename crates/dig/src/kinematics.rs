@@ -82,6 +82,7 @@ impl RopeShovel {
     #[inline]
     pub fn forward(&self, q: Joints) -> [f64; 2] {
         let g = &self.geometry;
+        // [RS eq. 3]: the translation column of T_BW(q), as the paper expands it.
         let (u, n) = handle_axes(q.theta1);
         let d = q.d2 + g.d20;
         [g.l1 + g.l3 * n[0] + d * u[0], g.l2 + g.l3 * n[1] + d * u[1]] // [RS eq. 6]
@@ -105,6 +106,8 @@ impl RopeShovel {
     #[inline]
     pub fn inverse(&self, p: [f64; 2]) -> Option<Joints> {
         let g = &self.geometry;
+        // [RS eq. 4]–[RS eq. 5]: p is b, the translation of the tip pose
+        // T = [a b; 0 1]; comparing it with [RS eq. 3] gives [RS eq. 6].
         let (dx, dy) = (p[0] - g.l1, p[1] - g.l2);
         let dd = dx * dx + dy * dy - g.l3 * g.l3;
         if dd.is_nan() || dd <= 0.0 {

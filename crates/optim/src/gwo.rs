@@ -84,6 +84,17 @@ impl GwoParams {
             parallel: true,
         }
     }
+
+    /// A pack of `population` wolves run for `iterations` from `init`,
+    /// the rest as [`GwoParams::default`].
+    pub fn pack(population: usize, iterations: usize, init: Init) -> Self {
+        Self {
+            population,
+            iterations,
+            init,
+            ..Self::default()
+        }
+    }
 }
 
 /// Summary of the pack after one iteration.

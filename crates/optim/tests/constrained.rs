@@ -97,10 +97,5 @@ fn product_under_a_budget_line() {
 /// The pack these tests were tuned on (the old default): 50 wolves, 100
 /// iterations, good-point-set start.
 fn gwo_50x100() -> GwoParams {
-    GwoParams {
-        population: 50,
-        iterations: 100,
-        init: autoshovel_optim::Init::GoodPointSet,
-        ..GwoParams::default()
-    }
+    GwoParams::pack(50, 100, autoshovel_optim::Init::GoodPointSet)
 }

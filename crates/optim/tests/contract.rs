@@ -262,10 +262,5 @@ fn nan_from_the_problem_names_wolf_and_iteration() {
 /// The pack these tests were tuned on (the old default): 50 wolves, 100
 /// iterations, good-point-set start.
 fn gwo_50x100() -> GwoParams {
-    GwoParams {
-        population: 50,
-        iterations: 100,
-        init: autoshovel_optim::Init::GoodPointSet,
-        ..GwoParams::default()
-    }
+    GwoParams::pack(50, 100, autoshovel_optim::Init::GoodPointSet)
 }

@@ -167,10 +167,5 @@ fn matches_a_plain_transcription_of_eq_37() {
 /// The pack these tests were tuned on (the old default): 50 wolves, 100
 /// iterations, good-point-set start.
 fn gwo_50x100() -> GwoParams {
-    GwoParams {
-        population: 50,
-        iterations: 100,
-        init: autoshovel_optim::Init::GoodPointSet,
-        ..GwoParams::default()
-    }
+    GwoParams::pack(50, 100, autoshovel_optim::Init::GoodPointSet)
 }

@@ -173,10 +173,5 @@ fn what_the_good_point_set_buys_the_optimiser() {
 /// The pack these tests were tuned on (the old default): 50 wolves, 100
 /// iterations, good-point-set start.
 fn gwo_50x100() -> GwoParams {
-    GwoParams {
-        population: 50,
-        iterations: 100,
-        init: autoshovel_optim::Init::GoodPointSet,
-        ..GwoParams::default()
-    }
+    GwoParams::pack(50, 100, autoshovel_optim::Init::GoodPointSet)
 }

@@ -29,6 +29,10 @@
 //!   arrives aligned. This needs μ < η. [W eq. 13]'s cap ½μρ_d is read as the
 //!   same C¹ cap as the attraction, μρ_t.
 //!
+//! - The planner never evaluates a potential: [W eq. 7] (the gradient that
+//!   turns [W eq. 6] into the force of [W eq. 8]) is done on paper, and the
+//!   total potential [W eq. 14] is descended through its force, [W eq. 15].
+//!
 //! Descent: q ← q + δ·F/|F| with a fixed step δ, stopping within the goal
 //! tolerance. A stall is no net progress: over the last `stall_window` steps
 //! the machine moved less than `stall_ratio` of the distance it stepped

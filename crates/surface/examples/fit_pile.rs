@@ -1,5 +1,5 @@
 //! Scan each of the four piles of the rope-shovel paper's Fig. 7, level the
-//! scan from its floor (eqs. 11–12), cut the floor away and fit eq. 21 on the
+//! scan from its floor ([RS eq. 11]–[RS eq. 12]), cut the floor away and fit [RS eq. 21] on the
 //! 8 × 8 grid; print the tilt error, the degree, R² and the surface as a
 //! polynomial in x, y. Asserts the targets: tilt within 0.2°, R² > 0.95.
 //!
