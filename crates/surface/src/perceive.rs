@@ -435,7 +435,7 @@ impl Perceived {
     }
 }
 
-fn ms(t: Instant) -> f64 {
+fn elapsed_ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
@@ -452,7 +452,7 @@ pub fn perceive_file(
     let read = StageRecord {
         stage: "read",
         points: report.cloud.len(),
-        ms: ms(t),
+        ms: elapsed_ms(t),
     };
     if report.cloud.is_empty() {
         return Err(SurfaceError::NoFinitePoints {
@@ -562,7 +562,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
     stages.push(StageRecord {
         stage: "level",
         points: cloud.len(),
-        ms: ms(t),
+        ms: elapsed_ms(t),
     });
     // The filter stages, in the paper's order; each timed and counted.
     type Filter<'a> = Box<dyn Fn(&PointCloud) -> autoshovel_cloud::Result<PointCloud> + 'a>;
@@ -638,7 +638,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
             stages.push(StageRecord {
                 stage,
                 points: cloud.len(),
-                ms: ms(t),
+                ms: elapsed_ms(t),
             });
         }
     }
@@ -653,7 +653,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
     stages.push(StageRecord {
         stage: "fit",
         points: fit.samples.len(),
-        ms: ms(t),
+        ms: elapsed_ms(t),
     });
     Ok(Perceived {
         cloud,
