@@ -206,7 +206,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     }
     sections.push(section(
         key,
-        "The rope-shovel paper's §4 on its typical 40° pile at the 1:30 scale: a 6th-order tooth path chosen by the Grey Wolf Optimizer (50 wolves, 100 iterations, good-point-set start) to minimise 0.7·f1 + 0.3·f2 under c1–c18 (constraint values shown: ≤ 0 is met). The first plot draws the machine at the start and end of the dig: our reading of the paper's missing Fig. 2.",
+        &format!("The rope-shovel paper's §4 on its typical 40° pile at the 1:30 scale: a 6th-order tooth path chosen by the Grey Wolf Optimizer ({} wolves, {} iterations, {} start) to minimise {}·f1 + {}·f2 under c1–c18 (constraint values shown: ≤ 0 is met). The first plot draws the machine at the start and end of the dig: our reading of the paper's missing Fig. 2.", setup.gwo.population, setup.gwo.iterations, setup.gwo.init.name(), setup.profile.objective.k1, setup.profile.objective.k2),
         &shown,
         sub,
         &job.written.plots,
@@ -254,12 +254,21 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     summaries.insert(key.into(), job.json()?);
     // Hydraulic excavator: the paper's §3 case passed over and under, then two boulders in one dig.
     let excavate_runs: [(&str, &str); 3] = [
-        ("paper-over", "The hydraulic-excavator paper's §3 case (Fig. 5): 0.9 m³ from (7, 0) at 0.7 m depth; the descending tooth meets a 0.5 m boulder it did not know about on its upper part, γ ∈ (0°, 180°), so it passes over; the boulder counts as dug and the rest is re-planned (paper: 0.909 m³, contact at 1.6 s)."),
-        ("paper-under", "The same case with the boulder met on its lower part, γ ∈ (180°, 360°): the bucket passes under it (Fig. 6; paper: 0.915 m³)."),
+        ("paper-over", "The hydraulic-excavator paper's §3 case (Fig. 5): 0.9 m³ from (7, 0) at 0.7 m depth; the descending tooth meets a 0.5 m boulder it did not know about on its upper part, γ ∈ (0°, 180°), so it passes over; the boulder counts as dug and the rest is re-planned."),
+        ("paper-under", "The same case with the boulder met on its lower part, γ ∈ (180°, 360°): the bucket passes under it."),
         ("two-boulders", "Two boulders in one dig: the first passed over while descending, the second met while lifting out after the re-plan; each contact repeats preimage decision, forward search and re-plan."),
     ];
     for (name, description) in excavate_runs {
         let setup = autoshovel_excavate::Setup::load(name, None)?;
+        let description = match autoshovel_excavate::paper_case(name) {
+            Some(c) => format!(
+                "{description} ({}; paper: {} m³, contacts at {} s)",
+                c.figure,
+                c.volume_m3,
+                c.contacts_text()
+            ),
+            None => description.to_string(),
+        };
         let sub = format!("plan-excavate-{name}");
         let dir = prepare_dir(&out.join(&sub))?;
         let job = crate::jobs::plan_excavate(&setup, Some(&dir))?;
@@ -293,7 +302,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         }
         sections.push(section(
             &key,
-            description,
+            &description,
             &shown,
             &sub,
             &job.written.plots,

@@ -5,15 +5,19 @@
 //!
 //! `cargo run -p autoshovel-excavate --example paper_cases`
 
-use autoshovel_excavate::{excavate, AvoidSide, MachineProfile, Scenario};
+use autoshovel_excavate::{excavate, AvoidSide, MachineProfile, Scenario, PAPER_CASES};
 
 fn main() {
     let profile = MachineProfile::default();
     // (scenario, side, the paper's volume [m³], the paper's contact times [s])
-    let cases = [
-        (Scenario::paper_over(), AvoidSide::Over, 0.909, "1.6"),
-        (Scenario::paper_under(), AvoidSide::Under, 0.915, "2.8, 5.3"),
-    ];
+    let cases = PAPER_CASES.map(|c| {
+        (
+            Scenario::builtin(c.scenario).expect("built-in"),
+            c.side,
+            c.volume_m3,
+            c.contacts_text(),
+        )
+    });
     println!(
         "| case | V [m³] (paper) | contacts [s] (paper) | γ [°] | side | dig [s] | plan [ms] |"
     );
