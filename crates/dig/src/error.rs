@@ -102,17 +102,21 @@ pub enum PackProblem {
     /// The file is empty.
     #[error("empty file; expected a pack.csv of plan-dig")]
     Empty,
-    /// The header is not [`crate::pack::PACK_COLUMNS`].
-    #[error("header '{found}' is not a plan-dig pack (expected {})", crate::pack::PACK_COLUMNS.join(","))]
+    /// The header is not the pack's columns.
+    #[error("header '{found}' is not a plan-dig pack (expected {expected})")]
     Header {
         /// The header found.
         found: String,
+        /// The header a pack has.
+        expected: String,
     },
     /// A row with the wrong number of cells.
-    #[error("{found} values, expected {}", crate::pack::PACK_COLUMNS.len())]
+    #[error("{found} values, expected {expected}")]
     Width {
         /// Cells found.
         found: usize,
+        /// Cells a row has.
+        expected: usize,
     },
     /// A cell that is not a finite number.
     #[error("{column} = '{cell}' is not a finite number")]

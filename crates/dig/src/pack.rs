@@ -79,6 +79,7 @@ pub fn parse_pack(text: &str, path: &Path) -> Result<Vec<Decision>> {
             Some(1),
             PackProblem::Header {
                 found: header.join(","),
+                expected: PACK_COLUMNS.join(","),
             },
         ));
     }
@@ -90,7 +91,13 @@ pub fn parse_pack(text: &str, path: &Path) -> Result<Vec<Decision>> {
         let at = Some(i + 1);
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
         if cells.len() != PACK_COLUMNS.len() {
-            return Err(fail(at, PackProblem::Width { found: cells.len() }));
+            return Err(fail(
+                at,
+                PackProblem::Width {
+                    found: cells.len(),
+                    expected: PACK_COLUMNS.len(),
+                },
+            ));
         }
         let mut x = [0.0; 5];
         for (k, (cell, v)) in cells.iter().zip(x.iter_mut()).enumerate() {

@@ -13,8 +13,8 @@
 //! path, so the controller commands n_right − n_left = −u.
 
 use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, Scratch};
-use serde::{Deserialize, Serialize};
 
+pub use crate::controller::FuzzyParams;
 use crate::controller::{ControlInput, Controller, Gains};
 
 pub use autoshovel_fuzzy::presets::shovel_table1::{TABLE1, TERMS};
@@ -22,38 +22,6 @@ pub use autoshovel_fuzzy::presets::shovel_table1::{TABLE1, TERMS};
 /// Builds the Table 1 Mamdani system (inputs [e, ec], output u).
 pub fn table1_system() -> Result<MamdaniSystem, FuzzyError> {
     autoshovel_fuzzy::presets::shovel_table1::system()
-}
-
-/// Parameters of the fuzzy tracker.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct FuzzyParams {
-    /// Weight α of the centroid deviation in e [W eq. 23].
-    pub alpha: f64,
-    /// Scaling factor k1 of e [W eq. 24] [1/m]: e_f = k1·e.
-    pub k1: f64,
-    /// Scaling factor k2 of ec [W eq. 24] [s/m]: ec_f = k2·ec.
-    pub k2: f64,
-    /// Scaling factor k3 of u [W eq. 24]: u = k3·u_f.
-    pub k3: f64,
-    /// Time constant of the first-order low-pass on ec [s] (0 = none): the
-    /// rate of a centimetre-noisy RTK error at 10 Hz is mostly noise.
-    pub ec_filter_s: f64,
-}
-
-impl Default for FuzzyParams {
-    fn default() -> Self {
-        // Tuned by a seeded random search on fig9a/b (noise off) and the
-        // straight / curve / V-shape runs with RTK noise (seeds 11–13; the tests
-        // check seeds 1–6); see docs/track.md.
-        Self {
-            alpha: 0.30,
-            k1: 2.42,
-            k2: 32.1,
-            k3: 1.11,
-            ec_filter_s: 0.34,
-        }
-    }
 }
 
 /// The fuzzy tracker.

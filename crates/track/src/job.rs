@@ -5,7 +5,8 @@
 
 use serde::Serialize;
 
-use crate::controller::{ControllerKind, ControllerParams, Gains};
+use crate::choice::ControllerKind;
+use crate::controller::{ControllerParams, Gains};
 use crate::error::TrackError;
 use crate::plant::{CrawlerParams, SlipParams};
 use crate::scenario::{Noise, TrackScenario};

@@ -9,6 +9,7 @@
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]
 
+pub mod choice;
 pub mod controller;
 pub mod error;
 pub mod fuzzy_tracker;
@@ -20,12 +21,13 @@ pub mod sensor;
 pub mod sim;
 
 pub use autoshovel_core::config::TomlFile;
+pub use choice::ControllerKind;
 pub use controller::{
-    ControlInput, Controller, ControllerKind, ControllerParams, Gains, Pid, PidParams, PurePursuit,
+    ControlInput, Controller, ControllerParams, FuzzyParams, Gains, Pid, PidParams, PurePursuit,
     PurePursuitParams,
 };
 pub use error::TrackError;
-pub use fuzzy_tracker::{FuzzyParams, FuzzyTracker};
+pub use fuzzy_tracker::FuzzyTracker;
 pub use geometry::{deviations, Deviations, PathFault, RefLeg};
 pub use job::{track, ControllerRun, RunSummary, TrackParams, TrackSummary, Tracking};
 pub use plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
