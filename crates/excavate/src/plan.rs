@@ -164,7 +164,9 @@ pub struct Level1Report {
     pub second_step_volume_m3: f64,
     /// Durations of descent and rise [s].
     pub durations_s: [f64; 2],
-    /// The planned tip path, sampled in time [m].
+    /// The planned tip path, sampled in time [m] (for plots and CSV; not
+    /// in summaries).
+    #[serde(skip_serializing)]
     pub path_m: Vec<[f64; 2]>,
 }
 

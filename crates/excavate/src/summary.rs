@@ -38,7 +38,7 @@ pub struct ExcavateSummary {
     /// Start of the first plan [m].
     pub level1_start_m: [f64; 2],
     /// The first (level-1) plan.
-    pub level1: Level1Summary,
+    pub level1: Level1Report,
     /// Every boulder of the scenario.
     pub obstacles: Vec<ObstacleSummary>,
     /// Every detour, in order.
@@ -57,27 +57,6 @@ pub struct ExcavateSummary {
     pub depth_m: f64,
     /// Whether the step search bisected inside its last step.
     pub refine_volume: bool,
-}
-
-/// The level-1 plan made before any contact.
-#[derive(Debug, Clone, Serialize)]
-pub struct Level1Summary {
-    /// (x_begin, ground) [m].
-    pub start_m: [f64; 2],
-    /// (x_mid, −h) [m].
-    pub mid_m: [f64; 2],
-    /// (x_end, ground) [m].
-    pub end_m: [f64; 2],
-    /// Volume of the first half [m³].
-    pub first_half_m3: f64,
-    /// Volume of the second half [m³].
-    pub second_half_m3: f64,
-    /// n of the midpoint.
-    pub mid_steps: usize,
-    /// n of the end point.
-    pub end_steps: usize,
-    /// Durations of descent and rise [s].
-    pub durations_s: [f64; 2],
 }
 
 /// One boulder of the scenario.
@@ -157,7 +136,7 @@ impl ExcavateSummary {
             avoid_directions: ex.contacts.iter().map(|c| c.decision).collect(),
             contact_count: ex.contacts.len(),
             level1_start_m: ex.level1.start_m,
-            level1: Level1Summary::from(&ex.level1),
+            level1: ex.level1.clone(),
             obstacles: ex
                 .obstacles
                 .iter()
@@ -193,21 +172,6 @@ impl ExcavateSummary {
             step_m: sc.dig.step_m,
             depth_m: sc.dig.depth_m,
             refine_volume: sc.planner.refine_volume,
-        }
-    }
-}
-
-impl From<&Level1Report> for Level1Summary {
-    fn from(l1: &Level1Report) -> Self {
-        Self {
-            start_m: l1.start_m,
-            mid_m: l1.mid_m,
-            end_m: l1.end_m,
-            first_half_m3: l1.first_half_m3,
-            second_half_m3: l1.second_half_m3,
-            mid_steps: l1.mid_steps,
-            end_steps: l1.end_steps,
-            durations_s: l1.durations_s,
         }
     }
 }
