@@ -187,3 +187,30 @@ fn bad_scans_and_settings_are_refused_clearly() {
     assert_ne!(r.code(), Some(0));
     r.no_panic();
 }
+
+/// Issue 11: scales whose coordinates overflow (all inf) or the sampler's
+/// range (a panic, exit 101) are refused, naming the setting, and no file
+/// is written.
+#[test]
+fn generate_pile_refuses_scales_that_overflow() {
+    let dir = TempDir::new("pile-scale");
+    for scale in ["1e39", "1e307", "1e-9"] {
+        let file = dir.path().join(format!("p{scale}.pcd"));
+        let r = run(&[
+            "generate-pile".as_ref(),
+            "--scale".as_ref(),
+            scale.as_ref(),
+            "--points".as_ref(),
+            "1000".as_ref(),
+            "--out".as_ref(),
+            file.as_os_str(),
+        ])
+        .fails();
+        assert!(
+            r.error_message().contains(&format!("scale = {scale}")),
+            "{}",
+            r.error_message()
+        );
+        assert!(!file.exists(), "{scale}: nothing written");
+    }
+}

@@ -41,6 +41,6 @@ pub use calibrate::{angles_from_normal, level, level_from_sensor, sensor_from_le
 pub use error::{Result, SurfaceError};
 pub use fit::{fit_samples, fit_surface, DegreeScore, FitParams, HeightMap, SurfaceFit, Term};
 pub use floor::{estimate_tilt, TiltEstimate, TiltParams};
-pub use pile::{generate_pile, GeneratePileSummary, PileParams, PileShape};
+pub use pile::{generate_pile, GeneratePileSummary, PileParams, PileShape, MAX_SCALE, MIN_SCALE};
 pub use ransac::{least_squares_plane, ransac_plane, Plane, PlaneFit, RansacParams};
 pub use sample::{sample_grid, Extent, GridSample, SampleParams, Samples};

@@ -209,6 +209,12 @@ impl FromStr for PileShape {
     }
 }
 
+/// Smallest length scale [`generate_pile`] accepts (a 1 mm face).
+pub const MIN_SCALE: f64 = 1e-4;
+/// Largest length scale [`generate_pile`] accepts (a 10 km face): f32
+/// coordinates still resolve centimetres there.
+pub const MAX_SCALE: f64 = 1e3;
+
 /// Parameters of [`generate_pile`]. Lengths are full-scale metres, multiplied
 /// by `scale` (see the module docs).
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
@@ -317,6 +323,13 @@ impl PileParams {
             if !(v.is_finite() && v >= 0.0) {
                 return bad(name, v, "a finite value >= 0");
             }
+        }
+        if !(MIN_SCALE..=MAX_SCALE).contains(&self.scale) {
+            return bad(
+                "PileParams.scale",
+                self.scale,
+                "a length scale in [1e-4, 1e3] (1 = a 10 m face; f32 coordinates hold no more)",
+            );
         }
         if self.points == 0 {
             return bad("PileParams.points", 0.0, "at least 1");
@@ -708,6 +721,29 @@ mod tests {
         })
         .unwrap_err();
         assert!(err.to_string().contains("PileParams.scale"), "{err}");
+        // Scales whose coordinates overflow f32 (all inf) or the sampler's
+        // range (a panic, issue 11) are refused, the value printed short.
+        for (scale, shown) in [(1e39, "1e39"), (1e307, "1e307"), (1e-9, "1e-9")] {
+            let err = generate_pile(&PileParams {
+                scale,
+                ..PileParams::default()
+            })
+            .unwrap_err()
+            .to_string();
+            assert!(
+                err.starts_with(&format!("PileParams.scale = {shown}: ")),
+                "{err}"
+            );
+        }
+        for scale in [MIN_SCALE, MAX_SCALE] {
+            let cloud = generate_pile(&PileParams {
+                scale,
+                points: 2_000,
+                ..PileParams::default()
+            })
+            .unwrap();
+            assert!(cloud.points.iter().flatten().all(|v| v.is_finite()));
+        }
         assert_eq!(
             "convex-concave".parse::<PileShape>().unwrap(),
             PileShape::ConvexConcave

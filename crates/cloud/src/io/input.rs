@@ -214,6 +214,8 @@ pub(crate) struct Points {
     pub(crate) points: Vec<Point>,
     /// How many non-finite points were dropped.
     pub(crate) non_finite: usize,
+    /// Columns of a text header other than x, y and z.
+    pub(crate) ignored_columns: usize,
 }
 
 impl Points {

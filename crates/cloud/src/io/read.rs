@@ -20,6 +20,8 @@ pub struct ReadReport {
     pub cloud: PointCloud,
     /// Points dropped because a coordinate was NaN or infinite.
     pub non_finite_dropped: usize,
+    /// Columns a text file's header names besides x, y and z (ignored).
+    pub ignored_columns: usize,
     /// The format and encoding read, e.g. `"pcd binary_compressed"`,
     /// `"ply binary_big_endian"`, `"laz 1.4"`, `"csv"`.
     pub format: &'static str,
@@ -140,6 +142,7 @@ fn report(out: Points, format: &'static str) -> ReadReport {
     ReadReport {
         cloud: PointCloud { points },
         non_finite_dropped: out.non_finite,
+        ignored_columns: out.ignored_columns,
         format,
     }
 }

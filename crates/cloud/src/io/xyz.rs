@@ -1,7 +1,9 @@
-//! Plain text clouds (`.xyz`, `.csv`, `.txt`): one point per line, x y z
-//! separated by whitespace, commas or semicolons; further columns (intensity,
-//! colour, ...) are ignored. `#` starts a comment; one header line of
-//! column names is allowed before the first point.
+//! Plain text clouds (`.xyz`, `.csv`, `.txt`): one point per line, fields
+//! separated by whitespace, commas or semicolons (one separator for the
+//! whole file). A header line of column names, if present, picks x, y and z
+//! by name in any case and order (other columns are ignored and counted);
+//! without one the first three fields are x, y, z. `#` starts a comment.
+//! Decimal commas and mixed separators are refused, not guessed.
 
 use std::io::{BufRead, Write};
 
@@ -14,66 +16,204 @@ const MAX_LINE: usize = 1 << 16;
 /// Lines sampled before the point vector is sized from the bytes per line.
 const SAMPLE_LINES: usize = 4096;
 
-fn words(text: &str) -> impl Iterator<Item = &str> {
-    text.split(|c: char| c == ',' || c == ';' || c.is_ascii_whitespace())
-        .filter(|w| !w.is_empty())
+/// How the fields of a line are separated: decided once, on the first
+/// line that is not blank or a comment, and held for the whole file.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Separator {
+    /// Spaces or tabs.
+    Whitespace,
+    /// `,` (fields may carry spaces around them).
+    Comma,
+    /// `;` (fields may carry spaces around them).
+    Semicolon,
 }
 
-/// Reads a text cloud into `out`.
+impl Separator {
+    fn of(line: &str) -> Self {
+        if line.contains(';') {
+            Separator::Semicolon
+        } else if line.contains(',') {
+            Separator::Comma
+        } else {
+            Separator::Whitespace
+        }
+    }
+
+    fn name(self) -> &'static str {
+        match self {
+            Separator::Whitespace => "whitespace",
+            Separator::Comma => "','",
+            Separator::Semicolon => "';'",
+        }
+    }
+
+    fn split(self, line: &str) -> Vec<&str> {
+        match self {
+            Separator::Whitespace => line.split_ascii_whitespace().collect(),
+            Separator::Comma => line.split(',').map(str::trim).collect(),
+            Separator::Semicolon => line.split(';').map(str::trim).collect(),
+        }
+    }
+}
+
+/// Which columns hold x, y and z.
+#[derive(Debug, Clone, Copy)]
+struct Layout {
+    sep: Separator,
+    xyz: [usize; 3],
+}
+
+/// The columns of a header line: x, y and z by name (any case, any order,
+/// quotes stripped); other columns are ignored and counted.
+fn header_layout(fields: &[&str], sep: Separator, full: &str) -> Result<(Layout, usize), String> {
+    let names: Vec<String> = fields
+        .iter()
+        .map(|f| {
+            f.trim_matches(|c| c == '"' || c == '\'')
+                .to_ascii_lowercase()
+        })
+        .collect();
+    let mut xyz = [0usize; 3];
+    for (a, axis) in ["x", "y", "z"].into_iter().enumerate() {
+        let at: Vec<usize> = (0..names.len()).filter(|&i| names[i] == axis).collect();
+        match at[..] {
+            [i] => xyz[a] = i,
+            [] => {
+                return Err(format!(
+                    "line 1: the header {:?} names no {axis:?} column; x, y and z are needed \
+                     by name (any case, any order), or no header at all for x y z by position",
+                    full.trim()
+                ))
+            }
+            _ => {
+                return Err(format!(
+                "line 1: the header {:?} names {axis:?} {} times; which one is meant is ambiguous",
+                full.trim(),
+                at.len()
+            ))
+            }
+        }
+    }
+    Ok((Layout { sep, xyz }, names.len() - 3))
+}
+
+fn parse_field(s: &str, sep: Separator) -> Result<f32, String> {
+    s.parse::<f32>().map_err(|_| {
+        if sep == Separator::Semicolon
+            && s.contains(',')
+            && s.replace(',', ".").parse::<f32>().is_ok()
+        {
+            format!(
+                "{s:?} has a decimal comma; write decimals with '.' (the file is read with ';' \
+                 between fields and does not guess)"
+            )
+        } else {
+            format!("{s:?} is not a number")
+        }
+    })
+}
+
+/// Reads a text cloud into `out`: a header line of column names, if there
+/// is one, picks x, y and z by name; without one the first three fields are
+/// x, y, z. The separator (whitespace, `,` or `;`) is taken from the first
+/// line and must hold for every line; decimal commas are refused.
 pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> crate::Result<()> {
     let mut line = Vec::new();
     let mut line_no = 0u64;
     let mut data_lines = 0usize;
-    let mut header_seen = false;
+    let mut layout: Option<Layout> = None;
     let mut sized = false;
     while input.read_line(&mut line, MAX_LINE, line_no + 1)? {
         line_no += 1;
         let full = line_str(input, &line, line_no)?;
         let text = full.split('#').next().unwrap_or("");
-        let mut w = words(text);
-        let Some(first) = w.next() else { continue };
-        let coords = [Some(first), w.next(), w.next()];
-        let parsed: Vec<Option<f32>> = coords
-            .iter()
-            .map(|c| c.and_then(|s| s.parse::<f32>().ok()))
-            .collect();
-        if let [Some(x), Some(y), Some(z)] = parsed[..] {
-            out.push([x, y, z]);
-            data_lines += 1;
-            if !sized && data_lines == SAMPLE_LINES {
-                // Size the vector once from the bytes per line so far,
-                // instead of doubling through a large file.
-                sized = true;
-                let per_line = (input.pos() / line_no).max(1);
-                out.reserve_bounded(
-                    u64::MAX,
-                    input.remaining() + input.remaining() / 16,
-                    per_line,
-                );
+        if text.trim().is_empty() {
+            continue;
+        }
+        let lay = match layout {
+            Some(l) => l,
+            None => {
+                let sep = Separator::of(text);
+                let fields = sep.split(text);
+                let numeric = fields
+                    .iter()
+                    .take(3)
+                    .filter(|f| f.parse::<f32>().is_ok())
+                    .count();
+                if fields.len() >= 3 && numeric == 3 {
+                    let l = Layout {
+                        sep,
+                        xyz: [0, 1, 2],
+                    };
+                    layout = Some(l);
+                    l
+                } else if numeric == 0
+                    && !fields
+                        .iter()
+                        .take(3)
+                        .any(|f| f.replace(',', ".").parse::<f32>().is_ok())
+                {
+                    let (l, ignored) = header_layout(&fields, sep, full).map_err(|what| {
+                        input.format_err(what.replacen("line 1", &format!("line {line_no}"), 1))
+                    })?;
+                    out.ignored_columns = ignored;
+                    layout = Some(l);
+                    continue;
+                } else {
+                    let found = fields.len();
+                    let what = if found < 3 {
+                        format!(
+                            "line {line_no}: needs x, y and z, found {found} value(s) separated by {}: {:?}",
+                            sep.name(),
+                            full.trim()
+                        )
+                    } else {
+                        let bad = fields
+                            .iter()
+                            .take(3)
+                            .find(|f| f.parse::<f32>().is_err())
+                            .copied()
+                            .unwrap_or("");
+                        format!(
+                            "line {line_no}: {}",
+                            parse_field(bad, sep).err().unwrap_or_default()
+                        )
+                    };
+                    return Err(input.format_err(what));
+                }
             }
-            continue;
-        }
-        let numeric_first = coords[0].is_some_and(|s| s.parse::<f32>().is_ok());
-        if data_lines == 0 && !header_seen && !numeric_first {
-            header_seen = true;
-            continue;
-        }
-        let found = coords.iter().flatten().count();
-        let what = if found < 3 {
-            format!(
-                "line {line_no}: needs x, y and z, found {found} value(s): {:?}",
-                full.trim()
-            )
-        } else {
-            let bad = coords
-                .iter()
-                .flatten()
-                .find(|s| s.parse::<f32>().is_err())
-                .copied()
-                .unwrap_or("");
-            format!("line {line_no}: {bad:?} is not a number")
         };
-        return Err(input.format_err(what));
+        let fields = lay.sep.split(text);
+        let mut p = [0f32; 3];
+        for (a, &col) in lay.xyz.iter().enumerate() {
+            let Some(f) = fields.get(col) else {
+                return Err(input.format_err(format!(
+                    "line {line_no}: needs {} fields separated by {} (x, y, z in columns {}, {}, {}), found {}: {:?}",
+                    lay.xyz.iter().max().unwrap_or(&2) + 1,
+                    lay.sep.name(),
+                    lay.xyz[0] + 1,
+                    lay.xyz[1] + 1,
+                    lay.xyz[2] + 1,
+                    fields.len(),
+                    full.trim()
+                )));
+            };
+            p[a] = parse_field(f, lay.sep)
+                .map_err(|e| input.format_err(format!("line {line_no}: {e}")))?;
+        }
+        out.push(p);
+        data_lines += 1;
+        if !sized && data_lines == SAMPLE_LINES {
+            // Size the vector once from the bytes per line so far,
+            // instead of doubling through a large file.
+            sized = true;
+            let per_line = (input.pos() / line_no).max(1);
+            out.reserve_bounded(
+                u64::MAX,
+                input.remaining() + input.remaining() / 16,
+                per_line,
+            );
+        }
     }
     Ok(())
 }
