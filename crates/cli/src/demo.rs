@@ -11,11 +11,35 @@ use serde_json::{json, Value};
 
 use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{prepare_dir, print_json};
+use crate::output::{print_json, OutDir};
 
 /// Runs the demo into `out`.
-pub fn run(out: &Path, json_only: bool) -> Result<()> {
-    let out = prepare_dir(out)?;
+///
+/// The demo writes only into its own sub-folders (each job under the output
+/// rule of `autoshovel_report::staging`) and its `index.html`,
+/// `summary.json` and the two scans it generates, which its summary lists
+/// as its own; without `force` a user's file of those names is refused
+/// before any work.
+pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
+    let top = crate::output::out_dir(Some(out), &[], force)?.expect("a folder");
+    let ours = autoshovel_report::files_written_before(out);
+    for name in [
+        autoshovel_report::INDEX_FILE,
+        autoshovel_report::SUMMARY_FILE,
+    ] {
+        let target = out.join(name);
+        if let Some(why) = autoshovel_report::refusal(&target, &[], &ours, force) {
+            anyhow::bail!("refusing to write {}: {why}", target.display());
+        }
+    }
+    std::fs::create_dir_all(out)?;
+    let out = top.dir.clone();
+    let sub_out = |sub: &str| OutDir {
+        dir: out.join(sub),
+        inputs: Vec::new(),
+        force,
+    };
+    let mut own: Vec<String> = Vec::new();
     let mut sections = Vec::new();
     let mut summaries = serde_json::Map::new();
     let runs: [(&str, FieldKind, &str); 6] = [
@@ -30,7 +54,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         let scenario = Scenario::builtin(name).expect("built-in scenario");
         let key = format!("plan-path {name} {}", field.name());
         let sub = format!("plan-path-{name}-{}", field.name());
-        let dir = prepare_dir(&out.join(&sub))?;
+        let dir = sub_out(&sub);
         let job = crate::jobs::plan_path(
             &scenario,
             field,
@@ -108,7 +132,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         } else {
             format!("track-{name}-fuzzy")
         };
-        let dir = prepare_dir(&out.join(&sub))?;
+        let dir = sub_out(&sub);
         let job = crate::jobs::track(&scenario, ctl, compare, Some(&dir))?;
         if !json_only {
             let m = &job.summary.run.metrics;
@@ -138,18 +162,28 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         autoshovel_surface::PileShape::ConvexConcave,
     ] {
         let sub = format!("perceive-{}", shape.name());
-        let dir = prepare_dir(&out.join(&sub))?;
-        let scan = dir.join("scan.pcd");
+        let dir = sub_out(&sub);
+        let scan = dir.dir.join("scan.pcd");
         let params = autoshovel_surface::PileParams {
             shape,
             points: 200_000,
             ..Default::default()
         };
         let cloud = autoshovel_surface::generate_pile(&params)?;
-        autoshovel_cloud::io::write(&scan, &cloud, autoshovel_cloud::io::Encoding::Binary)?;
+        std::fs::create_dir_all(&dir.dir)?;
+        autoshovel_report::write_file_atomically::<anyhow::Error>(
+            &scan,
+            &[],
+            (&ours, force),
+            |p| {
+                autoshovel_cloud::io::write(p, &cloud, autoshovel_cloud::io::Encoding::Binary)?;
+                Ok(())
+            },
+        )?;
+        own.push(format!("{sub}/scan.pcd"));
         let job = crate::jobs::perceive(&scan, &PerceptionParams::default(), Some(&dir), false)?;
         let mut written = job.written.clone();
-        written.file(&dir, &scan);
+        written.file(&dir.dir, &scan);
         let key = format!("perceive {} pile", shape.name());
         if !json_only {
             let s = &job.summary;
@@ -173,7 +207,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     // Dig planning: the typical pile, then all four beside the paper's Tables 4–5.
     let setup = autoshovel_dig::DigSetup::scale_model(1);
     let sub = "plan-dig-typical";
-    let dir = prepare_dir(&out.join(sub))?;
+    let dir = sub_out(sub);
     let typical = autoshovel_dig::paper_row(autoshovel_surface::PileShape::Typical);
     let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile);
     let job = crate::jobs::plan_dig(&pile, &setup, Some(&dir))?;
@@ -214,7 +248,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     ));
     summaries.insert(key.into(), summary);
     let sub = "plan-dig-all-surfaces";
-    let dir = prepare_dir(&out.join(sub))?;
+    let dir = sub_out(sub);
     let job = crate::jobs::plan_dig_all_surfaces(&setup, Some(&dir), |_| {})?;
     let key = "plan-dig --all-surfaces";
     if !json_only {
@@ -270,7 +304,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
             None => description.to_string(),
         };
         let sub = format!("plan-excavate-{name}");
-        let dir = prepare_dir(&out.join(&sub))?;
+        let dir = sub_out(&sub);
         let job = crate::jobs::plan_excavate(&setup, Some(&dir))?;
         let key = format!("plan-excavate {name}");
         if !json_only {
@@ -315,7 +349,7 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
         ..Default::default()
     };
     let sub = "study-paths";
-    let dir = prepare_dir(&out.join(sub))?;
+    let dir = sub_out(sub);
     let job = crate::jobs::study(&params, Some(&dir), !json_only)?;
     if !json_only {
         crate::say!(
@@ -334,7 +368,11 @@ pub fn run(out: &Path, json_only: bool) -> Result<()> {
     ));
     summaries.insert("study-paths".into(), summary);
     let all = Value::Object(summaries);
-    write_summary(&out, &json!({ "job": "demo", "jobs": all }))?;
+    own.extend([
+        autoshovel_report::INDEX_FILE.to_string(),
+        autoshovel_report::SUMMARY_FILE.to_string(),
+    ]);
+    write_summary(&out, &json!({ "job": "demo", "jobs": all, "files": own }))?;
     let index = write_index_html(&out, "autoshovel demo", &sections)?;
     if json_only {
         print_json(&json!({ "job": "demo", "jobs": all }))?;

@@ -19,7 +19,7 @@ use autoshovel_track::{ControllerKind, TrackSummary};
 use indicatif::ParallelProgressIterator;
 use rayon::prelude::*;
 
-use crate::output::{prepare_dir, progress_bar, Job};
+use crate::output::{progress_bar, Job, OutDir};
 
 /// `plan-path`: plan `scenario` with `field`; success within
 /// `heading_tolerance_deg` of every leg's heading.
@@ -27,7 +27,7 @@ pub fn plan_path(
     scenario: &Scenario,
     field: FieldKind,
     heading_tolerance_deg: f64,
-    out: Option<&Path>,
+    out: Option<&OutDir>,
 ) -> Result<Job<PlanPathSummary>> {
     let outcome = PlanOutcome::plan(scenario, field);
     let summary = outcome.summary(scenario, heading_tolerance_deg);
@@ -42,7 +42,7 @@ pub fn plan_path(
 /// progress bar when `progress`).
 pub fn study(
     params: &StudyParams,
-    out: Option<&Path>,
+    out: Option<&OutDir>,
     progress: bool,
 ) -> Result<Job<StudySummary>> {
     if params.maps == 0 || params.maps > 100_000 {
@@ -74,7 +74,7 @@ pub fn track(
     scenario: &TrackScenario,
     controller: ControllerKind,
     compare: bool,
-    out: Option<&Path>,
+    out: Option<&OutDir>,
 ) -> Result<Job<TrackSummary>> {
     let tracking = autoshovel_track::track(scenario, controller, compare);
     Job::finish(tracking.summary(scenario), out, |dir, written| {
@@ -103,7 +103,7 @@ pub fn read_and_perceive(
 pub fn perceive(
     input: &Path,
     params: &PerceptionParams,
-    out: Option<&Path>,
+    out: Option<&OutDir>,
     progress: bool,
 ) -> Result<Job<PerceiveSummary>> {
     let got = read_and_perceive(input, params, progress)?;
@@ -127,7 +127,7 @@ pub fn scan_pile(
 
 /// `plan-dig`: one plan on `pile` (a summary with `error` set when no
 /// feasible plan came out).
-pub fn plan_dig(pile: &Pile, setup: &DigSetup, out: Option<&Path>) -> Result<Job<DigSummary>> {
+pub fn plan_dig(pile: &Pile, setup: &DigSetup, out: Option<&OutDir>) -> Result<Job<DigSummary>> {
     let planned: PlannedPile = plan_pile(pile, setup)?;
     Job::finish(planned.summary.clone(), out, |dir, written| {
         Ok(figures::dig::write_plan(dir, &planned, written)?)
@@ -138,15 +138,16 @@ pub fn plan_dig(pile: &Pile, setup: &DigSetup, out: Option<&Path>) -> Result<Job
 /// its own folder under `out`; `on_pile` hears of each plan as it ends.
 pub fn plan_dig_all_surfaces(
     setup: &DigSetup,
-    out: Option<&Path>,
+    out: Option<&OutDir>,
     on_pile: impl FnMut(&SurfaceComparison),
 ) -> Result<Job<AllSurfacesSummary>> {
     let mut all: AllSurfaces = all_surfaces(setup, on_pile)?;
-    let piles = match out {
-        Some(dir) => figures::dig::write_piles(dir, &mut all)?,
+    let staging = out.map(OutDir::stage).transpose()?;
+    let piles = match &staging {
+        Some(s) => figures::dig::write_piles(s.path(), &mut all)?,
         None => Default::default(),
     };
-    Job::finish(all.summary.clone(), out, |dir, written| {
+    Job::finish_in(all.summary.clone(), staging, |dir, written| {
         written.plots.extend(piles.plots);
         written.files.extend(piles.files);
         Ok(figures::dig::write_comparison(dir, &all, written)?)
@@ -154,18 +155,15 @@ pub fn plan_dig_all_surfaces(
 }
 
 /// `plan-excavate`: plan and execute the dig of `setup`; an impossible dig
-/// is an error naming the scenario. `out` is created only for a plan.
-pub fn plan_excavate(setup: &Setup, out: Option<&Path>) -> Result<Job<ExcavateSummary>> {
+/// is an error naming the scenario; `out` is made only for a plan.
+pub fn plan_excavate(setup: &Setup, out: Option<&OutDir>) -> Result<Job<ExcavateSummary>> {
     let ex = setup.run().with_context(|| {
         format!(
             "plan-excavate {} ({})",
             setup.scenario.name, setup.scenario_source
         )
     })?;
-    let out = out.map(prepare_dir).transpose()?;
-    Job::finish(
-        ExcavateSummary::new(setup, &ex),
-        out.as_deref(),
-        |dir, written| Ok(figures::excavate::write(dir, setup, &ex, written)?),
-    )
+    Job::finish(ExcavateSummary::new(setup, &ex), out, |dir, written| {
+        Ok(figures::excavate::write(dir, setup, &ex, written)?)
+    })
 }

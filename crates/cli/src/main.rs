@@ -67,6 +67,9 @@ enum Command {
         /// Print the combined summary as JSON on stdout.
         #[arg(long)]
         json: bool,
+        /// Replace files in the report folder that autoshovel did not write.
+        #[arg(long)]
+        force: bool,
     },
 }
 
@@ -104,7 +107,7 @@ fn main() -> ExitCode {
                 let _ = write!(std::io::stdout().lock(), "{text}");
             })
             .map_err(anyhow::Error::from),
-        Command::Demo { out, json } => demo::run(&out, json),
+        Command::Demo { out, json, force } => demo::run(&out, json, force),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,

@@ -7,20 +7,27 @@
 
 use std::path::{Path, PathBuf};
 
-use anyhow::{bail, Context, Result};
-pub use autoshovel_report::Written;
+use anyhow::{bail, Result};
+pub use autoshovel_report::{OutDir, Staging, Written};
 use serde::Serialize;
 
-/// Makes sure `dir` is a directory we may write into, creating it if needed.
-/// An existing directory is used as it is: only the files a job names are
-/// written, nothing else in it is touched.
-pub fn prepare_dir(dir: &Path) -> Result<PathBuf> {
+/// The output folder of `--out DIR`, protecting the job's `inputs` (never
+/// written over) and, without `--force`, every existing file autoshovel did
+/// not write. A `DIR` that is a file is refused before any work.
+pub fn out_dir(
+    dir: Option<&Path>,
+    inputs: &[Option<&Path>],
+    force: bool,
+) -> Result<Option<OutDir>> {
+    let Some(dir) = dir else { return Ok(None) };
     if dir.exists() && !dir.is_dir() {
         bail!("--out {}: exists and is not a directory", dir.display());
     }
-    std::fs::create_dir_all(dir)
-        .with_context(|| format!("cannot create output directory {}", dir.display()))?;
-    Ok(dir.to_path_buf())
+    Ok(Some(OutDir {
+        dir: dir.to_path_buf(),
+        inputs: inputs.iter().flatten().map(|p| p.to_path_buf()).collect(),
+        force,
+    }))
 }
 
 /// Prints a summary as pretty JSON on stdout.
@@ -56,22 +63,36 @@ pub struct Job<S> {
 }
 
 impl<S: Serialize> Job<S> {
-    /// Writes the job's files into `out` (when given) with `write`, then
-    /// `summary.json` listing them all.
+    /// Writes the job's files with `write` into a staging folder of `out`
+    /// (when given), then `summary.json` listing them all, then moves them
+    /// into `out` under the output rule (`autoshovel_report::staging`).
     pub fn finish(
         summary: S,
-        out: Option<&Path>,
+        out: Option<&OutDir>,
+        write: impl FnOnce(&Path, &mut Written) -> Result<()>,
+    ) -> Result<Self> {
+        let staging = out.map(OutDir::stage).transpose()?;
+        Self::finish_in(summary, staging, write)
+    }
+
+    /// [`Job::finish`] into a staging folder the job has already written to.
+    pub fn finish_in(
+        summary: S,
+        staging: Option<Staging>,
         write: impl FnOnce(&Path, &mut Written) -> Result<()>,
     ) -> Result<Self> {
         let mut written = Written::default();
-        if let Some(dir) = out {
-            write(dir, &mut written)?;
-            autoshovel_report::write_job_summary(dir, &summary, &mut written)?;
+        let mut out = None;
+        if let Some(staging) = staging {
+            write(staging.path(), &mut written)?;
+            autoshovel_report::write_job_summary(staging.path(), &summary, &mut written)?;
+            out = Some(staging.dir().to_path_buf());
+            staging.commit(&written)?;
         }
         Ok(Self {
             summary,
             written,
-            out: out.map(Path::to_path_buf),
+            out,
         })
     }
 

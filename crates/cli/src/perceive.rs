@@ -7,7 +7,7 @@ use std::path::{Path, PathBuf};
 use anyhow::{Context, Result};
 use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::prepare_dir;
+use crate::output::out_dir;
 
 /// Arguments of `perceive`.
 #[derive(Debug, clap::Args)]
@@ -24,6 +24,10 @@ pub struct Args {
     /// Write summary.json, the cleaned cloud, the surface and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -45,8 +49,12 @@ pub fn run(args: &Args) -> Result<()> {
         return Ok(());
     }
     let input = args.input.as_deref().context("--input is required")?;
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    let job = crate::jobs::perceive(input, &params, out.as_deref(), !args.json)?;
+    let out = out_dir(
+        args.out.as_deref(),
+        &[Some(input), args.config.as_deref()],
+        args.force,
+    )?;
+    let job = crate::jobs::perceive(input, &params, out.as_ref(), !args.json)?;
     job.report(args.json, |s| {
         crate::say!("perceive {}", s.input);
         for st in &s.stages {

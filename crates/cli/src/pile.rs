@@ -3,7 +3,7 @@
 
 use std::path::PathBuf;
 
-use anyhow::{Context, Result};
+use anyhow::Result;
 use autoshovel_cloud::io::{write, Encoding};
 use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape};
 
@@ -49,6 +49,9 @@ pub struct Args {
     /// PCD/PLY encoding (default binary).
     #[arg(long, value_enum)]
     pub encoding: Option<EncodingArg>,
+    /// Replace an existing file at --out.
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -82,8 +85,15 @@ pub fn run(args: &Args) -> Result<()> {
         Some(EncodingArg::BinaryBigEndian) => Encoding::BinaryBigEndian,
     };
     let t1 = std::time::Instant::now();
-    write(&args.out, &cloud, encoding)
-        .with_context(|| format!("writing {}", args.out.display()))?;
+    autoshovel_report::write_file_atomically::<anyhow::Error>(
+        &args.out,
+        &[],
+        (&Default::default(), args.force),
+        |p| {
+            write(p, &cloud, encoding)?;
+            Ok(())
+        },
+    )?;
     let summary = GeneratePileSummary::new(
         &params,
         cloud.len(),

@@ -10,7 +10,7 @@
 //! and `paths`. A scan (`--cloud`) is cut into a dig profile by
 //! `autoshovel_dig::scan`'s rule.
 
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 
 use anyhow::{bail, Result};
 use autoshovel_dig::TomlFile as _;
@@ -23,7 +23,7 @@ use autoshovel_surface::PileShape;
 
 use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::prepare_dir;
+use crate::output::out_dir;
 
 /// How the optimiser's first pack is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -98,6 +98,10 @@ pub struct Args {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -127,15 +131,24 @@ pub fn run(args: &Args) -> Result<()> {
         Some(p) => PerceptionParams::load(p)?,
         None => PerceptionParams::default(),
     };
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
+    let out = out_dir(
+        args.out.as_deref(),
+        &[
+            args.cloud.as_deref(),
+            args.config.as_deref(),
+            args.profile.as_deref(),
+            args.warm_start.as_deref(),
+        ],
+        args.force,
+    )?;
     if args.all_surfaces {
-        return run_all_surfaces(&setup, out.as_deref(), args.json);
+        return run_all_surfaces(&setup, out.as_ref(), args.json);
     }
     let pile = match &args.cloud {
         Some(path) => crate::jobs::scan_pile(path, &pipeline, &setup.profile, !args.json)?,
         None => Pile::shape(args.surface.unwrap_or_default(), &setup.profile),
     };
-    let job = crate::jobs::plan_dig(&pile, &setup, out.as_deref())?;
+    let job = crate::jobs::plan_dig(&pile, &setup, out.as_ref())?;
     job.report(args.json, print_human)?;
     match &job.summary.error {
         Some(e) => bail!("{e}"),
@@ -144,7 +157,11 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// `--all-surfaces`: the four piles beside Tables 4–5.
-fn run_all_surfaces(setup: &DigSetup, out: Option<&Path>, json: bool) -> Result<()> {
+fn run_all_surfaces(
+    setup: &DigSetup,
+    out: Option<&crate::output::OutDir>,
+    json: bool,
+) -> Result<()> {
     let job = crate::jobs::plan_dig_all_surfaces(setup, out, |s| {
         if !json {
             crate::say!(

@@ -6,7 +6,7 @@
 //! arguments, loads, runs and writes. A plan that fails is an error naming
 //! the reason; no summary is written for it.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use autoshovel_excavate::{ExcavateSummary, Setup};
@@ -29,6 +29,10 @@ pub struct Args {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -45,13 +49,13 @@ pub fn run(args: &Args) -> Result<()> {
         return Ok(());
     }
     let setup = Setup::load(&args.scenario, args.profile.as_deref())?;
-    if let Some(dir) = &args.out {
-        // Refuse a bad --out before planning, but create it only for a plan.
-        if dir.exists() && !dir.is_dir() {
-            anyhow::bail!("--out {}: exists and is not a directory", dir.display());
-        }
-    }
-    crate::jobs::plan_excavate(&setup, args.out.as_deref())?.report(args.json, print_human)
+    // Refuse a bad --out before planning; it is created only for a plan.
+    let out = crate::output::out_dir(
+        args.out.as_deref(),
+        &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
+        args.force,
+    )?;
+    crate::jobs::plan_excavate(&setup, out.as_ref())?.report(args.json, print_human)
 }
 
 fn print_raw(text: &str) {

@@ -1,12 +1,12 @@
 //! `autoshovel plan-path`: travel planning with the classic or improved
 //! potential field on a built-in or user scenario (SPEC §2, §6).
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use autoshovel_propel::{PlanPathSummary, Scenario};
 
-use crate::output::prepare_dir;
+use crate::output::out_dir;
 use crate::PlannerArg;
 
 /// Arguments of `plan-path`.
@@ -21,6 +21,10 @@ pub struct Args {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -32,7 +36,11 @@ pub struct Args {
 /// Runs `plan-path` as the command line asks.
 pub fn run(args: &Args) -> Result<()> {
     let scenario = Scenario::resolve(&args.scenario)?;
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
+    let out = out_dir(
+        args.out.as_deref(),
+        &[Some(Path::new(&args.scenario))],
+        args.force,
+    )?;
     if !(args.heading_tolerance_deg.is_finite() && args.heading_tolerance_deg >= 0.0) {
         anyhow::bail!(
             "--heading-tolerance-deg {} must be a non-negative number",
@@ -43,7 +51,7 @@ pub fn run(args: &Args) -> Result<()> {
         &scenario,
         args.planner.into(),
         args.heading_tolerance_deg,
-        out.as_deref(),
+        out.as_ref(),
     )?;
     job.report(args.json, print_human)?;
     match &job.summary.error {

@@ -7,7 +7,7 @@ use anyhow::Result;
 use autoshovel_figures::study::markdown_table;
 use autoshovel_propel::study::StudyParams;
 
-use crate::output::prepare_dir;
+use crate::output::out_dir;
 
 /// Arguments of `study-paths`.
 #[derive(Debug, clap::Args)]
@@ -27,6 +27,10 @@ pub struct Args {
     /// Write summary.json, maps.csv and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -41,7 +45,7 @@ pub fn run(args: &Args) -> Result<()> {
         max_obstacles: args.max_obstacles,
         ..Default::default()
     };
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
-    let job = crate::jobs::study(&params, out.as_deref(), !args.json)?;
+    let out = out_dir(args.out.as_deref(), &[], args.force)?;
+    let job = crate::jobs::study(&params, out.as_ref(), !args.json)?;
     job.report(args.json, |s| crate::say!("{}", markdown_table(s)))
 }

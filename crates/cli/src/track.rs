@@ -2,13 +2,13 @@
 //! fuzzy tracker, PID or pure pursuit (SPEC §3, §6), and `--compare` to run
 //! every controller on the same scenario and seed.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
 use anyhow::Result;
 use autoshovel_track::scenario::{resolve, Noise};
 use autoshovel_track::{ControllerKind, RunSummary, TrackSummary};
 
-use crate::output::prepare_dir;
+use crate::output::out_dir;
 
 /// Controller choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -61,6 +61,10 @@ pub struct Args {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
@@ -73,12 +77,16 @@ pub fn run(args: &Args) -> Result<()> {
         NoiseArg::Rtk => Noise::Rtk,
     });
     let scenario = resolve(&args.scenario, noise, args.seed)?;
-    let out = args.out.as_deref().map(prepare_dir).transpose()?;
+    let out = out_dir(
+        args.out.as_deref(),
+        &[Some(Path::new(&args.scenario))],
+        args.force,
+    )?;
     let job = crate::jobs::track(
         &scenario,
         args.controller.into(),
         args.compare,
-        out.as_deref(),
+        out.as_ref(),
     )?;
     // The safety log: on stderr, so stdout stays the summary alone with --json.
     for e in job.summary.events.iter().filter(|e| e.is_safety()) {

@@ -26,6 +26,15 @@ pub enum ReportError {
         /// What the plotting library reported.
         message: String,
     },
+    /// A file may not be written there: it is an input of the job, or an
+    /// existing file autoshovel did not write (without `--force`).
+    #[error("refusing to write {}: {why}", path.display())]
+    Refused {
+        /// The file (or folder) at fault.
+        path: PathBuf,
+        /// Why, and what to do.
+        why: String,
+    },
     /// The input cannot be turned into a plot or table (bad range, ragged rows, bad file stem...).
     #[error("invalid report input: {what}")]
     Invalid {

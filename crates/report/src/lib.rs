@@ -40,6 +40,7 @@ mod json;
 mod layout;
 mod panels;
 mod render;
+mod staging;
 mod style;
 mod written;
 
@@ -56,5 +57,6 @@ pub use crate::panels::{
     finite_range, instant_marks, markdown_table, rating_line, time_panel, Line,
 };
 pub use crate::render::{write_figure, write_panels, MAX_MARKER_PX, MAX_STROKE_PX};
+pub use crate::staging::{files_written_before, refusal, write_file_atomically, OutDir, Staging};
 pub use crate::style::{viridis, Rgb, Stroke};
 pub use crate::written::{summary_value, write_job_summary, WithFiles, Written};

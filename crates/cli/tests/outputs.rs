@@ -1,0 +1,195 @@
+//! Issue 11, the output rule: no job writes onto a file it read, nor onto an
+//! existing file autoshovel did not write unless `--force` is given; a job
+//! may rerun into its own folder; a refusal leaves every file as it was and
+//! no staging folder behind.
+
+mod common;
+
+use std::path::Path;
+
+use common::*;
+
+fn args<'a>(v: &'a [&'a str]) -> Vec<&'a std::ffi::OsStr> {
+    v.iter().map(|s| s.as_ref()).collect()
+}
+
+fn no_staging_left(dir: &Path) {
+    let left: Vec<_> = std::fs::read_dir(dir)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .map(|e| e.file_name().to_string_lossy().into_owned())
+        .filter(|n| n.starts_with(".autoshovel"))
+        .collect();
+    assert!(
+        left.is_empty(),
+        "left behind in {}: {left:?}",
+        dir.display()
+    );
+}
+
+/// Every job: a user's `summary.json` in --out is kept (refused, byte for
+/// byte), --force replaces it, and a rerun into the job's own folder works.
+#[test]
+fn every_job_keeps_a_users_file_unless_forced_and_reruns_into_its_own_folder() {
+    let tmp = TempDir::new("outputs-jobs");
+    let jobs: [&[&str]; 5] = [
+        &["plan-path", "--scenario", "straight"],
+        &["track", "--scenario", "straight"],
+        &["study-paths", "--maps", "4"],
+        &["plan-excavate", "--scenario", "paper-over"],
+        &["plan-dig", "--surface", "typical"],
+    ];
+    for (i, job) in jobs.iter().enumerate() {
+        let dir = tmp.path().join(format!("job{i}"));
+        std::fs::create_dir_all(&dir).unwrap();
+        let mine = tmp.write(&format!("job{i}/summary.json"), "my notes\n");
+        let d = dir.to_str().unwrap();
+        let mut a = job.to_vec();
+        a.extend(["--out", d]);
+        let r = run(&args(&a)).fails();
+        assert!(
+            r.error_message().contains("--force") && r.error_message().contains("summary.json"),
+            "{}: {}",
+            job[0],
+            r.error_message()
+        );
+        assert_eq!(std::fs::read_to_string(&mine).unwrap(), "my notes\n");
+        no_staging_left(&dir);
+        a.push("--force");
+        run(&args(&a)).ok();
+        assert_ne!(std::fs::read_to_string(&mine).unwrap(), "my notes\n");
+        a.pop();
+        run(&args(&a)).ok(); // its own files now: no --force needed
+        no_staging_left(&dir);
+    }
+}
+
+#[test]
+fn no_job_writes_onto_its_input_even_forced() {
+    let tmp = TempDir::new("outputs-inputs");
+    let d = tmp.path().to_str().unwrap().to_string();
+    let scan = tmp.path().join("cleaned.pcd");
+    let s = scan.to_str().unwrap();
+    run(&args(&["generate-pile", "--points", "30000", "--out", s])).ok();
+    let before = std::fs::read(&scan).unwrap();
+    for force in [false, true] {
+        let mut a = vec!["perceive", "--input", s, "--out", &d];
+        if force {
+            a.push("--force");
+        }
+        let r = run(&args(&a)).fails();
+        assert!(
+            r.error_message().contains("is an input"),
+            "{}",
+            r.error_message()
+        );
+        assert_eq!(
+            std::fs::read(&scan).unwrap(),
+            before,
+            "the scan is untouched"
+        );
+    }
+    // A warm-start pack read from the folder it would be written to.
+    let out = tmp.path().join("dig");
+    let o = out.to_str().unwrap();
+    run(&args(&["plan-dig", "--surface", "convex", "--out", o])).ok();
+    let pack = out.join("pack.csv");
+    let p = pack.to_str().unwrap();
+    let before = std::fs::read(&pack).unwrap();
+    let r = run(&args(&[
+        "plan-dig",
+        "--warm-start",
+        p,
+        "--out",
+        o,
+        "--force",
+    ]))
+    .fails();
+    assert!(
+        r.error_message().contains("is an input"),
+        "{}",
+        r.error_message()
+    );
+    assert_eq!(std::fs::read(&pack).unwrap(), before);
+    no_staging_left(&out);
+    // A scenario file in the output folder under an output's name.
+    std::fs::create_dir_all(tmp.path().join("road")).unwrap();
+    let sc = tmp.write("road/path.csv", builtin_text("straight"));
+    let road = tmp.path().join("road");
+    let r = run(&args(&[
+        "plan-path",
+        "--scenario",
+        sc.to_str().unwrap(),
+        "--out",
+        road.to_str().unwrap(),
+        "--force",
+    ]));
+    // plan-path writes path.csv: the scenario of that name is an input.
+    let r = r.fails();
+    assert!(
+        r.error_message().contains("is an input"),
+        "{}",
+        r.error_message()
+    );
+    assert_eq!(
+        std::fs::read_to_string(&sc).unwrap(),
+        builtin_text("straight")
+    );
+}
+
+#[test]
+fn generate_pile_and_demo_keep_a_users_file() {
+    let tmp = TempDir::new("outputs-files");
+    let f = tmp.write("pile.pcd", "not mine to lose");
+    let r = run(&args(&[
+        "generate-pile",
+        "--points",
+        "1000",
+        "--out",
+        f.to_str().unwrap(),
+    ]))
+    .fails();
+    assert!(
+        r.error_message().contains("--force"),
+        "{}",
+        r.error_message()
+    );
+    assert_eq!(std::fs::read_to_string(&f).unwrap(), "not mine to lose");
+    run(&args(&[
+        "generate-pile",
+        "--points",
+        "1000",
+        "--out",
+        f.to_str().unwrap(),
+        "--force",
+    ]))
+    .ok();
+    assert_ne!(
+        std::fs::read_to_string(&f).unwrap_or_default(),
+        "not mine to lose"
+    );
+    let entries = std::fs::read_dir(tmp.path()).unwrap().count();
+    assert_eq!(entries, 1, "no temporary file left beside the pile");
+    std::fs::remove_file(&f).unwrap();
+    // The demo refuses a user's index.html before doing any work.
+    std::fs::create_dir_all(tmp.path().join("report")).unwrap();
+    let index = tmp.write("report/index.html", "<p>mine</p>");
+    let r = run(&args(&[
+        "demo",
+        "--out",
+        tmp.path().join("report").to_str().unwrap(),
+    ]))
+    .fails();
+    assert!(
+        r.error_message().contains("index.html"),
+        "{}",
+        r.error_message()
+    );
+    assert_eq!(std::fs::read_to_string(&index).unwrap(), "<p>mine</p>");
+    assert_eq!(
+        std::fs::read_dir(tmp.path().join("report"))
+            .unwrap()
+            .count(),
+        1
+    );
+}
