@@ -31,8 +31,10 @@ pub enum SurfaceError {
     /// lowest points to be the floor.
     #[error(
         "no floor: the best plane within {max_tilt_deg:.1} deg of horizontal holds {inliers} of \
-         {candidates} low points (at least {required} needed); raise TiltParams.floor_fraction, \
-         TiltParams.inlier_threshold_m or TiltParams.max_tilt_rad"
+         {candidates} low points (at least {required} needed); if the scan has a floor, raise the \
+         share searched for it (`[level] floor_fraction` in perceive's settings, \
+         TiltParams.floor_fraction in the library), or give roll and pitch \
+         (`[level] mode = \"given\"`)"
     )]
     NoFloor {
         /// Inliers of the best plane found.
@@ -63,7 +65,8 @@ pub enum SurfaceError {
     /// (rope-shovel paper §3.2 asks R² > 0.95).
     #[error(
         "poor surface fit: R² = {r2:.4} <= threshold {threshold} (degree {degree}, {samples} \
-         samples); clean the cloud first or lower/disable FitParams.r2_threshold"
+         samples); clean the cloud first, or lower the threshold (`[fit] r2_threshold` in \
+         perceive's settings, 0 accepts any fit; FitParams.r2_threshold in the library)"
     )]
     PoorFit {
         /// Coefficient of determination on the grid samples.

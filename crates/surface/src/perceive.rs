@@ -61,13 +61,49 @@ pub enum LevelMode {
 }
 
 /// A length scale: a number, or "auto" (from the scan).
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 #[serde(untagged)]
 pub enum ScaleSetting {
     /// A fixed value.
     Factor(f64),
     /// "auto".
     Word(AutoWord),
+}
+
+// By hand, so that a wrong word is named in the user's terms rather than as
+// serde's "untagged enum ScaleSetting".
+impl<'de> Deserialize<'de> for ScaleSetting {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        struct Visitor;
+        impl serde::de::Visitor<'_> for Visitor {
+            type Value = ScaleSetting;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number or \"auto\"")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> std::result::Result<Self::Value, E> {
+                Ok(ScaleSetting::Factor(v))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> std::result::Result<Self::Value, E> {
+                Ok(ScaleSetting::Factor(v as f64))
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> std::result::Result<Self::Value, E> {
+                Ok(ScaleSetting::Factor(v as f64))
+            }
+            fn visit_str<E: serde::de::Error>(
+                self,
+                v: &str,
+            ) -> std::result::Result<Self::Value, E> {
+                if v == "auto" {
+                    Ok(ScaleSetting::Word(AutoWord::Auto))
+                } else {
+                    Err(E::custom(format!(
+                        "\"{v}\" is not a length: expected a number or \"auto\""
+                    )))
+                }
+            }
+        }
+        d.deserialize_any(Visitor)
+    }
 }
 
 /// The word "auto".
@@ -804,6 +840,22 @@ mod tests {
                 "{text:?}: {msg}"
             );
         }
+    }
+
+    #[test]
+    fn a_wrong_word_for_a_length_is_named_in_the_users_terms() {
+        let err = <PerceptionParams as TomlFile>::from_toml("spacing = \"fine\"\n", "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(err.starts_with("p.toml:1:"), "{err}");
+        assert!(err.contains("\"fine\" is not a length"), "{err}");
+        assert!(
+            !err.contains("untagged") && !err.contains("ScaleSetting"),
+            "{err}"
+        );
+        let p: PerceptionParams = TomlFile::from_toml("scale = 2\nspacing = 0.05\n", "p").unwrap();
+        assert_eq!(p.scale, ScaleSetting::Factor(2.0));
+        assert_eq!(p.spacing, ScaleSetting::Factor(0.05));
     }
 
     #[test]
