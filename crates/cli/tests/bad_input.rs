@@ -216,7 +216,7 @@ fn wrong_types_and_missing_fields_name_the_line() {
             "short-array",
             "min_m = [0.0, -8.0]",
             "min_m = [0.0]",
-            "invalid length 1, expected an array of length 2",
+            "[0.0] has 1 coordinate(s); expected 2 (x, y)",
         ),
         (
             "direction",

@@ -569,3 +569,28 @@ fn closed_stdout_does_not_panic() {
         );
     }
 }
+
+/// Issue 11: a vertex with a third coordinate is refused at its line, not
+/// read as (x, y) with the rest dropped.
+#[test]
+fn a_three_coordinate_vertex_is_refused_at_its_line() {
+    let dir = TempDir::new("xyz-vertex");
+    let text = builtin_text("curve");
+    let line = text
+        .lines()
+        .find(|l| l.starts_with("vertices_m"))
+        .expect("a polygon")
+        .to_string();
+    let bad_line = line.replacen("]", ", 7.0]", 1);
+    let bad = replace_once(&text, &line, &bad_line);
+    let file = dir.write("road.toml", &bad);
+    let r = run(&[
+        "plan-path".as_ref(),
+        "--scenario".as_ref(),
+        file.as_os_str(),
+    ])
+    .fails();
+    let msg = r.error_message();
+    let at = format!("road.toml:{}:", line_of(&bad, &bad_line));
+    assert!(msg.contains(&at) && msg.contains("3 coordinate"), "{msg}");
+}

@@ -81,6 +81,36 @@ pub trait TomlFile: serde::de::DeserializeOwned + serde::Serialize {
     }
 }
 
+/// Deserialises an (x, y) point, refusing any other number of coordinates
+/// (`#[serde(deserialize_with = "xy")]`): a third coordinate in a 2-D file
+/// is a mistake to report, not to drop.
+pub fn xy<'de, D: serde::Deserializer<'de>>(d: D) -> Result<[f64; 2], D::Error> {
+    let v: Vec<f64> = serde::Deserialize::deserialize(d)?;
+    to_xy(&v).map_err(serde::de::Error::custom)
+}
+
+/// [`xy`] for a list of points.
+pub fn xy_list<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Vec<[f64; 2]>, D::Error> {
+    let v: Vec<Vec<f64>> = serde::Deserialize::deserialize(d)?;
+    v.iter()
+        .enumerate()
+        .map(|(i, p)| {
+            to_xy(p).map_err(|e| serde::de::Error::custom(format!("point {}: {e}", i + 1)))
+        })
+        .collect()
+}
+
+fn to_xy(v: &[f64]) -> Result<[f64; 2], String> {
+    match v {
+        [x, y] => Ok([*x, *y]),
+        _ => Err(format!(
+            "{:?} has {} coordinate(s); expected 2 (x, y) [m]",
+            v,
+            v.len()
+        )),
+    }
+}
+
 /// The text of a configuration file.
 pub fn read(path: &Path) -> Result<String, ConfigError> {
     std::fs::read_to_string(path).map_err(|source| ConfigError::Io {
@@ -229,5 +259,31 @@ mod tests {
             e.to_string(),
             "f.toml:2: [t] k = 2 is invalid: expected less than 1"
         );
+    }
+}
+
+#[cfg(test)]
+mod xy_tests {
+    #[derive(Debug, serde::Deserialize)]
+    struct T {
+        #[serde(deserialize_with = "super::xy")]
+        at: [f64; 2],
+        #[serde(deserialize_with = "super::xy_list")]
+        ring: Vec<[f64; 2]>,
+    }
+
+    #[test]
+    fn points_need_exactly_two_coordinates() {
+        let t: T = super::parse("at = [1, 2]\nring = [[0, 0], [1, 0.5]]\n", "f").unwrap();
+        assert_eq!((t.at, t.ring), ([1.0, 2.0], vec![[0.0, 0.0], [1.0, 0.5]]));
+        let e =
+            super::parse::<T>("at = [1, 2]\nring = [[0, 0], [1, 2, 3]]\n", "f.toml").unwrap_err();
+        let m = e.to_string();
+        assert!(
+            m.starts_with("f.toml:2:") && m.contains("point 2") && m.contains("3 coordinate"),
+            "{m}"
+        );
+        let e = super::parse::<T>("at = [1]\nring = []\n", "f.toml").unwrap_err();
+        assert!(e.to_string().starts_with("f.toml:1:"), "{e}");
     }
 }

@@ -172,7 +172,9 @@ pub struct ScenarioFile {
 #[derive(Debug, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 struct SiteSpec {
+    #[serde(deserialize_with = "config::xy")]
     min_m: [f64; 2],
+    #[serde(deserialize_with = "config::xy")]
     max_m: [f64; 2],
 }
 
@@ -188,6 +190,7 @@ struct PoseSpec {
 #[serde(deny_unknown_fields)]
 struct CircleSpec {
     name: Option<String>,
+    #[serde(deserialize_with = "config::xy")]
     center_m: [f64; 2],
     radius_m: f64,
 }
@@ -196,6 +199,7 @@ struct CircleSpec {
 #[serde(deny_unknown_fields)]
 struct PolygonSpec {
     name: Option<String>,
+    #[serde(deserialize_with = "config::xy_list")]
     vertices_m: Vec<[f64; 2]>,
 }
 
@@ -203,6 +207,7 @@ struct PolygonSpec {
 #[serde(deny_unknown_fields)]
 struct BoundarySpec {
     name: Option<String>,
+    #[serde(deserialize_with = "config::xy_list")]
     points_m: Vec<[f64; 2]>,
 }
 

@@ -259,6 +259,7 @@ pub struct LegSpec {
     /// Forward or reverse.
     pub direction: Direction,
     /// Path points [m].
+    #[serde(deserialize_with = "config::xy_list")]
     pub points_m: Vec<[f64; 2]>,
     /// Required heading at the end [deg] (default: along the last segment).
     #[serde(default, skip_serializing_if = "Option::is_none")]
