@@ -167,11 +167,30 @@ pub fn check_each(
 ) -> Result<(), ConfigError> {
     for &(table, key, v) in values {
         if !ok(v) {
-            return Err(invalid(text, file, (table, 0), key, v, expected));
+            return Err(invalid(text, file, (table, 0), key, short(v), expected));
         }
     }
     Ok(())
 }
+
+/// A number as a person writes it: plain for ordinary magnitudes, with an
+/// exponent for very large or small ones (`1e308`, not 309 digits).
+pub fn short(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&a) {
+        format!("{v}")
+    } else {
+        format!("{v:e}")
+    }
+}
+
+/// A finite length in (0, 1 km] [m], for [`check_each`]: no machine or
+/// site part is longer, and geometry beyond it overflows the f32 clouds
+/// and the planners' grids.
+pub const LENGTH: (fn(f64) -> bool, &str) = (
+    |v| v.is_finite() && v > 0.0 && v <= 1e3,
+    "a length in (0, 1000] m",
+);
 
 /// A finite value > 0, for [`check_each`].
 pub const POSITIVE: (fn(f64) -> bool, &str) = (|v| v.is_finite() && v > 0.0, "a finite value > 0");

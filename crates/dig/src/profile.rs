@@ -262,6 +262,8 @@ impl MachineProfile {
             ("limits", "time_min_s", self.limits.time_min_s),
         ];
         config::check_each(text, file, &positive, config::POSITIVE)?;
+        // The first ten are the machine's lengths [m].
+        config::check_each(text, file, &positive[..10], config::LENGTH)?;
         let non_negative = [
             (
                 "material",
@@ -560,6 +562,18 @@ pub(crate) mod tests {
             .unwrap_err()
             .to_string();
         assert!(err.contains("td_s") && err.contains("dig-time"), "{err}");
+
+        // Issue 11: a length no machine has is refused, printed short.
+        let text = with("boom_length_m = 0.450", "boom_length_m = 1e308");
+        let err = MachineProfile::from_toml(&text, "p.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            err.contains(
+                "p.toml:10: [geometry] boom_length_m = 1e308 is invalid: expected a length"
+            ),
+            "{err}"
+        );
 
         let text = with("[numerics]", "[numerics]\nbogus = 1");
         let err = MachineProfile::from_toml(&text, "p.toml")
