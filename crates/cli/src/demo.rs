@@ -21,7 +21,9 @@ use crate::output::{print_json, OutDir};
 /// as its own; without `force` a user's file of those names is refused
 /// before any work.
 pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
-    let top = crate::output::out_dir(Some(out), &[], force)?.expect("a folder");
+    if out.exists() && !out.is_dir() {
+        anyhow::bail!("--out {}: exists and is not a directory", out.display());
+    }
     let ours = autoshovel_report::files_written_before(out);
     for name in [
         autoshovel_report::INDEX_FILE,
@@ -33,7 +35,7 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
         }
     }
     std::fs::create_dir_all(out)?;
-    let out = top.dir.clone();
+    let out = out.to_path_buf();
     let sub_out = |sub: &str| OutDir {
         dir: out.join(sub),
         inputs: Vec::new(),

@@ -53,9 +53,7 @@ pub use crate::json::{write_summary, SUMMARY_FILE};
 pub use crate::layout::{
     data_ranges, plot_area_px, AxisRange, MAX_AREA_PX, MAX_SIDE_PX, MIN_HEIGHT_PX, MIN_WIDTH_PX,
 };
-pub use crate::panels::{
-    finite_range, instant_marks, markdown_table, rating_line, time_panel, Line,
-};
+pub use crate::panels::{finite_range, markdown_table, rating_line, time_panel, Line};
 pub use crate::render::{write_figure, write_panels, MAX_MARKER_PX, MAX_STROKE_PX};
 pub use crate::staging::{files_written_before, refusal, write_file_atomically, OutDir, Staging};
 pub use crate::style::{viridis, Rgb, Stroke};

@@ -60,27 +60,6 @@ pub fn rating_line(
     Layer::line([(t0, value), (t1, value)], Stroke::dashed(color, 1)).with_label(label)
 }
 
-/// Vertical dashed lines at the instants `ts`, from `lo` to `hi`; the first
-/// labelled `label`.
-pub fn instant_marks(
-    ts: impl IntoIterator<Item = f64>,
-    (lo, hi): (f64, f64),
-    color: Rgb,
-    label: &str,
-) -> Vec<Layer> {
-    ts.into_iter()
-        .enumerate()
-        .map(|(i, t)| {
-            let l = Layer::line([(t, lo), (t, hi)], Stroke::dashed(color, 1));
-            if i == 0 {
-                l.with_label(label)
-            } else {
-                l
-            }
-        })
-        .collect()
-}
-
 /// A markdown table (GitHub style) of `header` and `rows`.
 pub fn markdown_table(header: &[&str], rows: impl IntoIterator<Item = Vec<String>>) -> String {
     let mut s = format!(

@@ -6,7 +6,7 @@
 #[non_exhaustive]
 pub enum SurfaceError {
     /// A parameter out of its valid range.
-    #[error("{name} = {}: expected {expected}", short(*value))]
+    #[error("{name} = {}: expected {expected}", autoshovel_core::config::short(*value))]
     BadParameter {
         /// The parameter, as `Struct.field`.
         name: &'static str,
@@ -111,17 +111,6 @@ pub enum SurfaceError {
     /// The scan's points span no area in x and y, so the point spacing is unknown.
     #[error("the scan has no horizontal extent; give spacing in the settings")]
     NoHorizontalExtent,
-}
-
-/// A number as a person writes it: plain for ordinary magnitudes, with an
-/// exponent for very large or small ones (1e308, not 309 digits).
-fn short(v: f64) -> String {
-    let a = v.abs();
-    if v == 0.0 || !v.is_finite() || (1e-4..1e9).contains(&a) {
-        format!("{v}")
-    } else {
-        format!("{v:e}")
-    }
 }
 
 /// Result alias of this crate.
