@@ -208,6 +208,21 @@ fn las_lies() {
     let mut b = las_bytes(false, LasVersion::V1_2, 10);
     put_u32(&mut b, 96, 1 << 30);
     refuses("offset", Format::Las, &b, "past the end");
+    // A header_size smaller than the version's header (0, and 1.4's 256).
+    for (version, size) in [
+        (LasVersion::V1_2, 0u16),
+        (LasVersion::V1_4, 0),
+        (LasVersion::V1_4, 256),
+    ] {
+        let mut b = las_bytes(false, version, 10);
+        b[94..96].copy_from_slice(&size.to_le_bytes());
+        refuses(
+            "header size",
+            Format::Las,
+            &b,
+            &format!("says it is {size} bytes long"),
+        );
+    }
     // Not LAS at all.
     refuses("signature", Format::Las, b"LASX and more", "LASF");
 }

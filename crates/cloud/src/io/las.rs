@@ -62,6 +62,8 @@ const PROGRESS_POINTS: u64 = 1 << 16;
 
 /// What the public header says, after checking.
 struct Checked {
+    /// Bytes to show `las` in place of the file's (see [`Patched`]).
+    patch: Option<(u64, [u8; 4])>,
     compressed: bool,
     count: u64,
     minor: u8,
@@ -150,6 +152,13 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
         (1, 0..=2) => (227, 227),
         _ => (227, 375),
     };
+    // As LAStools does: a header smaller than its version's fields is not a
+    // LAS header (`las` would read the fields anyway, from wherever).
+    if header_size < fields {
+        return Err(format!(
+            "the header says it is {header_size} bytes long (byte 94); a LAS {major}.{minor} header takes at least {fields}"
+        ));
+    }
     let vlr_start = fields + header_size.saturating_sub(nominal);
     if n_vlrs.saturating_mul(VLR_HEADER) > offset.saturating_sub(vlr_start) {
         return Err(format!(
@@ -187,7 +196,8 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
             }
         }
     }
-    let c = Checked {
+    let mut c = Checked {
+        patch: None,
         compressed,
         count,
         minor,
@@ -196,14 +206,15 @@ fn check<R: Read + Seek>(src: &mut R, total: u64) -> Result<Checked, String> {
         record_len,
     };
     if compressed {
-        check_laz(src, total, vlr_start, n_vlrs, &c)?;
+        c.patch = check_laz(src, total, vlr_start, n_vlrs, &c)?;
     }
     Ok(c)
 }
 
 /// The LASzip checks: items, chunk table, layer sizes. They follow what
 /// `las` and `laz` do step by step: where the VLRs start, which VLR is the
-/// LASzip one, where decoding starts.
+/// LASzip one, where decoding starts. Returns the patch a point-wise file
+/// needs (see [`Patched`]).
 #[cfg(feature = "laz")]
 fn check_laz<R: Read + Seek>(
     src: &mut R,
@@ -211,14 +222,14 @@ fn check_laz<R: Read + Seek>(
     vlr_start: u64,
     n_vlrs: u64,
     c: &Checked,
-) -> Result<(), String> {
+) -> Result<Option<(u64, [u8; 4])>, String> {
     let io = |e: std::io::Error| format!("reading the LASzip records: {e}");
     let mut pos = vlr_start;
     let mut found = None;
     for _ in 0..n_vlrs {
         let mut v = [0u8; VLR_HEADER as usize];
         if !read_at(src, pos, &mut v).map_err(io)? {
-            return Ok(()); // `las` reports the truncation
+            return Ok(None); // `las` reports the truncation
         }
         let len = le16(&v, 20);
         // The user id up to its first NUL, as `las` compares it.
@@ -230,14 +241,14 @@ fn check_laz<R: Read + Seek>(
         pos += VLR_HEADER + len;
     }
     let Some((at, len)) = found else {
-        return Ok(());
+        return Ok(None);
     };
     let mut d = vec![0u8; len as usize];
     if !read_at(src, at, &mut d).map_err(io)? {
-        return Ok(());
+        return Ok(None);
     }
     let Ok(vlr) = laz::LazVlr::from_buffer(&d) else {
-        return Ok(()); // `las` refuses it the same way
+        return Ok(None); // `las` refuses it the same way
     };
     if vlr.items().is_empty() {
         return Err("the LASzip record lists no items".into());
@@ -245,12 +256,23 @@ fn check_laz<R: Read + Seek>(
     let compressor = le16(&d, 0);
     let layered = matches!(vlr.items()[0].version(), 3 | 4);
     let data_start = c.offset;
-    if compressor != 1 {
+    // Point-wise LASzip (compressor 1: one stream, no chunks, no table), as
+    // LASzip 1.2 wrote it, has 0 in the chunk-size field. `laz` 0.12 reads 0
+    // as "variable-size chunks" (LAStools' newer convention) and then panics
+    // for want of a chunk table on the first point. Point-wise decoding
+    // never uses the chunk size, so `las` is shown a fixed size there.
+    let patch = (compressor == 1 && d.len() >= 16 && le32(&d, 12) == 0)
+        .then(|| (at + 12, u32::MAX.wrapping_sub(1).to_le_bytes()));
+    // How many chunks `laz` decodes for the header's count.
+    let mut chunks_decoded = c.count.div_ceil(u64::from(vlr.chunk_size()).max(1));
+    if compressor == 1 {
+        chunks_decoded = c.count.min(1);
+    } else {
         // Chunk table: its offset is the first 8 bytes of the point data,
         // or the last 8 bytes of the file when the writer could not seek.
         let mut b8 = [0u8; 8];
         if !read_at(src, data_start, &mut b8).map_err(io)? {
-            return Ok(());
+            return Ok(patch);
         }
         let mut table = i64::from_le_bytes(b8);
         if table <= data_start as i64 && total >= 8 {
@@ -292,12 +314,17 @@ fn check_laz<R: Read + Seek>(
                     )
                 }
                 Err(_) => {}
-                // With variable-size chunks `laz` indexes the table by chunk
-                // number and panics past its end: the chunks must hold the
-                // header's point count.
+                // With variable-size chunks (COPC) `laz` indexes the table
+                // by chunk number and panics past its end: the chunks must
+                // hold the header's point count.
                 Ok(table) if variable => {
                     let mut left = c.count;
+                    chunks_decoded = 0;
                     for entry in table.as_ref() {
+                        if left == 0 {
+                            break;
+                        }
+                        chunks_decoded += 1;
                         if entry.point_count == 0 || left <= entry.point_count {
                             left = 0;
                             break;
@@ -317,7 +344,7 @@ fn check_laz<R: Read + Seek>(
         }
     }
     if !layered {
-        return Ok(());
+        return Ok(patch);
     }
     // Layered chunks: [first point, raw][u32 count][u32 size per layer]
     // [layers]; `laz` zero-fills a buffer of each size before reading it.
@@ -330,7 +357,7 @@ fn check_laz<R: Read + Seek>(
             laz::LazItemType::RGBNIR14 => (8, 2),
             laz::LazItemType::WavePacket14 => (29, 1),
             laz::LazItemType::Byte14(n) => (u64::from(n), u64::from(n)),
-            _ => return Ok(()), // `laz` refuses it
+            _ => return Ok(patch), // `laz` refuses it
         };
         first_point += bytes;
         layers += l;
@@ -341,13 +368,16 @@ fn check_laz<R: Read + Seek>(
         data_start + 8
     };
     let mut sizes = vec![0u8; 4 + 4 * layers as usize];
-    // Until the file ends: a header count larger than the chunks hold makes
-    // `laz` read "chunks" out of whatever follows.
-    loop {
+    // The chunks `laz` will decode, one after another (it reads the stream
+    // in order). Only those: COPC puts the chunk table and its hierarchy
+    // records right after the last chunk, and they are not chunks. A count
+    // larger than the chunks hold makes `laz` read "chunks" out of whatever
+    // follows, so that is walked too, up to the end of the file.
+    for _ in 0..chunks_decoded {
         let chunk = pos;
         pos += first_point;
         if pos + sizes.len() as u64 > total || !read_at(src, pos, &mut sizes).map_err(io)? {
-            return Ok(()); // `laz` stops with an end-of-file error here
+            return Ok(patch); // `laz` stops with an end-of-file error here
         }
         pos += sizes.len() as u64;
         let sum: u64 = (0..layers as usize).map(|k| le32(&sizes, 4 + 4 * k)).sum();
@@ -359,11 +389,50 @@ fn check_laz<R: Read + Seek>(
         }
         pos += sum;
     }
+    Ok(patch)
 }
 
 #[cfg(not(feature = "laz"))]
-fn check_laz<R: Read + Seek>(_: &mut R, _: u64, _: u64, _: u64, _: &Checked) -> Result<(), String> {
-    Ok(()) // `las` refuses compressed data without the feature
+fn check_laz<R: Read + Seek>(
+    _: &mut R,
+    _: u64,
+    _: u64,
+    _: u64,
+    _: &Checked,
+) -> Result<Option<(u64, [u8; 4])>, String> {
+    Ok(None) // `las` refuses compressed data without the feature
+}
+
+/// A source that shows `patch.1` at byte `patch.0` in place of the file's
+/// four bytes: how a point-wise LASzip record's chunk size reaches `laz`
+/// (see `check_laz`) without copying the file. Written by hand: a four-byte
+/// overlay on `Read + Seek` is smaller than any crate for it.
+struct Patched<R> {
+    inner: R,
+    pos: u64,
+    patch: Option<(u64, [u8; 4])>,
+}
+
+impl<R: Read> Read for Patched<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        let n = self.inner.read(buf)?;
+        if let Some((at, bytes)) = self.patch {
+            let lo = self.pos.max(at);
+            let hi = (self.pos + n as u64).min(at + 4);
+            for p in lo..hi {
+                buf[(p - self.pos) as usize] = bytes[(p - at) as usize];
+            }
+        }
+        self.pos += n as u64;
+        Ok(n)
+    }
+}
+
+impl<R: Seek> Seek for Patched<R> {
+    fn seek(&mut self, to: SeekFrom) -> std::io::Result<u64> {
+        self.pos = self.inner.seek(to)?;
+        Ok(self.pos)
+    }
 }
 
 /// Runs `f`, turning a panic (in `las` or `laz`) into a format error.
@@ -383,18 +452,46 @@ fn without_panics<T>(path: &Path, f: impl FnOnce() -> crate::Result<T>) -> crate
     })
 }
 
-fn las_err(path: &Path, e: las::Error) -> CloudError {
-    match e {
-        las::Error::Io(source) if source.kind() != std::io::ErrorKind::UnexpectedEof => {
-            CloudError::Io {
+/// Turns an error of `las` into ours. `at` is the index of the point being
+/// read (None while `las` reads the header and records); an early end of
+/// the data is reported as a truncation, with where it happened.
+fn las_err(path: &Path, e: las::Error, at: Option<u64>, c: &Checked, total: u64) -> CloudError {
+    let eof = match &e {
+        las::Error::Io(source) => source.kind() == std::io::ErrorKind::UnexpectedEof,
+        #[cfg(feature = "laz")]
+        las::Error::LasZipError(laz::LasZipError::IoError(source)) => {
+            source.kind() == std::io::ErrorKind::UnexpectedEof
+        }
+        _ => false,
+    };
+    let what = match e {
+        las::Error::Io(source) if !eof => {
+            return CloudError::Io {
                 path: path.to_path_buf(),
                 source,
             }
         }
-        e => CloudError::Format {
-            path: path.to_path_buf(),
-            what: format!("LAS: {e}"),
+        _ if eof => match at {
+            None => format!(
+                "truncated: the file ({total} bytes) ends inside its header or variable-length records"
+            ),
+            Some(i) if !c.compressed => format!(
+                "truncated: point {} of {} starts at byte {} and runs past the end of the file ({total} bytes)",
+                i + 1,
+                c.count,
+                c.offset + i * c.record_len
+            ),
+            Some(i) => format!(
+                "truncated or damaged compressed data: decoding stopped at point {} of the {} the header claims (the file has {total} bytes)",
+                i + 1,
+                c.count
+            ),
         },
+        e => format!("LAS: {e}"),
+    };
+    CloudError::Format {
+        path: path.to_path_buf(),
+        what,
     }
 }
 
@@ -419,13 +516,21 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
     // `laz` 0.12 panics on some malformed streams (an index out of bounds
     // in its arithmetic decoder, found by fuzzing): decoding runs under
     // catch_unwind so that such a file is a format error, not a crash.
+    let src = Patched {
+        inner: src,
+        pos: 0,
+        patch: c.patch,
+    };
     without_panics(path, || {
-        let mut reader = las::Reader::new(src).map_err(|e| las_err(path, e))?;
+        let mut reader = las::Reader::new(src).map_err(|e| las_err(path, e, None, &c, total))?;
         if !c.compressed {
             out.reserve_bounded(c.count, total - c.offset, c.record_len.max(1));
         }
         let mut i = 0u64;
-        while let Some(p) = reader.read_point().map_err(|e| las_err(path, e))? {
+        while let Some(p) = reader
+            .read_point()
+            .map_err(|e| las_err(path, e, Some(i), &c, total))?
+        {
             out.push([p.x as f32, p.y as f32, p.z as f32]);
             i += 1;
             if i.is_multiple_of(PROGRESS_POINTS) {
