@@ -184,6 +184,43 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// `v` to three significant figures, for estimates in messages:
+/// `7.01e9`, `729`, `0.0123`, `7.01e-6`.
+pub fn approx(v: f64) -> String {
+    let a = v.abs();
+    if v == 0.0 || !v.is_finite() {
+        format!("{v}")
+    } else if (0.01..1e5).contains(&a) {
+        let decimals = (2 - a.log10().floor() as i32).max(0) as usize;
+        format!("{v:.decimals$}")
+    } else {
+        format!("{v:.2e}")
+    }
+}
+
+/// `bytes` in B, kB, MB, GB, TB or PB (decimal, three significant
+/// figures), for work estimates in messages.
+pub fn bytes(bytes: f64) -> String {
+    let units = ["B", "kB", "MB", "GB", "TB", "PB"];
+    let mut v = bytes;
+    let mut u = 0;
+    while v >= 1000.0 && u + 1 < units.len() {
+        v /= 1000.0;
+        u += 1;
+    }
+    if v >= 1000.0 {
+        return format!("{v:.1e} PB");
+    }
+    let digits = if v >= 100.0 || u == 0 {
+        0
+    } else if v >= 10.0 {
+        1
+    } else {
+        2
+    };
+    format!("{v:.digits$} {}", units[u])
+}
+
 /// A finite length in (0, 1 km] [m], for [`check_each`]: no machine or
 /// site part is longer, and geometry beyond it overflows the f32 clouds
 /// and the planners' grids.
@@ -304,5 +341,23 @@ mod xy_tests {
         );
         let e = super::parse::<T>("at = [1]\nring = []\n", "f.toml").unwrap_err();
         assert!(e.to_string().starts_with("f.toml:1:"), "{e}");
+    }
+}
+
+#[cfg(test)]
+mod bytes_tests {
+    #[test]
+    fn sizes_read_in_decimal_units() {
+        assert_eq!(super::bytes(512.0), "512 B");
+        assert_eq!(super::bytes(1500.0), "1.50 kB");
+        assert_eq!(super::bytes(63e9), "63.0 GB");
+        assert_eq!(super::bytes(180e6), "180 MB");
+        assert_eq!(super::bytes(2.9e16), "29.0 PB");
+        assert_eq!(super::bytes(2.9e21), "2.9e6 PB");
+        assert_eq!(super::approx(7.013481971e9), "7.01e9");
+        assert_eq!(super::approx(729.27), "729");
+        assert_eq!(super::approx(0.012345), "0.0123");
+        assert_eq!(super::approx(7.0134819714e-6), "7.01e-6");
+        assert_eq!(super::approx(1e7), "1.00e7");
     }
 }

@@ -125,6 +125,19 @@ pub enum ExcavateError {
         /// The cap.
         max: usize,
     },
+    /// A setting sizes more work than the stated ceiling (found once the
+    /// work is known, before it is done).
+    #[error("{key} = {value} asks too much: {estimate}; the ceiling is {ceiling}")]
+    TooMuchWork {
+        /// The setting, as written in the scenario (`[planner] dt_s`).
+        key: &'static str,
+        /// Its value.
+        value: String,
+        /// The work it implies.
+        estimate: String,
+        /// The ceiling, and the value that would meet it.
+        ceiling: String,
+    },
 }
 
 /// Shorthand for results of this crate.

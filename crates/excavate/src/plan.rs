@@ -24,7 +24,7 @@
 use std::collections::VecDeque;
 use std::time::Instant;
 
-use autoshovel_core::Vec2;
+use autoshovel_core::{config, Vec2};
 use serde::Serialize;
 
 use crate::dynamics::Dynamics;
@@ -35,7 +35,7 @@ use crate::level1::{plan_level1, EndLevel, Level1Plan, StepFound, StepSearch};
 use crate::obstacle::Envelope;
 use crate::preimage::{decide, gamma_rad, AvoidSide};
 use crate::profile::MachineProfile;
-use crate::scenario::Scenario;
+use crate::scenario::{Scenario, MAX_SIM_STEPS, SIM_STEP_BYTES};
 use crate::search::{forward_search, SearchParams, SearchPath};
 use crate::segment::{Motion, MotionState, Segment, SegmentKind};
 use crate::simulate::{Contact, SoilSim};
@@ -424,8 +424,10 @@ impl<'a> Run<'a> {
         }
         let req = self.sc.level1_request();
         let plan = plan_level1(&self.step_search(&[]), &req)?;
-        let level1 = self.level1_report(&plan);
         let mut pending: VecDeque<PlannedSegment> = plan_segments(&plan);
+        let planned_s = pending.iter().map(|ps| ps.segment.duration_s()).sum();
+        self.check_steps(planned_s, "the level-1 plan")?;
+        let level1 = self.level1_report(&plan);
 
         // The first sample, at rest at the start.
         let first = plan.first.segment.state(&self.machine, 0.0);
@@ -446,6 +448,11 @@ impl<'a> Run<'a> {
                 bucket_width_m: self.width_m,
                 max_force_n: self.max_force_n,
             };
+            let after = self.contacts.len();
+            self.check_steps(
+                self.t_s + seg.duration_s(),
+                &format!("the dig after {after} contact(s)"),
+            )?;
             let run = sim.advance(seg, sc.planner.dt_s, &self.known);
             let t0 = self.t_s;
             let n = run.states.len();
@@ -715,6 +722,30 @@ impl<'a> Run<'a> {
             kind,
             contact,
         });
+    }
+
+    /// Refuses a dig of `duration_s` that would take more than
+    /// [`MAX_SIM_STEPS`] simulator steps, before taking them.
+    fn check_steps(&self, duration_s: f64, what: &str) -> Result<()> {
+        let dt = self.sc.planner.dt_s;
+        let steps = duration_s / dt;
+        if steps <= MAX_SIM_STEPS {
+            return Ok(());
+        }
+        Err(ExcavateError::TooMuchWork {
+            key: "[planner] dt_s",
+            value: config::short(dt),
+            estimate: format!(
+                "{what} takes {duration_s:.1} s, about {} simulator steps ({})",
+                config::approx(steps),
+                config::bytes(steps * SIM_STEP_BYTES)
+            ),
+            ceiling: format!(
+                "{} steps (here dt_s ≥ {} s)",
+                config::approx(MAX_SIM_STEPS),
+                config::approx(duration_s / MAX_SIM_STEPS)
+            ),
+        })
     }
 
     fn level1_report(&self, plan: &Level1Plan) -> Level1Report {

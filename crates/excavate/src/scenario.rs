@@ -70,6 +70,24 @@ pub const BUILTINS: [(&str, &str); 3] = [
     ),
 ];
 
+/// Most points of a forward-search grid. Each holds about
+/// [`GRID_POINT_BYTES`] of search state, so 10⁷ is about 180 MB; the
+/// built-ins use about 3 000.
+pub const MAX_GRID_POINTS: f64 = 1e7;
+/// Bytes of search state per forward-search grid point (class, cost,
+/// parent, closed flag).
+pub const GRID_POINT_BYTES: f64 = 18.0;
+/// Most volume strips one level-1 step search may evaluate (the steps
+/// from the start to the slew axis times the trapezoids per candidate);
+/// 10⁸ takes seconds. The built-ins use about 14 000.
+pub const MAX_STEP_SEARCH_STRIPS: f64 = 1e8;
+/// Most simulator steps in one dig. Each keeps about [`SIM_STEP_BYTES`]
+/// (the sample, the state, the tip), so 10⁶ is about 300 MB; the
+/// built-ins take about 2 000.
+pub const MAX_SIM_STEPS: f64 = 1e6;
+/// Bytes kept per simulator step.
+pub const SIM_STEP_BYTES: f64 = 300.0;
+
 /// The dig the operator asks for.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -346,6 +364,94 @@ impl Scenario {
                     "a finite radius > 0",
                 ));
             }
+        }
+        self.check_work(text, file)
+    }
+
+    /// Points of the forward-search grid round the largest boulder at
+    /// `step_m` reaching `window_m` beyond its inflated envelope (0 with no
+    /// boulders): the square `forward_search` allocates.
+    fn grid_points_at(&self, step_m: f64, window_m: f64) -> f64 {
+        let largest = self
+            .obstacles
+            .iter()
+            .map(|o| o.radius_m)
+            .fold(0.0, f64::max);
+        if self.obstacles.is_empty() {
+            return 0.0;
+        }
+        let side = 2.0 * (largest + self.planner.clearance_m + window_m) / step_m + 5.0;
+        side * side
+    }
+
+    /// Volume strips one level-1 step search may evaluate.
+    fn strips_at(&self, step_m: f64, trapezoids: f64) -> f64 {
+        (self.dig.start_x_m / step_m).ceil() * trapezoids
+    }
+
+    /// The work the settings imply, against the ceilings
+    /// ([`MAX_GRID_POINTS`], [`MAX_STEP_SEARCH_STRIPS`]); the simulator's
+    /// steps need the planned duration and are checked by the planner.
+    /// A refusal names the setting that breaks the ceiling (the one whose
+    /// built-in value would meet it) with the estimate.
+    fn check_work(&self, text: &str, file: &str) -> Result<()> {
+        // The built-ins' values, to tell which setting is at fault.
+        const STEP_M: f64 = 0.05;
+        const WINDOW_M: f64 = 1.0;
+        const TRAPEZOIDS: f64 = 100.0;
+        let (d, p) = (&self.dig, &self.planner);
+        let grid = self.grid_points_at(d.step_m, p.search_window_m);
+        if grid > MAX_GRID_POINTS {
+            let (table, key, value) = if self.grid_points_at(d.step_m, WINDOW_M) <= MAX_GRID_POINTS
+            {
+                ("planner", "search_window_m", p.search_window_m)
+            } else {
+                ("dig", "step_m", d.step_m)
+            };
+            return Err(config::invalid(
+                text,
+                file,
+                (table, 0),
+                key,
+                config::short(value),
+                format!(
+                    "at most {} forward-search grid points; with step_m = {} m and search_window_m = {} m the grid round the largest boulder would have about {} ({})",
+                    config::approx(MAX_GRID_POINTS),
+                    config::short(d.step_m),
+                    config::short(p.search_window_m),
+                    config::approx(grid),
+                    config::bytes(grid * GRID_POINT_BYTES)
+                ),
+            )
+            .into());
+        }
+        let strips = self.strips_at(d.step_m, p.trapezoids as f64);
+        if strips > MAX_STEP_SEARCH_STRIPS {
+            let (table, key, value) =
+                if self.strips_at(STEP_M, p.trapezoids as f64) <= MAX_STEP_SEARCH_STRIPS {
+                    ("dig", "step_m", d.step_m)
+                } else if self.strips_at(d.step_m, TRAPEZOIDS) <= MAX_STEP_SEARCH_STRIPS {
+                    ("planner", "trapezoids", p.trapezoids as f64)
+                } else {
+                    ("dig", "start_x_m", d.start_x_m)
+                };
+            return Err(config::invalid(
+                text,
+                file,
+                (table, 0),
+                key,
+                config::short(value),
+                format!(
+                    "at most {} volume strips per step search; {} steps of {} m from x = {} m, {} trapezoids each, are about {}",
+                    config::approx(MAX_STEP_SEARCH_STRIPS),
+                    config::approx((d.start_x_m / d.step_m).ceil()),
+                    config::short(d.step_m),
+                    config::short(d.start_x_m),
+                    p.trapezoids,
+                    config::approx(strips)
+                ),
+            )
+            .into());
         }
         Ok(())
     }

@@ -156,3 +156,90 @@ fn unknown_names_missing_files_and_bad_files_are_named() {
         "{e}"
     );
 }
+
+/// The built-in paper-over scenario with `key = value` set in its TOML.
+fn edited(key: &str, value: &str) -> Result<Scenario, ExcavateError> {
+    let text = Scenario::builtin_toml("paper-over").unwrap();
+    let mut found = false;
+    let edited: String = text
+        .lines()
+        .map(|l| {
+            if l.starts_with(&format!("{key} =")) {
+                found = true;
+                format!("{key} = {value}\n")
+            } else {
+                format!("{l}\n")
+            }
+        })
+        .collect();
+    assert!(found, "{key} is in the built-in");
+    Scenario::from_toml(&edited, "edited.toml")
+}
+
+/// Settings that size work beyond the ceilings are refused before the
+/// work, at the line of the setting at fault, with the estimate; the
+/// estimates are the closed forms of the grid and the step search.
+#[test]
+fn settings_that_size_too_much_work_are_refused_with_the_estimate() {
+    use autoshovel_excavate::scenario::{MAX_GRID_POINTS, MAX_STEP_SEARCH_STRIPS};
+    let line = |key: &str| {
+        let text = Scenario::builtin_toml("paper-over").unwrap();
+        1 + text
+            .lines()
+            .position(|l| l.starts_with(&format!("{key} =")))
+            .unwrap()
+    };
+    // Grid round the 0.25 m boulder with 0.1 m clearance: side
+    // 2·(0.35 + window)/step + 5 points.
+    for (key, value, side) in [
+        ("search_window_m", "1e6", 2.0 * (0.35 + 1e6) / 0.05 + 5.0),
+        ("step_m", "1e-4", 2.0 * (0.35 + 1.0) / 1e-4 + 5.0),
+    ] {
+        let msg = edited(key, value).unwrap_err().to_string();
+        assert!(side * side > MAX_GRID_POINTS);
+        let expect = autoshovel_core::config::approx(side * side);
+        assert!(
+            msg.starts_with(&format!("edited.toml:{}:", line(key)))
+                && msg.contains(key)
+                && msg.contains("grid points")
+                && msg.contains(&expect),
+            "{msg} (expected about {expect})"
+        );
+    }
+    // The step search: 7 m / step × trapezoids strips; without boulders
+    // the grid does not apply and the step search is what breaks.
+    let mut s = Scenario::paper_over();
+    s.obstacles.clear();
+    let text = toml::to_string(&s)
+        .unwrap()
+        .replace("step_m = 0.05", "step_m = 1e-6");
+    let msg = Scenario::from_toml(&text, "s.toml")
+        .unwrap_err()
+        .to_string();
+    assert!(7e6 * 100.0 > MAX_STEP_SEARCH_STRIPS);
+    assert!(
+        msg.contains("[dig] step_m") && msg.contains("7.00e8") && msg.contains("volume strips"),
+        "{msg}"
+    );
+    // Simulator steps: refused once the level-1 plan's duration is known,
+    // before any step is taken.
+    let s = edited("dt_s", "1e-9").unwrap();
+    let e = plan(&s);
+    assert!(
+        matches!(
+            e,
+            ExcavateError::TooMuchWork {
+                key: "[planner] dt_s",
+                ..
+            }
+        ),
+        "{e:?}"
+    );
+    let msg = e.to_string();
+    assert!(
+        msg.contains("the level-1 plan takes")
+            && msg.contains("simulator steps")
+            && msg.contains("TB"),
+        "{msg}"
+    );
+}
