@@ -13,7 +13,9 @@ use autoshovel_excavate::{ExcavateSummary, Setup};
 use autoshovel_figures as figures;
 use autoshovel_propel::study::{run_map, summarize, MapRow, StudyParams, StudySummary};
 use autoshovel_propel::{FieldKind, PlanOutcome, PlanPathSummary, Scenario};
-use autoshovel_surface::perceive::{perceive_file, PerceiveSummary, Perceived, PerceptionParams};
+use autoshovel_surface::perceive::{
+    perceive_file_with, PerceiveSummary, Perceived, PerceptionParams,
+};
 use autoshovel_track::scenario::TrackScenario;
 use autoshovel_track::{ControllerKind, TrackSummary};
 use indicatif::ParallelProgressIterator;
@@ -91,11 +93,31 @@ pub fn read_and_perceive(
     progress: bool,
 ) -> Result<Perceived> {
     let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
-    let got = perceive_file(input, params, &mut |done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    });
+    let spinner = progress_bar(progress, "{spinner} {msg} ({elapsed})");
+    let got = perceive_file_with(
+        input,
+        params,
+        &mut |done, total| {
+            bar.set_length(total);
+            bar.set_position(done);
+        },
+        &mut |stage| {
+            bar.finish_and_clear();
+            spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+            spinner.set_message(match stage {
+                "level" => "levelling",
+                "ground" => "removing the floor",
+                "radius" => "radius outlier removal",
+                "statistical" => "statistical outlier removal",
+                "voxel" => "voxel grid",
+                "smooth" => "bilateral smoothing",
+                "fit" => "fitting the surface",
+                other => other,
+            });
+        },
+    );
     bar.finish_and_clear();
+    spinner.finish_and_clear();
     got.with_context(|| input.display().to_string())
 }
 

@@ -93,6 +93,13 @@ impl From<PlannerArg> for autoshovel_propel::FieldKind {
 
 fn main() -> ExitCode {
     let cli = Cli::parse();
+    // Ctrl-C stops any job at once; what it had staged in the output folder
+    // goes with it, so nothing half-written is left there.
+    let _ = ctrlc::set_handler(|| {
+        autoshovel_report::remove_unfinished();
+        eprintln!("interrupted: nothing more was written");
+        std::process::exit(130);
+    });
     let result = match cli.command {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),

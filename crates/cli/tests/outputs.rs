@@ -193,3 +193,38 @@ fn generate_pile_and_demo_keep_a_users_file() {
         1
     );
 }
+
+/// Ctrl-C stops a job with exit code 130 and leaves no staging folder or
+/// temporary file in the output folder (the demo runs many jobs; the
+/// interrupt lands in one of them).
+#[test]
+fn an_interrupted_job_leaves_nothing_half_written() {
+    let tmp = TempDir::new("outputs-interrupt");
+    let out = tmp.path().join("demo");
+    let mut child = std::process::Command::new(bin())
+        .args(["demo", "--out"])
+        .arg(&out)
+        .stdout(std::process::Stdio::null())
+        .stderr(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    std::thread::sleep(std::time::Duration::from_millis(1500));
+    let killed = std::process::Command::new("kill")
+        .args(["-INT", &child.id().to_string()])
+        .status()
+        .unwrap();
+    assert!(killed.success());
+    let status = wait_or_kill(&mut child, std::time::Duration::from_secs(60), "demo");
+    assert_eq!(status.code(), Some(130), "{status:?}");
+    let mut err = String::new();
+    std::io::Read::read_to_string(child.stderr.as_mut().unwrap(), &mut err).unwrap();
+    assert!(err.contains("interrupted"), "{err}");
+    if out.exists() {
+        no_staging_left(&out);
+        for e in std::fs::read_dir(&out).unwrap().flatten() {
+            if e.path().is_dir() {
+                no_staging_left(&e.path());
+            }
+        }
+    }
+}

@@ -105,6 +105,32 @@ pub struct Staging {
 
 static STAGED: AtomicU64 = AtomicU64::new(0);
 
+/// Staging folders and temporary files not yet committed or removed, for
+/// [`remove_unfinished`].
+static UNFINISHED: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+fn unfinished() -> std::sync::MutexGuard<'static, Vec<PathBuf>> {
+    UNFINISHED.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+fn finished(path: &Path) {
+    unfinished().retain(|p| p != path);
+}
+
+/// Removes every staging folder and temporary file of this process that is
+/// not yet committed: what an interrupt handler calls before exiting, so
+/// that an interrupted job leaves the output folder as it found it (files
+/// already moved into place by a commit stay, whole).
+pub fn remove_unfinished() {
+    for p in unfinished().drain(..) {
+        if p.is_dir() {
+            let _ = std::fs::remove_dir_all(&p);
+        } else {
+            let _ = std::fs::remove_file(&p);
+        }
+    }
+}
+
 impl OutDir {
     /// An output folder with no inputs to protect and no `--force`.
     pub fn new(dir: impl Into<PathBuf>) -> Self {
@@ -127,6 +153,7 @@ impl OutDir {
         let tmp = self
             .dir
             .join(format!(".autoshovel-staging-{}-{n}", std::process::id()));
+        unfinished().push(tmp.clone());
         std::fs::create_dir_all(&tmp).map_err(|e| ReportError::io(&tmp, e))?;
         Ok(Staging {
             out: self.clone(),
@@ -172,6 +199,7 @@ impl Staging {
 impl Drop for Staging {
     fn drop(&mut self) {
         let _ = std::fs::remove_dir_all(&self.tmp);
+        finished(&self.tmp);
     }
 }
 
@@ -197,15 +225,18 @@ pub fn write_file_atomically<E: From<ReportError>>(
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
     let tmp = target.with_file_name(format!(".autoshovel-{}-{name}", std::process::id()));
+    unfinished().push(tmp.clone());
     let result = write(&tmp);
     if result.is_ok() {
         if let Err(e) = std::fs::rename(&tmp, target) {
             let _ = std::fs::remove_file(&tmp);
+            finished(&tmp);
             return Err(ReportError::io(target, e).into());
         }
     } else {
         let _ = std::fs::remove_file(&tmp);
     }
+    finished(&tmp);
     result
 }
 

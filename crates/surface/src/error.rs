@@ -15,6 +15,19 @@ pub enum SurfaceError {
         /// The valid range, in words.
         expected: &'static str,
     },
+    /// A setting sizes more work than the stated ceiling (checked before
+    /// the work, once the cloud is known).
+    #[error("{key} = {value} asks too much: {estimate}; the ceiling is {ceiling}")]
+    TooMuchWork {
+        /// The setting, as written in the settings file (`[smooth] iterations`).
+        key: String,
+        /// Its value.
+        value: String,
+        /// The work it implies.
+        estimate: String,
+        /// The ceiling.
+        ceiling: String,
+    },
     /// Too few points for a stage to work with.
     #[error("{stage}: {points} points, at least {required} needed{hint}")]
     TooFewPoints {

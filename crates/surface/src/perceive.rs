@@ -160,6 +160,21 @@ pub struct GroundStage {
     pub margin_m: f64,
 }
 
+/// Most neighbour visits per point one filter stage may cost (all its
+/// passes). The defaults cost about 28 (radius), 20 (statistical) and 113
+/// (smoothing); 10⁴ keeps a million-point cloud's stage within minutes.
+pub const MAX_NEIGHBOUR_VISITS: f64 = 1e4;
+
+/// One neighbourhood stage's cost: the setting that sizes it and the
+/// neighbour visits per point it implies.
+struct StageWork {
+    table: &'static str,
+    key: &'static str,
+    value: f64,
+    visits: f64,
+    how: String,
+}
+
 /// Radius outlier removal settings (`[RS eq. 13]`).
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
@@ -409,11 +424,105 @@ impl TomlFile for PerceptionParams {
             )
             .into());
         }
+        // The work per point at the spacing the settings scale by (the
+        // run checks again on the cloud's true spacing).
+        for w in self.neighbour_work(1.0, f64::INFINITY) {
+            if w.visits > MAX_NEIGHBOUR_VISITS {
+                return Err(config::invalid(
+                    text,
+                    file,
+                    (w.table, 0),
+                    w.key,
+                    config::short(w.value),
+                    format!(
+                        "at most {} neighbour visits per point; this is about {} ({})",
+                        config::approx(MAX_NEIGHBOUR_VISITS),
+                        config::approx(w.visits),
+                        w.how
+                    ),
+                )
+                .into());
+            }
+        }
         Ok(())
     }
 }
 
 impl PerceptionParams {
+    /// Neighbour visits per point of each enabled neighbourhood stage on a
+    /// cloud of `n` points whose true spacing is `ratio` times smaller than
+    /// the spacing the settings scale by (1 for "auto"); neighbours within
+    /// r of a scanned surface ≈ π·(r / spacing)², never more than `n`.
+    fn neighbour_work(&self, ratio: f64, n: f64) -> Vec<StageWork> {
+        let within = |r_spacings: f64| (std::f64::consts::PI * (r_spacings * ratio).powi(2)).min(n);
+        let mut out = Vec::new();
+        if self.radius.enabled {
+            let k = within(self.radius.radius_spacings);
+            out.push(StageWork {
+                table: "radius",
+                key: "radius_spacings",
+                value: self.radius.radius_spacings,
+                visits: k,
+                how: format!("about {} neighbours within the radius", config::approx(k)),
+            });
+        }
+        if self.statistical.enabled {
+            let k = (self.statistical.mean_k as f64).min(n);
+            out.push(StageWork {
+                table: "statistical",
+                key: "mean_k",
+                value: self.statistical.mean_k as f64,
+                visits: k,
+                how: format!("{} nearest neighbours", config::approx(k)),
+            });
+        }
+        if self.smooth.enabled {
+            let k = within(self.smooth.radius_spacings);
+            let passes = self.smooth.iterations as f64;
+            // Blame the passes when one pass is within the ceiling.
+            let (key, value) = if k <= MAX_NEIGHBOUR_VISITS {
+                ("iterations", passes)
+            } else {
+                ("radius_spacings", self.smooth.radius_spacings)
+            };
+            out.push(StageWork {
+                table: "smooth",
+                key,
+                value,
+                visits: k * passes,
+                how: format!(
+                    "about {} neighbours within radius_spacings = {} × {} pass(es)",
+                    config::approx(k),
+                    config::short(self.smooth.radius_spacings),
+                    self.smooth.iterations
+                ),
+            });
+        }
+        out
+    }
+
+    /// Refuses settings that would cost more than [`MAX_NEIGHBOUR_VISITS`]
+    /// per point on a cloud of `n` points whose true spacing is `ratio`
+    /// times smaller than the one the settings scale by.
+    pub fn check_work(&self, ratio: f64, n: usize) -> Result<()> {
+        for w in self.neighbour_work(ratio, n as f64) {
+            if w.visits > MAX_NEIGHBOUR_VISITS {
+                return Err(SurfaceError::TooMuchWork {
+                    key: format!("[{}] {}", w.table, w.key),
+                    value: config::short(w.value),
+                    estimate: format!(
+                        "{} neighbour visits per point ({}), {} for the {n} points",
+                        config::approx(w.visits),
+                        w.how,
+                        config::approx(w.visits * n as f64)
+                    ),
+                    ceiling: format!("{} per point", config::approx(MAX_NEIGHBOUR_VISITS)),
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// Reads and checks a settings file (errors name the file, line and key).
     pub fn load(path: &Path) -> Result<Self> {
         <Self as TomlFile>::load(path)
@@ -483,6 +592,17 @@ pub fn perceive_file(
     params: &PerceptionParams,
     progress: &mut dyn FnMut(u64, u64),
 ) -> Result<Perceived> {
+    perceive_file_with(path, params, progress, &mut |_| {})
+}
+
+/// [`perceive_file`], calling `on_stage(name)` as each stage after the
+/// read starts (`"level"`, `"ground"`, `"radius"`, …, `"fit"`).
+pub fn perceive_file_with(
+    path: &Path,
+    params: &PerceptionParams,
+    progress: &mut dyn FnMut(u64, u64),
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<Perceived> {
     let t = Instant::now();
     let report = autoshovel_cloud::io::read(path, progress)?;
     let read = StageRecord {
@@ -495,7 +615,7 @@ pub fn perceive_file(
             non_finite_dropped: report.non_finite_dropped,
         });
     }
-    let mut got = perceive(&report.cloud, params)?;
+    let mut got = perceive_with(&report.cloud, params, on_stage)?;
     got.stages.insert(0, read);
     got.format = Some(report.format);
     got.non_finite_dropped = report.non_finite_dropped;
@@ -547,6 +667,16 @@ pub fn scale_and_spacing(cloud: &PointCloud, params: &PerceptionParams) -> Resul
 /// radius and statistical outliers, voxel grid, bilateral smoothing, fit.
 /// A stage's failure names the stage.
 pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceived> {
+    perceive_with(cloud, params, &mut |_| {})
+}
+
+/// [`perceive`], calling `on_stage(name)` as each stage starts (`"level"`,
+/// then the enabled filters by name, then `"fit"`): for progress display.
+pub fn perceive_with(
+    cloud: &PointCloud,
+    params: &PerceptionParams,
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<Perceived> {
     let p = params;
     let input_points = cloud.len();
     if input_points == 0 {
@@ -555,6 +685,37 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
         });
     }
     let (scale, spacing) = scale_and_spacing(cloud, p)?;
+    // The work the filters imply on this cloud, before doing it: with a
+    // spacing given as a number, the cloud's own may be much finer.
+    if let (Some((lo, hi)), ScaleSetting::Factor(_)) = (cloud.bounds(), p.spacing) {
+        let area = f64::from(hi[0] - lo[0]) * f64::from(hi[1] - lo[1]);
+        let own = (area / input_points as f64).sqrt();
+        if own.is_finite() && own > 0.0 {
+            match p.check_work(spacing / own, input_points) {
+                // Within the ceiling at the spacing given, beyond it on
+                // this cloud: the spacing is what is wrong.
+                Err(SurfaceError::TooMuchWork {
+                    key,
+                    value,
+                    estimate,
+                    ceiling,
+                }) if p.check_work(1.0, input_points).is_ok() => {
+                    return Err(SurfaceError::TooMuchWork {
+                        key: "spacing".into(),
+                        value: config::short(spacing),
+                        estimate: format!(
+                            "it is {}× this cloud's own spacing ({} m), so {key} = {value} costs {estimate}",
+                            config::approx(spacing / own),
+                            config::approx(own)
+                        ),
+                        ceiling,
+                    })
+                }
+                other => other?,
+            }
+        }
+    }
+    p.check_work(1.0, input_points)?;
     let mut stages: Vec<StageRecord> = Vec::new();
     let in_stage = |stage: &'static str| {
         move |source: SurfaceError| SurfaceError::Stage {
@@ -563,6 +724,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
         }
     };
     // Level [RS eq. 11]–[RS eq. 12].
+    on_stage("level");
     let t = Instant::now();
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.floor_fraction = p.level.floor_fraction;
@@ -669,6 +831,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
     let mut cloud = cloud;
     for (stage, enabled, run) in filters {
         if enabled {
+            on_stage(stage);
             let t = Instant::now();
             cloud = run(&cloud).map_err(|source| SurfaceError::Filter { stage, source })?;
             stages.push(StageRecord {
@@ -679,6 +842,7 @@ pub fn perceive(cloud: &PointCloud, params: &PerceptionParams) -> Result<Perceiv
         }
     }
     // Fit [RS eq. 21].
+    on_stage("fit");
     let t = Instant::now();
     let fit_params = FitParams {
         max_degree: p.fit.max_degree,
@@ -840,6 +1004,60 @@ mod tests {
                 "{text:?}: {msg}"
             );
         }
+    }
+
+    #[test]
+    fn settings_that_size_too_much_work_are_refused_with_the_estimate() {
+        // π·6² ≈ 113 neighbours per pass: 10⁶ passes is 1.13e8 visits.
+        for (text, key, line, estimate) in [
+            (
+                "[smooth]\niterations = 1000000\n",
+                "[smooth] iterations",
+                2,
+                "1.13e8",
+            ),
+            (
+                "[statistical]\nmean_k = 100000\n",
+                "[statistical] mean_k",
+                2,
+                "1.00e5",
+            ),
+            (
+                "\n[radius]\nradius_spacings = 1000\n",
+                "[radius] radius_spacings",
+                3,
+                "3.14e6",
+            ),
+        ] {
+            let msg = <PerceptionParams as TomlFile>::from_toml(text, "p.toml")
+                .unwrap_err()
+                .to_string();
+            assert!(
+                msg.starts_with(&format!("p.toml:{line}: {key} = ")) && msg.contains(estimate),
+                "{text:?}: {msg}"
+            );
+        }
+        // 88 passes at the default radius are within the ceiling, 89 not.
+        let ok = |passes: usize| {
+            let mut p = PerceptionParams::default();
+            p.smooth.iterations = passes;
+            p.check_work(1.0, 1000).is_ok()
+        };
+        assert!(ok(88) && !ok(89));
+        // A spacing given as a number 20 times the cloud's own: the radius
+        // stage meets 400 times the neighbours, and the spacing is named.
+        let cloud = PointCloud::new(
+            (0..20_000)
+                .map(|i| [(i % 200) as f32 * 0.1, (i / 200) as f32 * 0.1, 0.0])
+                .collect(),
+        );
+        let p: PerceptionParams = TomlFile::from_toml("spacing = 2.0\n", "p").unwrap();
+        let msg = perceive(&cloud, &p).unwrap_err().to_string();
+        assert!(
+            msg.starts_with("spacing = 2 asks too much")
+                && msg.contains("[radius] radius_spacings"),
+            "{msg}"
+        );
     }
 
     #[test]
