@@ -216,7 +216,7 @@ fn settings_that_size_too_much_work_are_refused_with_the_estimate() {
     let msg = Scenario::from_toml(&text, "s.toml")
         .unwrap_err()
         .to_string();
-    assert!(7e6 * 100.0 > MAX_STEP_SEARCH_STRIPS);
+    const { assert!(7e6 * 100.0 > MAX_STEP_SEARCH_STRIPS) };
     assert!(
         msg.contains("[dig] step_m") && msg.contains("7.00e8") && msg.contains("volume strips"),
         "{msg}"
