@@ -54,9 +54,9 @@ enum Command {
     PlanExcavate(plan_excavate::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
-    /// Print a built-in scenario as TOML, to copy and edit.
+    /// Print a built-in scenario (of plan-path, track or plan-excavate) as TOML, to copy and edit.
     Scenario {
-        /// Built-in scenario name.
+        /// Built-in scenario name (an unknown one lists them all, by job).
         name: String,
     },
     /// Run every job on its embedded defaults and write one report (index.html).
@@ -91,6 +91,31 @@ impl From<PlannerArg> for autoshovel_propel::FieldKind {
     }
 }
 
+/// `autoshovel scenario NAME`: a built-in's TOML, whichever job it is for
+/// (plan-path's travel scenarios, which `track` also takes, then track's
+/// own, then plan-excavate's).
+fn print_scenario(name: &str) -> anyhow::Result<()> {
+    let text = autoshovel_propel::scenario::builtin_text(name)
+        .ok()
+        .or_else(|| autoshovel_track::scenario::builtin_text(name))
+        .or_else(|| autoshovel_excavate::Scenario::builtin_toml(name));
+    let Some(text) = text else {
+        let own: Vec<&str> = autoshovel_track::scenario::BUILTIN_TOML
+            .iter()
+            .map(|(n, _)| *n)
+            .collect();
+        anyhow::bail!(
+            "unknown built-in scenario '{name}': plan-path and track have {}; track also {}; plan-excavate has {}",
+            autoshovel_propel::scenario::builtin_names().join(", "),
+            own.join(", "),
+            autoshovel_excavate::Scenario::builtin_names().join(", ")
+        );
+    };
+    use std::io::Write as _;
+    let _ = write!(std::io::stdout().lock(), "{text}");
+    Ok(())
+}
+
 fn main() -> ExitCode {
     let cli = Cli::parse();
     // Ctrl-C stops any job at once; what it had staged in the output folder
@@ -108,12 +133,7 @@ fn main() -> ExitCode {
         Command::Perceive(args) => perceive::run(&args),
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
-        Command::Scenario { name } => autoshovel_propel::scenario::builtin_text(&name)
-            .map(|text| {
-                use std::io::Write as _;
-                let _ = write!(std::io::stdout().lock(), "{text}");
-            })
-            .map_err(anyhow::Error::from),
+        Command::Scenario { name } => print_scenario(&name),
         Command::Demo { out, json, force } => demo::run(&out, json, force),
     };
     match result {

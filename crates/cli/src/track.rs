@@ -43,7 +43,7 @@ pub enum NoiseArg {
 /// Arguments of `track`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// fig9a, fig9b, straight, curve, v-shape, or a TOML file (tracking scenario, or a plan-path scenario to plan first).
+    /// fig9a, fig9b, a plan-path built-in (straight, curve, v-shape, ...), or a TOML file (tracking scenario, or a plan-path scenario to plan first); `autoshovel scenario NAME` prints a built-in.
     #[arg(long, default_value = "fig9a")]
     pub scenario: String,
     /// Tracker.

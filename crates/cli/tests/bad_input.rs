@@ -349,10 +349,48 @@ fn unknown_scenario_name_lists_the_builtins() {
     assert!(
         r.error_message().contains("'nosuch'")
             && r.error_message()
-                .contains("straight, straight-reverse, curve, curve-reverse, v-shape"),
+                .contains("straight, straight-reverse, curve, curve-reverse, v-shape")
+            && r.error_message().contains("fig9a, fig9b")
+            && r.error_message().contains("paper-over"),
         "{}",
         r.stderr
     );
+}
+
+/// `autoshovel scenario NAME` prints every job's built-ins, and what it
+/// prints runs as the built-in does (the same summary).
+#[test]
+fn every_built_in_scenario_prints_and_runs_as_itself() {
+    let dir = TempDir::new("scenario-print");
+    for (job, name) in [
+        ("track", "fig9a"),
+        ("track", "fig9b"),
+        ("track", "straight-reverse"),
+        ("plan-path", "curve"),
+        ("plan-excavate", "two-boulders"),
+    ] {
+        let text = run(&["scenario", name]).ok().stdout;
+        let file = dir.write(&format!("{name}.toml"), &text);
+        let file = file.to_str().unwrap();
+        let mut built_in = run(&[job, "--scenario", name, "--json"]).ok().json();
+        let mut printed = run(&[job, "--scenario", file, "--json"]).ok().json();
+        // Only where the scenario came from and the timings may differ.
+        fn strip(v: &mut serde_json::Value) {
+            match v {
+                serde_json::Value::Object(m) => {
+                    m.retain(|k, _| {
+                        !(k.ends_with("_ms") || k == "realtime_factor" || k.starts_with("scenario"))
+                    });
+                    m.values_mut().for_each(strip);
+                }
+                serde_json::Value::Array(a) => a.iter_mut().for_each(strip),
+                _ => {}
+            }
+        }
+        strip(&mut built_in);
+        strip(&mut printed);
+        assert_eq!(built_in, printed, "{job} {name}");
+    }
 }
 
 #[test]

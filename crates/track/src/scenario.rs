@@ -58,7 +58,15 @@ use crate::sensor::RtkParams;
 use crate::sim::{Setup, SimParams};
 
 /// The built-in tracking scenarios.
-pub const BUILTINS: &[&str] = &["fig9a", "fig9b", "straight", "curve", "v-shape"];
+pub const BUILTINS: &[&str] = &[
+    "fig9a",
+    "fig9b",
+    "straight",
+    "straight-reverse",
+    "curve",
+    "curve-reverse",
+    "v-shape",
+];
 
 /// Whether a run has sensor noise and slip.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -98,14 +106,26 @@ pub struct TrackScenario {
 /// Farthest the start may be from the first leg [m].
 pub const MAX_START_OFFSET_M: f64 = 20.0;
 
-/// The Fig. 9 path: (0, 0) → (30, 30).
-fn fig9_leg() -> RefLeg {
-    RefLeg::new(
-        Direction::Forward,
-        vec![Vec2::new(0.0, 0.0), Vec2::new(30.0, 30.0)],
-        None,
-    )
-    .expect("valid")
+/// The built-in tracking scenarios written as tracking-scenario TOML (the
+/// others are `plan-path`'s travel scenarios, planned first).
+pub const BUILTIN_TOML: &[(&str, &str)] = &[
+    ("fig9a", include_str!("../scenarios/fig9a.toml")),
+    ("fig9b", include_str!("../scenarios/fig9b.toml")),
+];
+
+/// The TOML text of a built-in (with its comments), to print and edit:
+/// Fig. 9's own files, or the travel scenario a built-in plans first.
+pub fn builtin_text(name: &str) -> Option<&'static str> {
+    BUILTIN_TOML
+        .iter()
+        .find(|(n, _)| *n == name)
+        .map(|(_, t)| *t)
+        .or_else(|| {
+            BUILTINS
+                .contains(&name)
+                .then(|| autoshovel_propel::scenario::builtin_text(name).ok())
+                .flatten()
+        })
 }
 
 /// Builds a built-in scenario, or reads a file. `noise` overrides the
@@ -121,33 +141,11 @@ pub fn resolve(
     };
     match name_or_path {
         "fig9a" | "fig9b" => {
-            let (start, v) = if name_or_path == "fig9a" {
-                (Pose2::new(2.0, -2.0, std::f64::consts::FRAC_PI_4), 2.0)
-            } else {
-                (Pose2::new(0.0, 5.0, std::f64::consts::FRAC_PI_4), 1.0)
-            };
-            let noise = noise.unwrap_or(Noise::Off);
-            let setup = Setup {
-                legs: vec![fig9_leg()],
-                start,
-                crawler: CrawlerParams::default(),
-                slip: SlipParams::none(),
-                rtk: RtkParams::ideal(),
-                sim: SimParams {
-                    speed_mps: v,
-                    ..Default::default()
-                },
-            };
-            Ok(TrackScenario {
-                name: name_or_path.to_string(),
-                setup: with(noise, setup),
-                noise,
-                map: None,
-                controllers: ControllerParams::default(),
-            })
+            let text = builtin_text(name_or_path).expect("a built-in");
+            from_toml(text, &format!("<builtin {name_or_path}>"), noise, seed)
         }
-        "straight" | "curve" | "v-shape" => {
-            let travel = TravelScenario::builtin(name_or_path).expect("built-in travel scenario");
+        name if BUILTINS.contains(&name) => {
+            let travel = TravelScenario::builtin(name).expect("built-in travel scenario");
             let noise = noise.unwrap_or(Noise::Rtk);
             let setup = from_travel(&travel, &format!("<builtin {name_or_path}>"))?;
             Ok(TrackScenario {
