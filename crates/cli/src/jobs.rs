@@ -118,7 +118,11 @@ pub fn read_and_perceive(
     );
     bar.finish_and_clear();
     spinner.finish_and_clear();
-    got.with_context(|| input.display().to_string())
+    // A read error names the file itself; the pipeline's do not.
+    got.map_err(|e| match e {
+        autoshovel_surface::SurfaceError::Cloud(e) => anyhow::Error::from(e),
+        e => anyhow::Error::from(e).context(input.display().to_string()),
+    })
 }
 
 /// `perceive`: the §3 pipeline on `input`.

@@ -520,3 +520,28 @@ fn mutated_scenarios_never_panic_or_hang() {
         t0.elapsed()
     );
 }
+
+/// OS errors are printed once, after the file they concern (never the
+/// temporary file autoshovel writes through).
+#[test]
+fn os_errors_are_printed_once_naming_the_users_path() {
+    let dir = TempDir::new("os-errors");
+    let missing = dir.path().join("missing.pcd");
+    let m = missing.to_str().unwrap();
+    let cases: [Vec<&str>; 3] = [
+        vec!["perceive", "--input", m],
+        vec!["plan-dig", "--cloud", m],
+        vec!["generate-pile", "--out", "PLACEHOLDER"],
+    ];
+    let nested = dir.path().join("no-such-folder").join("pile.pcd");
+    for mut a in cases {
+        if a[2] == "PLACEHOLDER" {
+            a[2] = nested.to_str().unwrap();
+        }
+        let r = run(&a).fails();
+        let e = r.error_message();
+        assert_eq!(e.matches("os error").count(), 1, "{e}");
+        assert_eq!(e.matches(a[2]).count(), 1, "{e}");
+        assert!(!e.contains(".autoshovel"), "{e}");
+    }
+}

@@ -7,8 +7,9 @@ use std::path::PathBuf;
 #[derive(Debug, thiserror::Error)]
 #[non_exhaustive]
 pub enum CloudError {
-    /// An I/O error on a file.
-    #[error("{path}: {source}")]
+    /// An I/O error on a file (the cause is the error's source, printed
+    /// after the file in an error chain).
+    #[error("{path}")]
     Io {
         /// The file.
         path: PathBuf,

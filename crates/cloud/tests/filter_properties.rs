@@ -124,6 +124,36 @@ proptest! {
         }
     }
 
+    /// Leaves from 1e-12 m to 1 km on clouds from 1 cm to 10 km across:
+    /// the map of voxels, or a refusal naming the leaf when a voxel index
+    /// passes 4e18 — never a panic (a 1e-12 leaf on a 100 m pile once
+    /// overflowed the voxel count).
+    #[test]
+    fn voxel_grid_at_any_scale_is_the_map_of_voxels_or_a_refusal(
+        seed in any::<u64>(), n in 1usize..200, leaf_exp in -12.0f64..3.0, size_exp in -2.0f32..4.0,
+    ) {
+        let leaf = 10f64.powf(leaf_exp);
+        let cloud = lcg_cloud(n, 10f32.powf(size_exp), seed);
+        let inv = 1.0 / leaf as f32;
+        let mut voxels: BTreeMap<[i64; 3], usize> = BTreeMap::new();
+        let mut too_fine = false;
+        for p in &cloud.points {
+            let c = [2, 1, 0].map(|a| (p[a] * inv).floor());
+            too_fine |= c.iter().any(|v| !v.is_finite() || v.abs() >= 4.0e18);
+            *voxels.entry(c.map(|v| v as i64)).or_default() += 1;
+        }
+        match filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(leaf)) {
+            Ok(got) => {
+                prop_assert!(!too_fine);
+                prop_assert_eq!(got.len(), voxels.len());
+            }
+            Err(e) => {
+                prop_assert!(too_fine, "{e}");
+                prop_assert!(e.to_string().contains("too small"), "{e}");
+            }
+        }
+    }
+
     #[test]
     fn pass_through_inside_and_outside_split_the_cloud(seed in any::<u64>(), lo in -0.2f64..0.6, w in 0.0f64..0.8) {
         let cloud = lcg_cloud(200, 1.0, seed);
@@ -273,7 +303,14 @@ fn bad_parameters_name_the_value() {
         },
     );
     assert!(what(e.unwrap_err()).contains("std_mul must be finite, got inf"));
-    for leaf in [0.0, -0.05, f64::NAN, f64::INFINITY, 1e-300, 1e300] {
+    for (leaf, shown) in [
+        (0.0, "0"),
+        (-0.05, "-0.05"),
+        (f64::NAN, "NaN"),
+        (f64::INFINITY, "inf"),
+        (1e-300, "1e-300"),
+        (1e300, "1e300"),
+    ] {
         let e = filter::voxel_grid(
             &cloud,
             &filter::VoxelGridParams {
@@ -281,7 +318,7 @@ fn bad_parameters_name_the_value() {
             },
         );
         assert!(what(e.unwrap_err()).contains(&format!(
-            "leaf_m[1] must be positive and finite in f32, got {leaf}"
+            "leaf_m[1] must be positive and finite in f32, got {shown}"
         )));
     }
     let e = filter::pass_through(

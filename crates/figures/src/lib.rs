@@ -31,7 +31,7 @@ pub enum FiguresError {
     #[error(transparent)]
     Dig(#[from] autoshovel_dig::DigError),
     /// An output folder could not be created.
-    #[error("cannot create output directory {}: {source}", path.display())]
+    #[error("cannot create output directory {}", path.display())]
     CreateDir {
         /// The folder.
         path: std::path::PathBuf,

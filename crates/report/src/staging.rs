@@ -220,6 +220,12 @@ pub fn write_file_atomically<E: From<ReportError>>(
         }
         .into());
     }
+    // A missing folder is the target's error, not the temporary file's.
+    if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
+        if let Err(e) = std::fs::metadata(parent) {
+            return Err(ReportError::io(target, e).into());
+        }
+    }
     let name = target
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())

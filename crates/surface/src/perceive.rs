@@ -833,7 +833,10 @@ pub fn perceive_with(
         if enabled {
             on_stage(stage);
             let t = Instant::now();
-            cloud = run(&cloud).map_err(|source| SurfaceError::Filter { stage, source })?;
+            cloud = run(&cloud).map_err(|source| SurfaceError::Filter {
+                stage,
+                source: in_settings_terms(stage, source, p, spacing, scale),
+            })?;
             stages.push(StageRecord {
                 stage,
                 points: cloud.len(),
@@ -868,6 +871,63 @@ pub fn perceive_with(
         format: None,
         non_finite_dropped: 0,
     })
+}
+
+/// A filter's error restated in the perceive settings' terms: the hint of
+/// an emptied cloud names the TOML keys to change, and a bad value says
+/// which setting it came from (the filters speak of `radius_m`, `leaf_m`;
+/// the settings of spacings).
+fn in_settings_terms(
+    stage: &str,
+    e: autoshovel_cloud::CloudError,
+    p: &PerceptionParams,
+    spacing: f64,
+    scale: f64,
+) -> autoshovel_cloud::CloudError {
+    use autoshovel_cloud::CloudError;
+    let sp = config::approx(spacing);
+    match e {
+        CloudError::Emptied { filter, input, .. } => CloudError::Emptied {
+            filter,
+            input,
+            hint: match stage {
+                "ground" => "every point is below the floor cut (the floor found by levelling plus [ground] margin_m × scale): lower [ground] margin_m, or check [level]".into(),
+                "radius" => "lower [radius] min_neighbors or raise [radius] radius_spacings (or set [radius] enabled = false)".into(),
+                "statistical" => "raise [statistical] std_mul (or set [statistical] enabled = false)".into(),
+                other => format!("check the [{other}] settings"),
+            },
+        },
+        CloudError::BadParameter { filter, what } => CloudError::BadParameter {
+            filter,
+            what: format!(
+                "{what} [from {}]",
+                match stage {
+                    "radius" => format!(
+                        "[radius] radius_spacings = {} × the spacing {sp} m",
+                        config::short(p.radius.radius_spacings)
+                    ),
+                    "voxel" => format!(
+                        "[voxel] leaf_spacings = {} × the spacing {sp} m",
+                        config::short(p.voxel.leaf_spacings)
+                    ),
+                    "smooth" => format!(
+                        "[smooth] radius_spacings = {}, sigma_d_spacings = {} × the spacing {sp} m, sigma_n_m = {} × the scale {}",
+                        config::short(p.smooth.radius_spacings),
+                        config::short(p.smooth.sigma_d_spacings),
+                        config::short(p.smooth.sigma_n_m),
+                        config::approx(scale)
+                    ),
+                    "statistical" => format!(
+                        "[statistical] mean_k = {}, std_mul = {}",
+                        p.statistical.mean_k,
+                        config::short(p.statistical.std_mul)
+                    ),
+                    _ => format!("[ground] margin_m = {} × the scale {}", config::short(p.ground.margin_m), config::approx(scale)),
+                }
+            ),
+        },
+        other => other,
+    }
 }
 
 /// The fit part of a perception summary.
@@ -1058,6 +1118,40 @@ mod tests {
                 && msg.contains("[radius] radius_spacings"),
             "{msg}"
         );
+    }
+
+    /// An error and its sources, as an error chain prints them.
+    fn chain(e: &dyn std::error::Error) -> String {
+        let mut out = e.to_string();
+        let mut next = e.source();
+        while let Some(c) = next {
+            out += &format!(": {c}");
+            next = c.source();
+        }
+        out
+    }
+
+    #[test]
+    fn filter_errors_name_the_settings_keys() {
+        let cloud = PointCloud::new(
+            (0..2_000)
+                .map(|i| [(i % 50) as f32 * 0.1, (i / 50) as f32 * 0.1, 0.0])
+                .collect(),
+        );
+        let mut p = PerceptionParams::default();
+        p.level.mode = LevelMode::None;
+        p.ground.margin_m = -1.0;
+        p.radius.min_neighbors = 100_000;
+        let msg = chain(&perceive(&cloud, &p).unwrap_err());
+        assert!(
+            msg.contains("[radius] min_neighbors") && msg.contains("[radius] radius_spacings"),
+            "{msg}"
+        );
+        assert!(!msg.contains("radius_m"), "{msg}");
+        p.radius.min_neighbors = 1;
+        p.voxel.leaf_spacings = 1e-30;
+        let msg = chain(&perceive(&cloud, &p).unwrap_err());
+        assert!(msg.contains("[from [voxel] leaf_spacings = 1e-30"), "{msg}");
     }
 
     #[test]

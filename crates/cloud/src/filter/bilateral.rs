@@ -30,6 +30,7 @@ use super::common::{bad, empty_input, f32_at_most, is_finite};
 use super::kdtree::KdTree;
 use super::normals::pca_normal;
 use crate::{Point, PointCloud, Result};
+use autoshovel_core::config::short;
 
 const FILTER: &str = "bilateral normal smoothing";
 
@@ -70,7 +71,7 @@ impl BilateralParams {
             if !(v.is_finite() && v > 0.0) {
                 return Err(bad(
                     FILTER,
-                    format!("{name} must be positive and finite, got {v}"),
+                    format!("{name} must be positive and finite, got {}", short(v)),
                 ));
             }
         }

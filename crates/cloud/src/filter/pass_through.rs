@@ -20,6 +20,7 @@
 //! Open3D has no pass-through; its `crop(AxisAlignedBoundingBox)` keeps the
 //! closed box too.
 
+use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 use super::common::{bad, emptied, empty_input, is_finite};
@@ -96,7 +97,11 @@ impl PassThroughParams {
         if self.min_m > self.max_m {
             return Err(bad(
                 FILTER,
-                format!("min_m = {} is above max_m = {}", self.min_m, self.max_m),
+                format!(
+                    "min_m = {} is above max_m = {}",
+                    short(self.min_m),
+                    short(self.max_m)
+                ),
             ));
         }
         Ok((self.min_m as f32, self.max_m as f32))

@@ -35,6 +35,7 @@
 //! the points at exactly the radius (on `tests/data/filters/grid.pcd`,
 //! r = 0.25, N = 6 it keeps 400 points where PCL and we keep 620).
 
+use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_points};
@@ -71,7 +72,7 @@ impl RadiusOutlierParams {
                 FILTER,
                 format!(
                     "radius_m must be positive and finite, got {}",
-                    self.radius_m
+                    short(self.radius_m)
                 ),
             ));
         }

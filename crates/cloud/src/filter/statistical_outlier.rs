@@ -43,6 +43,7 @@
 use super::common::{bad, emptied, empty_input, gather, on_finite_points};
 use super::kdtree::KdTree;
 use crate::{Point, PointCloud, Result};
+use autoshovel_core::config::short;
 
 const FILTER: &str = "statistical outlier removal";
 
@@ -78,7 +79,7 @@ impl StatisticalOutlierParams {
         if !self.std_mul.is_finite() {
             return Err(bad(
                 FILTER,
-                format!("std_mul must be finite, got {}", self.std_mul),
+                format!("std_mul must be finite, got {}", short(self.std_mul)),
             ));
         }
         Ok(())

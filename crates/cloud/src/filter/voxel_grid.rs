@@ -25,6 +25,7 @@
 //! Open3D's `voxel_down_sample` anchors its grid at `min_bound − leaf/2`
 //! and computes in f64, so its voxels differ from PCL's.
 
+use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 use super::common::{bad, empty_input, is_finite};
@@ -70,8 +71,9 @@ impl VoxelGridParams {
                 return Err(bad(
                     FILTER,
                     format!(
-                        "leaf_m[{a}] must be positive and finite in f32, got {leaf} \
-                         (use a voxel edge in metres, e.g. 0.05)"
+                        "leaf_m[{a}] must be positive and finite in f32, got {} \
+                         (use a voxel edge in metres, e.g. 0.05)",
+                        short(leaf)
                     ),
                 ));
             }
@@ -109,7 +111,8 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
                     FILTER,
                     format!(
                         "leaf_m[{a}] = {} is too small for the coordinate {} (voxel index beyond 4e18)",
-                        params.leaf_m[a], p[a]
+                        short(params.leaf_m[a]),
+                        p[a]
                     ),
                 ));
             }
@@ -146,7 +149,12 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
         ));
     }
     let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]) as u128 + 1);
-    let voxels = extent[0] * extent[1] * extent[2];
+    // Each extent is below 8e18, so the product of all three may pass
+    // u128 (fuzzing the settings found it): saturate, which only selects
+    // the triplet sort below.
+    let voxels = extent[0]
+        .saturating_mul(extent[1])
+        .saturating_mul(extent[2]);
     // The linear index, PCL's order: x fastest, z slowest (the cell is
     // valid: the bounds pass checked every finite point).
     let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
