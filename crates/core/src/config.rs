@@ -128,9 +128,29 @@ pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T
             file: file.to_string(),
             line,
             column,
-            message: e.message().trim().to_string(),
+            message: short_floats(e.message().trim()),
         }
     })
+}
+
+/// `message` with every "floating point `…`" of serde's type errors
+/// printed short (`1e-300`, not 300 digits).
+fn short_floats(message: &str) -> String {
+    const TAG: &str = "floating point `";
+    let mut out = String::new();
+    let mut rest = message;
+    while let Some(at) = rest.find(TAG) {
+        let (head, tail) = rest.split_at(at + TAG.len());
+        out.push_str(head);
+        let end = tail.find('`').unwrap_or(tail.len());
+        match tail[..end].parse::<f64>() {
+            Ok(v) => out.push_str(&short(v)),
+            Err(_) => out.push_str(&tail[..end]),
+        }
+        rest = &tail[end..];
+    }
+    out.push_str(rest);
+    out
 }
 
 /// [`ConfigError::Invalid`] for `key` of the `occurrence`-th (0-based)
@@ -359,5 +379,14 @@ mod bytes_tests {
         assert_eq!(super::approx(0.012345), "0.0123");
         assert_eq!(super::approx(7.0134819714e-6), "7.01e-6");
         assert_eq!(super::approx(1e7), "1.00e7");
+        #[derive(serde::Deserialize, Debug)]
+        #[allow(dead_code)]
+        struct N {
+            n: usize,
+        }
+        let e = super::parse::<N>("n = 1e-300\n", "f.toml")
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("floating point `1e-300`"), "{e}");
     }
 }

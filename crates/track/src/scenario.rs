@@ -353,6 +353,7 @@ impl ScenarioFile {
             rtk: RtkParams::ideal(),
             sim: self.sim(),
         };
+        check_work(&setup, text, file)?;
         apply_noise(&mut setup, noise, seed);
         if let Some(slip) = self.slip {
             setup.slip = slip;
@@ -579,6 +580,97 @@ pub fn from_toml(
         });
     }
     ScenarioFile::from_toml(text, file)?.into_scenario(text, file, noise, seed)
+}
+
+/// Refuses a run whose worst case ([`crate::sim::worst_case`]: the time
+/// limit at the plant and control rates) passes the ceilings, naming the
+/// `[sim]` setting at fault (the one whose default would meet it) with
+/// the estimate.
+fn check_work(setup: &Setup, text: &str, file: &str) -> Result<(), TrackError> {
+    use crate::sim::{worst_case, MAX_CONTROL_STEPS, MAX_PLANT_STEPS, SAMPLE_BYTES};
+    let (t_limit, plant, control) = worst_case(setup);
+    let defaults = SimParams::default();
+    let with = |sim: SimParams| {
+        worst_case(&Setup {
+            sim,
+            ..setup.clone()
+        })
+    };
+    let sim = setup.sim;
+    let fault = |key: &'static str, value: f64, what: String| {
+        TrackError::from(config::invalid(
+            text,
+            file,
+            ("sim", 0),
+            key,
+            config::short(value),
+            what,
+        ))
+    };
+    // The setting at fault: the first whose default would meet the ceiling.
+    let culprit = |over: &dyn Fn(&SimParams) -> bool| {
+        let candidates: [(&'static str, f64, SimParams); 3] = [
+            (
+                "plant_dt_s",
+                sim.plant_dt_s,
+                SimParams {
+                    plant_dt_s: defaults.plant_dt_s,
+                    ..sim
+                },
+            ),
+            (
+                "control_rate_hz",
+                sim.control_rate_hz,
+                SimParams {
+                    control_rate_hz: defaults.control_rate_hz,
+                    ..sim
+                },
+            ),
+            (
+                "time_per_m_limit_s",
+                sim.time_per_m_limit_s,
+                SimParams {
+                    time_per_m_limit_s: defaults.time_per_m_limit_s,
+                    ..sim
+                },
+            ),
+        ];
+        candidates.iter().find(|(_, _, s)| !over(s)).map_or(
+            ("time_per_m_limit_s", sim.time_per_m_limit_s),
+            |(k, v, _)| (*k, *v),
+        )
+    };
+    if plant > MAX_PLANT_STEPS {
+        let (key, value) = culprit(&|s| with(*s).1 > MAX_PLANT_STEPS);
+        return Err(fault(
+            key,
+            value,
+            format!(
+                "at most {} plant steps per run; the time limit of {} s at plant_dt_s = {} s and control_rate_hz = {} is about {}",
+                config::approx(MAX_PLANT_STEPS),
+                config::approx(t_limit),
+                config::short(sim.plant_dt_s),
+                config::short(sim.control_rate_hz),
+                config::approx(plant)
+            ),
+        ));
+    }
+    if control > MAX_CONTROL_STEPS {
+        let (key, value) = culprit(&|s| with(*s).2 > MAX_CONTROL_STEPS);
+        return Err(fault(
+            key,
+            value,
+            format!(
+                "at most {} control steps per run; the time limit of {} s at {} Hz is about {} ({})",
+                config::approx(MAX_CONTROL_STEPS),
+                config::approx(t_limit),
+                config::short(sim.control_rate_hz),
+                config::approx(control),
+                config::bytes(control * SAMPLE_BYTES)
+            ),
+        ));
+    }
+    Ok(())
 }
 
 fn apply_noise(setup: &mut Setup, noise: Noise, seed: u64) {

@@ -184,6 +184,30 @@ pub struct Setup {
 /// Convergence threshold: |centroid deviation| below this for good (SPEC §3) [m].
 pub const CONVERGED_BELOW_M: f64 = 0.05;
 
+/// Most plant steps one run may take (each a few tens of nanoseconds).
+pub const MAX_PLANT_STEPS: f64 = 1e8;
+/// Most control steps one run may take; each keeps a [`Sample`] (about
+/// [`SAMPLE_BYTES`]), so 10⁶ is about 150 MB.
+pub const MAX_CONTROL_STEPS: f64 = 1e6;
+/// Bytes a control step's sample keeps.
+pub const SAMPLE_BYTES: f64 = 150.0;
+
+/// The most a run of `setup` can take, before it runs: the time limit
+/// (30 s plus `time_per_m_limit_s` per metre of path) [s], the plant steps
+/// and the control steps (samples) up to it.
+pub fn worst_case(setup: &Setup) -> (f64, f64, f64) {
+    let sp = setup.sim;
+    let total_len: f64 = setup.legs.iter().map(RefLeg::length_m).sum();
+    let t_limit = 30.0 + sp.time_per_m_limit_s * total_len;
+    // The last control step runs all its plant steps, past the limit too.
+    let control_dt = 1.0 / sp.control_rate_hz;
+    (
+        t_limit,
+        (t_limit + control_dt) / sp.plant_dt_s.min(control_dt),
+        t_limit * sp.control_rate_hz,
+    )
+}
+
 /// Runs the closed loop.
 pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
     let sp = setup.sim;
@@ -192,8 +216,7 @@ pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
     let control_dt = 1.0 / sp.control_rate_hz;
     let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);
     let dt = control_dt / substeps as f64;
-    let total_len: f64 = setup.legs.iter().map(RefLeg::length_m).sum();
-    let t_limit = 30.0 + sp.time_per_m_limit_s * total_len;
+    let (t_limit, _, _) = worst_case(setup);
     let mut samples = Vec::new();
     let mut events = Vec::new();
     let mut t = 0.0;
