@@ -694,6 +694,45 @@ mod tests {
         [[leg]]\ndirection = \"forward\"\npoints_m = [[0.0, 0.0], [10.0, 0.0]]\n\
         [controller.fuzzy]\nk1 = 1.5\n";
 
+    /// Runs whose worst case passes the ceilings are refused before they
+    /// start, naming the setting at fault (the settings fuzzer hung on the
+    /// first: 1.8e19 plant steps in one control step).
+    #[test]
+    fn runs_sized_beyond_the_ceilings_are_refused_naming_the_setting() {
+        // 10 m path: time limit 30 + 20·10 = 230 s.
+        for (sim, key, estimate) in [
+            (
+                "control_rate_hz = 1e-300",
+                "[sim] control_rate_hz",
+                "plant steps",
+            ),
+            ("plant_dt_s = 1e-9", "[sim] plant_dt_s", "2.30e11"),
+            (
+                "time_per_m_limit_s = 1e308",
+                "[sim] time_per_m_limit_s",
+                "plant steps",
+            ),
+            (
+                "control_rate_hz = 1000.0\ntime_per_m_limit_s = 1000.0",
+                "[sim] control_rate_hz",
+                "1.00e7",
+            ),
+        ] {
+            let text = format!("{TEXT}[sim]\n{sim}\n");
+            let msg = match from_toml(&text, "t.toml", None, 1) {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("{sim}: accepted"),
+            };
+            assert!(
+                msg.starts_with("t.toml:") && msg.contains(key) && msg.contains(estimate),
+                "{sim}: {msg}"
+            );
+        }
+        // The ceilings leave room: 1 kHz control over the default limit.
+        let text = format!("{TEXT}[sim]\ncontrol_rate_hz = 1000.0\n");
+        assert!(from_toml(&text, "t.toml", None, 1).is_ok());
+    }
+
     #[test]
     fn gains_load_with_defaults_beside_them_and_round_trip() {
         let f = ScenarioFile::from_toml(TEXT, "t.toml").unwrap();
