@@ -75,7 +75,31 @@ pub fn run(args: &Args) -> Result<()> {
         ..PileParams::default()
     };
     let t0 = std::time::Instant::now();
-    let cloud = generate_pile(&params)?;
+    // The library names its fields; the user wrote flags.
+    let cloud = generate_pile(&params).map_err(|e| match e {
+        autoshovel_surface::SurfaceError::BadParameter {
+            name,
+            value,
+            expected,
+        } => {
+            let flag = match name {
+                "PileParams.scale" => "--scale",
+                "PileParams.points" => "--points",
+                "PileParams.roll_rad" => "--roll",
+                "PileParams.pitch_rad" => "--pitch",
+                other => other,
+            };
+            let (value, expected) = match flag {
+                "--roll" | "--pitch" => (value.to_degrees(), expected.replace(" [rad]", "")),
+                _ => (value, expected.to_string()),
+            };
+            anyhow::anyhow!(
+                "{flag} {}: expected {expected}",
+                autoshovel_core::config::short(value)
+            )
+        }
+        e => e.into(),
+    })?;
     let gen_ms = t0.elapsed().as_secs_f64() * 1e3;
     let encoding = match args.encoding {
         None => Encoding::default_for(&args.out),

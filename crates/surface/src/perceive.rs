@@ -391,7 +391,15 @@ impl TomlFile for PerceptionParams {
         ];
         for (table, key, v, ok, expected) in checks {
             if !ok {
-                return Err(config::invalid(text, file, (table, 0), key, v, expected).into());
+                return Err(config::invalid(
+                    text,
+                    file,
+                    (table, 0),
+                    key,
+                    config::short(v),
+                    expected,
+                )
+                .into());
             }
         }
         let counts = [

@@ -360,9 +360,9 @@ fn read_ascii<R: BufRead>(
         for (i, word) in text.split_ascii_whitespace().enumerate() {
             for (a, axis) in h.axes.iter().enumerate() {
                 if axis.value_index == i {
-                    p[a] = axis.scalar.parse_f32(word).ok_or_else(|| {
+                    p[a] = axis.scalar.parse_f32(word).map_err(|why| {
                         input.format_err(format!(
-                            "line {line_no}: {:?} is not a valid {} value",
+                            "line {line_no}: {:?} is not a valid {} value ({why})",
                             word, h.fields[axis.field].name
                         ))
                     })?;

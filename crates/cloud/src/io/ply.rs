@@ -377,9 +377,9 @@ fn read_ascii<R: BufRead>(
                         let word = words.next().ok_or_else(missing)?;
                         let is_axis = is_vertex && axes.iter().any(|(idx, _)| *idx == pk);
                         if is_axis {
-                            let v = ty.parse_f32(word).ok_or_else(|| {
+                            let v = ty.parse_f32(word).map_err(|why| {
                                 input.format_err(format!(
-                                    "line {line_no}: {word:?} is not a valid {name}"
+                                    "line {line_no}: {word:?} is not a valid {name} ({why})"
                                 ))
                             })?;
                             for (a, (idx, _)) in axes.iter().enumerate() {

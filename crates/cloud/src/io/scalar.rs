@@ -118,19 +118,50 @@ impl Scalar {
         }
     }
 
-    /// A text value of this type as an `f32` (one rounding step).
-    pub(crate) fn parse_f32(self, s: &str) -> Option<f32> {
-        match self {
-            Scalar::F32 => s.parse::<f32>().ok(),
-            Scalar::F64 => s.parse::<f64>().ok().map(|v| v as f32),
-            // Integer fields written by sloppy tools as "3.0" are accepted.
-            _ => s
-                .parse::<i64>()
-                .map(|v| v as f32)
-                .or_else(|_| s.parse::<u64>().map(|v| v as f32))
-                .ok()
-                .or_else(|| s.parse::<f64>().ok().map(|v| v as f32)),
+    /// The values an integer type holds, inclusive, and its name (None
+    /// for the float types).
+    fn int_range(self) -> Option<(i128, i128, &'static str)> {
+        Some(match self {
+            Scalar::I8 => (i8::MIN.into(), i8::MAX.into(), "an 8-bit integer"),
+            Scalar::U8 => (0, u8::MAX.into(), "an unsigned 8-bit integer"),
+            Scalar::I16 => (i16::MIN.into(), i16::MAX.into(), "a 16-bit integer"),
+            Scalar::U16 => (0, u16::MAX.into(), "an unsigned 16-bit integer"),
+            Scalar::I32 => (i32::MIN.into(), i32::MAX.into(), "a 32-bit integer"),
+            Scalar::U32 => (0, u32::MAX.into(), "an unsigned 32-bit integer"),
+            Scalar::I64 => (i64::MIN.into(), i64::MAX.into(), "a 64-bit integer"),
+            Scalar::U64 => (0, u64::MAX.into(), "an unsigned 64-bit integer"),
+            Scalar::F32 | Scalar::F64 => return None,
+        })
+    }
+
+    /// A text value of this type as an `f32` (one rounding step), or why
+    /// it is not one: not a number, or for an integer type a fraction or a
+    /// value the type cannot hold (written by sloppy tools, "3.0" is
+    /// accepted; 1.5, 300 for a uchar and -5 for an unsigned type are not:
+    /// reading them would return what the file does not say).
+    pub(crate) fn parse_f32(self, s: &str) -> Result<f32, String> {
+        let Some((lo, hi, name)) = self.int_range() else {
+            let v = match self {
+                Scalar::F32 => s.parse::<f32>().ok(),
+                _ => s.parse::<f64>().ok().map(|v| v as f32),
+            };
+            return v.ok_or_else(|| "not a number".to_string());
+        };
+        let v = match s.parse::<i128>() {
+            Ok(v) => v,
+            Err(_) => {
+                let f = s.parse::<f64>().map_err(|_| format!("not {name}"))?;
+                if !(f.is_finite() && f.fract() == 0.0) {
+                    return Err(format!("the field is {name}, which holds no fraction"));
+                }
+                // Beyond every integer type: the range check refuses it.
+                f.clamp(-1e20, 1e20) as i128
+            }
+        };
+        if v < lo || v > hi {
+            return Err(format!("the field is {name}, which holds {lo} to {hi}"));
         }
+        Ok(v as f32)
     }
 
     /// A text list count.
@@ -156,6 +187,30 @@ fn sign_extend(raw: u64, n: usize, signed: bool) -> i128 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn text_integers_must_fit_their_type_and_have_no_fraction() {
+        assert_eq!(Scalar::U8.parse_f32("255"), Ok(255.0));
+        assert_eq!(Scalar::U8.parse_f32("3.0"), Ok(3.0));
+        assert_eq!(Scalar::I8.parse_f32("-128"), Ok(-128.0));
+        assert_eq!(
+            Scalar::U64.parse_f32("18446744073709551615"),
+            Ok(1.8446744e19)
+        );
+        for (ty, s, why) in [
+            (Scalar::U8, "300", "0 to 255"),
+            (Scalar::U8, "-5", "0 to 255"),
+            (Scalar::U8, "1.5", "no fraction"),
+            (Scalar::I8, "-129", "-128 to 127"),
+            (Scalar::U16, "1e30", "0 to 65535"),
+            (Scalar::U16, "inf", "no fraction"),
+            (Scalar::I32, "x", "not a 32-bit integer"),
+            (Scalar::F32, "x", "not a number"),
+        ] {
+            let e = ty.parse_f32(s).unwrap_err();
+            assert!(e.contains(why), "{ty:?} {s}: {e}");
+        }
+    }
 
     #[test]
     fn decodes_each_type_in_both_byte_orders() {
