@@ -29,6 +29,20 @@ fn refused(args: &[&str], names: &[&str], inputs: &[&Path]) {
     }
 }
 
+/// A 5 000-point synthetic scan in `dir`.
+fn small_pile(dir: &TempDir) -> PathBuf {
+    let pile = dir.path().join("pile.pcd");
+    run(&[
+        "generate-pile",
+        "--points",
+        "5000",
+        "--out",
+        pile.to_str().unwrap(),
+    ])
+    .ok();
+    pile
+}
+
 fn edited(dir: &TempDir, name: &str, text: &str, from: &str, to: &str) -> PathBuf {
     dir.write(name, replace_once(text, from, to))
 }
@@ -108,15 +122,7 @@ fn settings_that_exhaust_the_machine_are_refused_with_the_estimate() {
             &[&f],
         );
     }
-    let pile = dir.path().join("pile.pcd");
-    run(&[
-        "generate-pile",
-        "--points",
-        "5000",
-        "--out",
-        pile.to_str().unwrap(),
-    ])
-    .ok();
+    let pile = small_pile(&dir);
     let p = dir.write("p.toml", "[smooth]\niterations = 1000000\n");
     refused(
         &[
@@ -142,15 +148,7 @@ fn settings_that_exhaust_the_machine_are_refused_with_the_estimate() {
 #[test]
 fn messages_name_the_setting_as_the_user_wrote_it() {
     let dir = TempDir::new("hostile-messages");
-    let pile = dir.path().join("pile.pcd");
-    run(&[
-        "generate-pile",
-        "--points",
-        "5000",
-        "--out",
-        pile.to_str().unwrap(),
-    ])
-    .ok();
+    let pile = small_pile(&dir);
     let pile_s = pile.to_str().unwrap();
     for (text, names) in [
         (

@@ -204,6 +204,28 @@ pub fn short(v: f64) -> String {
     }
 }
 
+/// A setting that sizes work past a ceiling: its `(table, key, value)` and
+/// whether restoring its built-in value would bring the work within the
+/// ceiling.
+pub type WorkSetting<'a> = (&'a str, &'a str, f64, bool);
+
+/// [`ConfigError::Invalid`] for work past a ceiling, at the setting at
+/// fault: the first of `settings` whose built-in value would meet the
+/// ceiling, else the last. `expected` states the ceiling and the estimate.
+pub fn over_ceiling(
+    text: &str,
+    file: &str,
+    settings: &[WorkSetting],
+    expected: String,
+) -> ConfigError {
+    let &(table, key, value, _) = settings
+        .iter()
+        .find(|s| s.3)
+        .or(settings.last())
+        .expect("at least one setting");
+    invalid(text, file, (table, 0), key, short(value), expected)
+}
+
 /// `v` to three significant figures, for estimates in messages:
 /// `7.01e9`, `729`, `0.0123`, `7.01e-6`.
 pub fn approx(v: f64) -> String {

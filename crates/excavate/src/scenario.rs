@@ -402,18 +402,14 @@ impl Scenario {
         let (d, p) = (&self.dig, &self.planner);
         let grid = self.grid_points_at(d.step_m, p.search_window_m);
         if grid > MAX_GRID_POINTS {
-            let (table, key, value) = if self.grid_points_at(d.step_m, WINDOW_M) <= MAX_GRID_POINTS
-            {
-                ("planner", "search_window_m", p.search_window_m)
-            } else {
-                ("dig", "step_m", d.step_m)
-            };
-            return Err(config::invalid(
+            let within = |step, window| self.grid_points_at(step, window) <= MAX_GRID_POINTS;
+            return Err(config::over_ceiling(
                 text,
                 file,
-                (table, 0),
-                key,
-                config::short(value),
+                &[
+                    ("planner", "search_window_m", p.search_window_m, within(d.step_m, WINDOW_M)),
+                    ("dig", "step_m", d.step_m, within(STEP_M, p.search_window_m)),
+                ],
                 format!(
                     "at most {} forward-search grid points; with step_m = {} m and search_window_m = {} m the grid round the largest boulder would have about {} ({})",
                     config::approx(MAX_GRID_POINTS),
@@ -427,20 +423,16 @@ impl Scenario {
         }
         let strips = self.strips_at(d.step_m, p.trapezoids as f64);
         if strips > MAX_STEP_SEARCH_STRIPS {
-            let (table, key, value) =
-                if self.strips_at(STEP_M, p.trapezoids as f64) <= MAX_STEP_SEARCH_STRIPS {
-                    ("dig", "step_m", d.step_m)
-                } else if self.strips_at(d.step_m, TRAPEZOIDS) <= MAX_STEP_SEARCH_STRIPS {
-                    ("planner", "trapezoids", p.trapezoids as f64)
-                } else {
-                    ("dig", "start_x_m", d.start_x_m)
-                };
-            return Err(config::invalid(
+            let within =
+                |step, trapezoids| self.strips_at(step, trapezoids) <= MAX_STEP_SEARCH_STRIPS;
+            return Err(config::over_ceiling(
                 text,
                 file,
-                (table, 0),
-                key,
-                config::short(value),
+                &[
+                    ("dig", "step_m", d.step_m, within(STEP_M, p.trapezoids as f64)),
+                    ("planner", "trapezoids", p.trapezoids as f64, within(d.step_m, TRAPEZOIDS)),
+                    ("dig", "start_x_m", d.start_x_m, false),
+                ],
                 format!(
                     "at most {} volume strips per step search; {} steps of {} m from x = {} m, {} trapezoids each, are about {}",
                     config::approx(MAX_STEP_SEARCH_STRIPS),

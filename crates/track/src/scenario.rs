@@ -589,62 +589,51 @@ pub fn from_toml(
 fn check_work(setup: &Setup, text: &str, file: &str) -> Result<(), TrackError> {
     use crate::sim::{worst_case, MAX_CONTROL_STEPS, MAX_PLANT_STEPS, SAMPLE_BYTES};
     let (t_limit, plant, control) = worst_case(setup);
-    let defaults = SimParams::default();
+    let (d, sim) = (SimParams::default(), setup.sim);
+    // The work with one setting back at its default: (plant, control) steps.
     let with = |sim: SimParams| {
-        worst_case(&Setup {
+        let (_, plant, control) = worst_case(&Setup {
             sim,
             ..setup.clone()
-        })
+        });
+        (plant, control)
     };
-    let sim = setup.sim;
-    let fault = |key: &'static str, value: f64, what: String| {
-        TrackError::from(config::invalid(
-            text,
-            file,
-            ("sim", 0),
-            key,
-            config::short(value),
-            what,
-        ))
-    };
-    // The setting at fault: the first whose default would meet the ceiling.
-    let culprit = |over: &dyn Fn(&SimParams) -> bool| {
-        let candidates: [(&'static str, f64, SimParams); 3] = [
+    let restored = [
+        with(SimParams {
+            plant_dt_s: d.plant_dt_s,
+            ..sim
+        }),
+        with(SimParams {
+            control_rate_hz: d.control_rate_hz,
+            ..sim
+        }),
+        with(SimParams {
+            time_per_m_limit_s: d.time_per_m_limit_s,
+            ..sim
+        }),
+    ];
+    let settings = |within: &dyn Fn((f64, f64)) -> bool| {
+        [
+            ("sim", "plant_dt_s", sim.plant_dt_s, within(restored[0])),
             (
-                "plant_dt_s",
-                sim.plant_dt_s,
-                SimParams {
-                    plant_dt_s: defaults.plant_dt_s,
-                    ..sim
-                },
-            ),
-            (
+                "sim",
                 "control_rate_hz",
                 sim.control_rate_hz,
-                SimParams {
-                    control_rate_hz: defaults.control_rate_hz,
-                    ..sim
-                },
+                within(restored[1]),
             ),
             (
+                "sim",
                 "time_per_m_limit_s",
                 sim.time_per_m_limit_s,
-                SimParams {
-                    time_per_m_limit_s: defaults.time_per_m_limit_s,
-                    ..sim
-                },
+                within(restored[2]),
             ),
-        ];
-        candidates.iter().find(|(_, _, s)| !over(s)).map_or(
-            ("time_per_m_limit_s", sim.time_per_m_limit_s),
-            |(k, v, _)| (*k, *v),
-        )
+        ]
     };
     if plant > MAX_PLANT_STEPS {
-        let (key, value) = culprit(&|s| with(*s).1 > MAX_PLANT_STEPS);
-        return Err(fault(
-            key,
-            value,
+        return Err(config::over_ceiling(
+            text,
+            file,
+            &settings(&|(p, _)| p <= MAX_PLANT_STEPS),
             format!(
                 "at most {} plant steps per run; the time limit of {} s at plant_dt_s = {} s and control_rate_hz = {} is about {}",
                 config::approx(MAX_PLANT_STEPS),
@@ -653,13 +642,14 @@ fn check_work(setup: &Setup, text: &str, file: &str) -> Result<(), TrackError> {
                 config::short(sim.control_rate_hz),
                 config::approx(plant)
             ),
-        ));
+        )
+        .into());
     }
     if control > MAX_CONTROL_STEPS {
-        let (key, value) = culprit(&|s| with(*s).2 > MAX_CONTROL_STEPS);
-        return Err(fault(
-            key,
-            value,
+        return Err(config::over_ceiling(
+            text,
+            file,
+            &settings(&|(_, c)| c <= MAX_CONTROL_STEPS),
             format!(
                 "at most {} control steps per run; the time limit of {} s at {} Hz is about {} ({})",
                 config::approx(MAX_CONTROL_STEPS),
@@ -668,7 +658,8 @@ fn check_work(setup: &Setup, text: &str, file: &str) -> Result<(), TrackError> {
                 config::approx(control),
                 config::bytes(control * SAMPLE_BYTES)
             ),
-        ));
+        )
+        .into());
     }
     Ok(())
 }
