@@ -16,6 +16,7 @@ pub(crate) use say;
 
 mod demo;
 mod jobs;
+mod link;
 mod output;
 mod perceive;
 mod pile;
@@ -59,6 +60,15 @@ enum Command {
         /// Built-in scenario name (an unknown one lists them all, by job).
         name: String,
     },
+    /// A simulated shovel PLC on OPC UA: the crawler plant behind a secure server, with its watchdog and faults.
+    PlcSim(link::PlcSimArgs),
+    /// The workstation: drive a PLC (or plc-sim) along a path over secure OPC UA.
+    Drive(link::DriveArgs),
+    /// Acknowledge a PLC's latched fault (the machine must be at rest).
+    PlcAck(link::AckArgs),
+    /// Certificates and trust lists for the machine link.
+    #[command(subcommand)]
+    Pki(link::PkiCommand),
     /// Run every job on its embedded defaults and write one report (index.html).
     Demo {
         /// Report folder.
@@ -121,6 +131,15 @@ fn main() -> ExitCode {
     // Ctrl-C stops any job at once; what it had staged in the output folder
     // goes with it, so nothing half-written is left there.
     let _ = ctrlc::set_handler(|| {
+        // A drive (or plc-sim) ends its own way: setpoints zeroed first.
+        // A second Ctrl-C exits at once.
+        use std::sync::atomic::Ordering;
+        if link::DRIVE_ACTIVE.load(Ordering::Relaxed)
+            && !link::DRIVE_STOP.swap(true, Ordering::Relaxed)
+        {
+            eprintln!("interrupted: zeroing the setpoints");
+            return;
+        }
         autoshovel_report::remove_unfinished();
         eprintln!("interrupted: nothing more was written");
         std::process::exit(130);
@@ -134,6 +153,10 @@ fn main() -> ExitCode {
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
         Command::Scenario { name } => print_scenario(&name),
+        Command::PlcSim(args) => link::plc_sim(&args),
+        Command::Drive(args) => link::drive(&args),
+        Command::PlcAck(args) => link::ack(&args),
+        Command::Pki(cmd) => link::pki_cmd(&cmd),
         Command::Demo { out, json, force } => demo::run(&out, json, force),
     };
     match result {

@@ -207,7 +207,7 @@ fn generate_pile_refuses_scales_that_overflow() {
         ])
         .fails();
         assert!(
-            r.error_message().contains(&format!("scale = {scale}")),
+            r.error_message().contains(&format!("--scale {scale}")),
             "{}",
             r.error_message()
         );

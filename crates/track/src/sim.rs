@@ -11,10 +11,12 @@
 use autoshovel_core::{angle_diff, Pose2};
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{ControlInput, Controller};
+use crate::controller::Controller;
 use crate::geometry::{deviations, RefLeg};
-use crate::plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
-use crate::sensor::{Rtk, RtkParams};
+use crate::machine::Machine;
+use crate::plant::{CrawlerParams, SlipParams, TrackCommand};
+use crate::sensor::RtkParams;
+use crate::workstation::{Decision, Status, Workstation};
 
 /// Closed-loop settings.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -154,7 +156,7 @@ pub struct Metrics {
 }
 
 /// A finished run.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct Run {
     /// Control-tick samples.
     pub samples: Vec<Sample>,
@@ -208,187 +210,113 @@ pub fn worst_case(setup: &Setup) -> (f64, f64, f64) {
     )
 }
 
-/// Runs the closed loop.
-pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
-    let sp = setup.sim;
-    let mut crawler = Crawler::new(setup.crawler, setup.slip, setup.start);
-    let mut rtk = Rtk::new(setup.rtk);
-    let control_dt = 1.0 / sp.control_rate_hz;
-    let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);
-    let dt = control_dt / substeps as f64;
-    let (t_limit, _, _) = worst_case(setup);
-    let mut samples = Vec::new();
-    let mut events = Vec::new();
-    let mut t = 0.0;
-    let mut travelled = 0.0;
-    let mut last_fix: Option<(f64, Pose2)> = None;
-    let mut stale = false;
-    let mut completed = true;
-    let k_rpm = setup.crawler.mps_per_rpm();
-    'legs: for (li, leg) in setup.legs.iter().enumerate() {
-        controller.reset();
-        let dir = leg.direction.sign();
-        let mut s_hint: Option<f64> = None;
-        let mut speed_ref = 0.0f64;
-        let mut stopping = false;
-        let mut true_hint: Option<f64> = None;
-        loop {
-            if t > t_limit {
-                events.push(Event {
-                    t_s: t,
-                    kind: "timeout",
-                    message: format!("leg {li} not finished after {t:.1} s; stopped"),
-                });
-                completed = false;
-                break 'legs;
-            }
-            // Sense.
-            let truth = crawler.state.pose;
-            if let Some(fix) = rtk.poll(truth, t) {
-                let pose = fix.to_pose();
-                if let Some((tf, prev)) = last_fix {
-                    let implied = (pose.position() - prev.position()).norm() / (t - tf).max(1e-9);
-                    if implied > sp.max_plausible_speed_mps
-                        && (pose.position() - prev.position()).norm() > 0.5
-                    {
-                        events.push(Event {
-                            t_s: t,
-                            kind: "pose-jump",
-                            message: format!(
-                                "fix jumped {:.2} m in {:.2} s ({implied:.1} m/s): tracks stopped",
-                                (pose.position() - prev.position()).norm(),
-                                t - tf
-                            ),
-                        });
-                        completed = false;
-                        stop_machine(&mut crawler, dt, &mut t);
-                        break 'legs;
-                    }
-                }
-                if stale {
-                    events.push(Event {
-                        t_s: t,
-                        kind: "pose-recovered",
-                        message: "fixes are back; resuming".into(),
-                    });
-                    stale = false;
-                }
-                last_fix = Some((t, pose));
-            }
-            let Some((tf, measured)) = last_fix else {
-                completed = false;
-                events.push(Event {
-                    t_s: t,
-                    kind: "stale-pose",
-                    message: "no fix at the start: tracks stopped".into(),
-                });
-                break 'legs;
-            };
-            let cmd;
-            let mut steer = 0.0;
-            let remaining_hint = s_hint.map(|h| leg.length_m() - h).unwrap_or(f64::INFINITY);
-            // The preview distance L of [W eq. 21], growing with speed.
-            let mut preview = sp.preview_m + sp.preview_gain_s * speed_ref.abs();
-            if remaining_hint <= sp.terminal_zone_m {
-                preview = preview.max(sp.terminal_preview_m);
-            }
-            let dev = deviations(leg, measured, preview, s_hint);
-            if t - tf > sp.pose_timeout_s + 1e-6 {
-                if !stale {
-                    events.push(Event {
-                        t_s: t,
-                        kind: "stale-pose",
-                        message: format!(
-                            "newest fix is {:.0} ms old (limit {:.0} ms): tracks stopped",
-                            (t - tf) * 1e3,
-                            sp.pose_timeout_s * 1e3
-                        ),
-                    });
-                    stale = true;
-                }
-                speed_ref = 0.0;
-                cmd = TrackCommand::STOP;
-            } else {
-                s_hint = Some(dev.s_a_m);
-                let remaining = leg.length_m() - dev.s_a_m;
-                if remaining <= 0.02 || stopping {
-                    stopping = true;
-                    speed_ref = 0.0;
-                    cmd = TrackCommand::STOP;
-                } else {
-                    let brake = (2.0 * sp.accel_mps2 * remaining).sqrt().max(sp.creep_mps);
-                    let want = sp.speed_mps.min(brake);
-                    speed_ref = (speed_ref.abs() + sp.accel_mps2 * control_dt).min(want) * dir;
-                    let input = ControlInput {
-                        leg,
-                        pose: measured,
-                        dev: &dev,
-                        speed_mps: speed_ref,
-                        dt_s: control_dt,
-                        crawler: &setup.crawler,
-                    };
-                    steer = controller.step(&input);
-                    let base = speed_ref / k_rpm;
-                    cmd = TrackCommand {
-                        left_rpm: base - 0.5 * steer,
-                        right_rpm: base + 0.5 * steer,
-                    }
-                    .saturate(setup.crawler.motor_max_rpm);
-                }
-            }
-            // True deviation from the path for the metrics.
-            let true_dev = deviations(leg, truth, 0.0, true_hint);
-            true_hint = Some(true_dev.s_a_m);
-            samples.push(Sample {
-                t_s: t,
-                leg: li,
-                truth,
-                measured,
-                centroid_dev_m: true_dev.d0_m,
-                heading_error_rad: true_dev.heading_error_rad,
-                d_m: dev.d_m,
-                d0_m: dev.d0_m,
-                speed_ref_mps: speed_ref,
-                steer_rpm: steer,
-                command: cmd,
-                travelled_m: travelled,
-            });
-            if stopping && crawler.state.left_rpm.abs() < 1.0 && crawler.state.right_rpm.abs() < 1.0
-            {
-                events.push(Event {
-                    t_s: t,
-                    kind: Event::LEG_END,
-                    message: format!("leg {li} ({}) done, machine at rest", leg.direction.name()),
-                });
-                break;
-            }
-            for _ in 0..substeps {
-                let before = crawler.state.pose.position();
-                crawler.step(cmd, dt);
-                travelled += (crawler.state.pose.position() - before).norm();
-                t += dt;
-            }
+/// Turns the workstation's decisions into [`Sample`]s, measuring the
+/// pose given as truth against the leg the workstation is on: the
+/// simulator's truth in [`simulate`] and over the link when the PLC is a
+/// simulator, else the measured pose. Kept apart from the workstation,
+/// which never sees the truth.
+#[derive(Debug, Clone, Default)]
+pub struct Evaluator {
+    hint: Option<(usize, f64)>,
+}
+
+impl Evaluator {
+    /// An evaluator at the start of a run.
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The sample of decision `d` taken at `t_s` with the machine at
+    /// `truth` after `travelled_m`.
+    pub fn sample(
+        &mut self,
+        legs: &[RefLeg],
+        d: &Decision,
+        t_s: f64,
+        truth: Pose2,
+        travelled_m: f64,
+    ) -> Sample {
+        let hint = self.hint.filter(|(leg, _)| *leg == d.leg).map(|(_, s)| s);
+        let true_dev = deviations(&legs[d.leg], truth, 0.0, hint);
+        self.hint = Some((d.leg, true_dev.s_a_m));
+        Sample {
+            t_s,
+            leg: d.leg,
+            truth,
+            measured: d.measured,
+            centroid_dev_m: true_dev.d0_m,
+            heading_error_rad: true_dev.heading_error_rad,
+            d_m: d.dev.d_m,
+            d0_m: d.dev.d0_m,
+            speed_ref_mps: d.speed_ref_mps,
+            steer_rpm: d.steer_rpm,
+            command: d.command,
+            travelled_m,
         }
     }
-    let metrics = measure(&samples, setup, crawler.state.pose, travelled, t, completed);
+}
+
+/// Plant steps per control tick and their length [s].
+pub fn plant_steps(sp: &SimParams) -> (usize, f64) {
+    let control_dt = 1.0 / sp.control_rate_hz;
+    let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);
+    (substeps, control_dt / substeps as f64)
+}
+
+/// Most plant steps [`simulate`] spends bringing the machine to rest after
+/// a safety stop.
+pub const MAX_STOP_STEPS: usize = 100_000;
+
+/// Runs the closed loop in one process: the [`Workstation`] (controller and
+/// safety, on RTK fixes alone) against the simulated [`Machine`], the
+/// metrics measured on the machine's truth.
+pub fn simulate(setup: &Setup, controller: &mut dyn Controller) -> Run {
+    let (substeps, dt) = plant_steps(&setup.sim);
+    let (t_limit, _, _) = worst_case(setup);
+    let mut machine = Machine::new(setup.crawler, setup.slip, setup.rtk, setup.start);
+    let mut ws = Workstation::new(&setup.legs, setup.crawler, setup.sim, controller, t_limit);
+    let mut eval = Evaluator::new();
+    let mut samples = Vec::new();
+    let status = loop {
+        let fix = machine.poll_rtk();
+        let tick = ws.tick(machine.time_s(), fix, machine.motors_rpm());
+        for d in &tick.decisions {
+            samples.push(eval.sample(
+                &setup.legs,
+                d,
+                machine.time_s(),
+                machine.truth(),
+                machine.travelled_m(),
+            ));
+        }
+        match tick.status {
+            Status::Running => machine.advance(tick.command(), dt, substeps),
+            Status::Stopped => {
+                machine.stop(dt, MAX_STOP_STEPS);
+                break Status::Stopped;
+            }
+            s => break s,
+        }
+    };
+    let completed = status == Status::Finished;
+    let metrics = measure(
+        &samples,
+        setup,
+        machine.truth(),
+        machine.travelled_m(),
+        machine.time_s(),
+        completed,
+    );
     Run {
         samples,
-        events,
+        events: ws.events,
         metrics,
     }
 }
 
-fn stop_machine(crawler: &mut Crawler, dt: f64, t: &mut f64) {
-    for _ in 0..100_000 {
-        if crawler.state.left_rpm.abs() < 1.0 && crawler.state.right_rpm.abs() < 1.0 {
-            break;
-        }
-        crawler.step(TrackCommand::STOP, dt);
-        *t += dt;
-    }
-}
-
-fn measure(
+/// The measures of a run from its samples (SPEC §3): `end` is the final
+/// pose, `travelled` the distance, `t` the duration.
+pub fn measure(
     samples: &[Sample],
     setup: &Setup,
     end: Pose2,

@@ -1,0 +1,506 @@
+//! The machine link's commands: `plc-sim` (a simulated shovel PLC on OPC
+//! UA), `drive` (the workstation driving a PLC along a path), `plc-ack`
+//! (a person acknowledging a latched fault) and `pki` (certificates and
+//! trust lists). The model, the PLC, the workstation and the certificates
+//! are `autoshovel_link`; this module parses, runs and writes.
+
+use std::path::{Path, PathBuf};
+use std::sync::atomic::{AtomicBool, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use anyhow::{bail, Context, Result};
+use autoshovel_link::drive::{DriveSummary, LinkSummary};
+use autoshovel_link::{
+    pki, Clock, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy, ServeParams,
+};
+use autoshovel_track::scenario::{resolve, TrackScenario};
+use autoshovel_track::sim::worst_case;
+use autoshovel_track::{ControllerKind, ControllerRun, Tracking};
+
+use crate::output::{out_dir, Job};
+use crate::track::{ControllerArg, NoiseArg};
+
+/// Set by Ctrl-C while a drive runs: the drive zeroes the setpoints and ends.
+pub static DRIVE_STOP: AtomicBool = AtomicBool::new(false);
+/// Whether a drive is running (Ctrl-C then stops it instead of exiting).
+pub static DRIVE_ACTIVE: AtomicBool = AtomicBool::new(false);
+
+/// The default endpoint (4840: the OPC UA port registered with IANA).
+const DEFAULT_ENDPOINT: &str = "opc.tcp://127.0.0.1:4840/";
+
+/// Security and identity, shared by `drive` and `plc-ack`.
+#[derive(Debug, clap::Args)]
+pub struct SecurityArgs {
+    /// PKI folder (`plc/` and `workstation/` certificates and trust lists,
+    /// the operator's password); made on first use.
+    #[arg(long, default_value = "pki")]
+    pub pki: PathBuf,
+    /// User name to log in as (writing setpoints needs one).
+    #[arg(long, default_value = pki::OPERATOR)]
+    pub user: String,
+    /// File whose first line is the user's password (default: PKI/operator.password).
+    #[arg(long)]
+    pub password_file: Option<PathBuf>,
+    /// Security policy (always SignAndEncrypt; `none` needs --insecure).
+    #[arg(long, value_enum, default_value = "basic256sha256")]
+    pub policy: PolicyArg,
+    /// Allow security None (logged loudly).
+    #[arg(long)]
+    pub insecure: bool,
+}
+
+/// Policy choice.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
+pub enum PolicyArg {
+    /// Basic256Sha256, SignAndEncrypt.
+    Basic256sha256,
+    /// Aes256-Sha256-RsaPss, SignAndEncrypt.
+    Aes256sha256rsapss,
+    /// No security (needs --insecure).
+    None,
+}
+
+impl SecurityArgs {
+    fn password(&self) -> Result<String> {
+        let file = self
+            .password_file
+            .clone()
+            .unwrap_or_else(|| self.pki.join(pki::PASSWORD_FILE));
+        Ok(pki::read_password(&file)?)
+    }
+
+    fn link(&self, endpoint: &str) -> Result<LinkParams> {
+        first_use(&self.pki)?;
+        let mut p = LinkParams::new(
+            endpoint,
+            self.pki.clone(),
+            Some((self.user.clone(), self.password()?)),
+        );
+        p.policy = match self.policy {
+            PolicyArg::Basic256sha256 => Policy::Basic256Sha256,
+            PolicyArg::Aes256sha256rsapss => Policy::Aes256Sha256RsaPss,
+            PolicyArg::None => Policy::None,
+        };
+        p.insecure = self.insecure;
+        Ok(p)
+    }
+}
+
+/// Makes the PKI folder on first use (when it does not exist at all).
+fn first_use(root: &Path) -> Result<()> {
+    if root.exists() {
+        return Ok(());
+    }
+    let r = pki::init(root, &[])?;
+    eprintln!(
+        "made {}: plc and workstation certificates, each trusting the other{}",
+        root.display(),
+        r.password_file
+            .map(|p| format!("; the operator's password in {}", p.display()))
+            .unwrap_or_default()
+    );
+    Ok(())
+}
+
+fn runtime() -> Result<tokio::runtime::Runtime> {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .context("starting the async runtime")
+}
+
+fn scenario_of(name: &str, noise: Option<NoiseArg>, seed: u64) -> Result<TrackScenario> {
+    let noise = noise.map(|n| match n {
+        NoiseArg::Off => autoshovel_track::Noise::Off,
+        NoiseArg::Rtk => autoshovel_track::Noise::Rtk,
+    });
+    Ok(resolve(name, noise, seed)?)
+}
+
+/// Arguments of `plc-sim`.
+#[derive(Debug, clap::Args)]
+pub struct PlcSimArgs {
+    /// The scenario whose machine, ground, receiver and start pose to simulate (as `track` takes it).
+    #[arg(long, default_value = "curve")]
+    pub scenario: String,
+    /// Sensor noise and slip (default: off for fig9a/b, rtk for the others).
+    #[arg(long, value_enum)]
+    pub noise: Option<NoiseArg>,
+    /// Seed of the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Address to listen on.
+    #[arg(long, default_value = "127.0.0.1")]
+    pub host: String,
+    /// Port (4840 is OPC UA's; 0 picks a free one and prints it).
+    #[arg(long, default_value_t = 4840)]
+    pub port: u16,
+    /// Machine time per wall-clock time (1 = real time).
+    #[arg(long, default_value_t = 1.0)]
+    pub time_scale: f64,
+    /// Advance one control period each time the workstation answers (exact repeats under any load).
+    #[arg(long, conflicts_with = "time_scale")]
+    pub lockstep: bool,
+    /// Start in manual mode (setpoints ignored).
+    #[arg(long)]
+    pub manual: bool,
+    /// Inject a fault at a machine time: KIND@SECONDS[:VALUE], KIND one of
+    /// rtk-dropout, rtk-jump, rtk-freeze, link-cut, delay (VALUE: duration
+    /// [s], for rtk-jump the offset [m]; default 1). Repeatable.
+    #[arg(long = "fault")]
+    pub faults: Vec<String>,
+    /// Stop after this many wall-clock seconds (default: run until Ctrl-C).
+    #[arg(long)]
+    pub duration: Option<f64>,
+    /// PKI folder (made on first use).
+    #[arg(long, default_value = "pki")]
+    pub pki: PathBuf,
+    /// The operator's password file (default: PKI/operator.password).
+    #[arg(long)]
+    pub password_file: Option<PathBuf>,
+    /// Also offer security None (logged loudly).
+    #[arg(long)]
+    pub insecure: bool,
+    /// Print the PLC's summary JSON alone on stdout at the end.
+    #[arg(long)]
+    pub json: bool,
+}
+
+fn parse_fault(s: &str) -> Result<(f64, FaultKind)> {
+    let (kind, rest) = s
+        .split_once('@')
+        .with_context(|| format!("--fault {s}: expected KIND@SECONDS[:VALUE]"))?;
+    let (at, value) = match rest.split_once(':') {
+        Some((a, v)) => (a, v),
+        None => (rest, "1"),
+    };
+    let at: f64 = at
+        .parse()
+        .ok()
+        .filter(|t: &f64| t.is_finite() && *t >= 0.0)
+        .with_context(|| format!("--fault {s}: time {at:?} is not a number of seconds ≥ 0"))?;
+    let value: f64 = value
+        .parse()
+        .with_context(|| format!("--fault {s}: value {value:?} is not a number"))?;
+    let f = FaultKind::parse(kind, value).map_err(|e| anyhow::anyhow!("--fault {s}: {e}"))?;
+    Ok((at, f))
+}
+
+/// Runs `plc-sim`.
+pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
+    if !(args.time_scale.is_finite() && args.time_scale > 0.0 && args.time_scale <= 100.0) {
+        bail!(
+            "--time-scale {}: expected a factor in (0, 100]",
+            args.time_scale
+        );
+    }
+    let scenario = scenario_of(&args.scenario, args.noise, args.seed)?;
+    let schedule = args
+        .faults
+        .iter()
+        .map(|f| parse_fault(f))
+        .collect::<Result<Vec<_>>>()?;
+    first_use(&args.pki)?;
+    let password = pki::read_password(
+        &args
+            .password_file
+            .clone()
+            .unwrap_or_else(|| args.pki.join(pki::PASSWORD_FILE)),
+    )?;
+    let params = PlcParams {
+        setup: scenario.setup.clone(),
+        clock: if args.lockstep {
+            Clock::Lockstep
+        } else {
+            Clock::Scaled(args.time_scale)
+        },
+        heartbeat_timeout: Duration::from_millis(300),
+        auto: !args.manual,
+        schedule,
+    };
+    let serve = ServeParams {
+        host: args.host.clone(),
+        port: args.port,
+        pki: args.pki.clone(),
+        insecure: args.insecure,
+        users: vec![(pki::OPERATOR.to_string(), password)],
+    };
+    let rt = runtime()?;
+    DRIVE_STOP.store(false, Ordering::Relaxed);
+    DRIVE_ACTIVE.store(true, Ordering::Relaxed);
+    let summary = rt.block_on(async {
+        let server = PlcServer::start(params, serve).await?;
+        eprintln!(
+            "plc-sim: {} on {} ({}; machine of scenario {}, seed {}); Ctrl-C to stop",
+            if args.lockstep { "lockstep" } else { "running" },
+            server.endpoint(),
+            if args.insecure {
+                "Basic256Sha256 / Aes256-Sha256-RsaPss SignAndEncrypt, and None"
+            } else {
+                "Basic256Sha256 / Aes256-Sha256-RsaPss SignAndEncrypt"
+            },
+            scenario.name,
+            args.seed
+        );
+        let until = args.duration.map(Duration::from_secs_f64);
+        let mut seen = 0usize;
+        let t0 = tokio::time::Instant::now();
+        loop {
+            tokio::time::sleep(Duration::from_millis(20)).await;
+            {
+                let p = server.plc.lock().unwrap_or_else(|e| e.into_inner());
+                for e in &p.events[seen..] {
+                    eprintln!(
+                        "plc-sim: t = {:.2} s (wall {:.2} s): {}: {}",
+                        e.t_s, e.wall_s, e.kind, e.message
+                    );
+                }
+                seen = p.events.len();
+            }
+            if DRIVE_STOP.load(Ordering::Relaxed) || until.is_some_and(|u| t0.elapsed() >= u) {
+                break;
+            }
+        }
+        let p = server.plc.lock().unwrap_or_else(|e| e.into_inner());
+        let s = serde_json::json!({
+            "job": "plc-sim",
+            "scenario": scenario.name,
+            "seed": args.seed,
+            "endpoint": server.endpoint(),
+            "machine_time_s": p.machine.time_s(),
+            "travelled_m": p.machine.travelled_m(),
+            "fault": p.fault.as_ref().map(|f| f.1.clone()),
+            "faults_latched": p.stops.len(),
+            "moved_while_faulted": p.moved_while_faulted(),
+            "events": p.events,
+            "success": !p.moved_while_faulted(),
+        });
+        drop(p);
+        server.stop().await;
+        Ok::<_, anyhow::Error>(s)
+    })?;
+    if args.json {
+        crate::output::print_json(&summary)?;
+    }
+    Ok(())
+}
+
+/// Arguments of `drive`.
+#[derive(Debug, clap::Args)]
+pub struct DriveArgs {
+    /// The PLC's endpoint.
+    #[arg(long, default_value = DEFAULT_ENDPOINT)]
+    pub endpoint: String,
+    /// The path to drive: as `track` takes it (a built-in or a TOML file).
+    #[arg(long, default_value = "curve")]
+    pub scenario: String,
+    /// Tracker.
+    #[arg(long, value_enum, default_value = "fuzzy")]
+    pub controller: ControllerArg,
+    /// The scenario's noise setting (the machine's own noise is the PLC's; this sets the loop's parameters as `track` does).
+    #[arg(long, value_enum)]
+    pub noise: Option<NoiseArg>,
+    /// The scenario's seed.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Security and identity.
+    #[command(flatten)]
+    pub security: SecurityArgs,
+    /// Give up when the link stays down this long [s].
+    #[arg(long, default_value_t = 30.0)]
+    pub link_timeout: f64,
+    /// Give up waiting for a fault's acknowledgement after this long [s].
+    #[arg(long, default_value_t = 600.0)]
+    pub ack_timeout: f64,
+    /// Write summary.json, CSV and plots here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write.
+    #[arg(long)]
+    pub force: bool,
+    /// Print the summary JSON alone on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs `drive`.
+pub fn drive(args: &DriveArgs) -> Result<()> {
+    for (flag, v) in [
+        ("--link-timeout", args.link_timeout),
+        ("--ack-timeout", args.ack_timeout),
+    ] {
+        if !(v.is_finite() && v > 0.0 && v <= 86_400.0) {
+            bail!("{flag} {v}: expected seconds in (0, 86400]");
+        }
+    }
+    let scenario = scenario_of(&args.scenario, args.noise, args.seed)?;
+    let out = out_dir(
+        args.out.as_deref(),
+        &[Some(Path::new(&args.scenario))],
+        args.force,
+    )?;
+    let mut params = args.security.link(&args.endpoint)?;
+    params.link_timeout = Duration::from_secs_f64(args.link_timeout);
+    params.ack_timeout = Duration::from_secs_f64(args.ack_timeout);
+    let kind: ControllerKind = args.controller.into();
+    let mut ctl = kind.build(&scenario.controllers);
+    let (t_limit, _, _) = worst_case(&scenario.setup);
+    let rt = runtime()?;
+    DRIVE_STOP.store(false, Ordering::Relaxed);
+    DRIVE_ACTIVE.store(true, Ordering::Relaxed);
+    let stop = Arc::new(AtomicBool::new(false));
+    let stop_c = stop.clone();
+    let t0 = std::time::Instant::now();
+    let got = rt.block_on(async {
+        let watcher = tokio::spawn(async move {
+            loop {
+                if DRIVE_STOP.load(Ordering::Relaxed) {
+                    stop_c.store(true, Ordering::Relaxed);
+                }
+                tokio::time::sleep(Duration::from_millis(5)).await;
+            }
+        });
+        let link = Link::open(&params).await?;
+        let r = autoshovel_link::drive(
+            &link,
+            &scenario.setup,
+            ctl.as_mut(),
+            t_limit,
+            params.ack_timeout,
+            params.link_timeout,
+            stop,
+        )
+        .await;
+        link.close().await;
+        watcher.abort();
+        r
+    });
+    DRIVE_ACTIVE.store(false, Ordering::Relaxed);
+    let run = got?;
+    let link_summary = LinkSummary::of(&run, &params);
+    let tracking = Tracking {
+        runs: vec![ControllerRun {
+            kind,
+            name: ctl.name(),
+            gains: ctl.gains(),
+            run: run.run,
+            sim_time_ms: t0.elapsed().as_secs_f64() * 1e3,
+        }],
+        main: 0,
+        compare: false,
+    };
+    let mut track = tracking.summary(&scenario);
+    track.job = "drive";
+    let summary = DriveSummary {
+        track,
+        link: link_summary,
+    };
+    for e in summary.track.events.iter().filter(|e| e.is_safety()) {
+        eprintln!("safety: t = {:.2} s: {} ({})", e.t_s, e.message, e.kind);
+    }
+    for e in &summary.link.events {
+        eprintln!("link: wall {:.2} s: {} ({})", e.wall_s, e.message, e.kind);
+    }
+    let job = Job::finish(summary, out.as_ref(), |dir, written| {
+        autoshovel_figures::track::write(dir, &scenario, &tracking, written)
+            .context("writing the drive figures")
+    })?;
+    job.report(args.json, |s: &DriveSummary| {
+        let m = &s.track.run.metrics;
+        crate::say!(
+            "drive {} over {} ({:?}, metrics on {}): max dev {:.3} m, mean dev {:.3} m, final pos err {:.3} m, completed {}",
+            s.track.scenario,
+            s.link.endpoint,
+            s.link.policy,
+            s.link.metrics_on,
+            m.max_centroid_dev_m,
+            m.mean_centroid_dev_m,
+            m.final_position_error_m,
+            m.completed
+        );
+        crate::say!(
+            "round trips: read p50 {:.2} ms p99 {:.2} ms, write p50 {:.2} ms p99 {:.2} ms",
+            s.link.read_ms.p50,
+            s.link.read_ms.p99,
+            s.link.write_ms.p50,
+            s.link.write_ms.p99
+        );
+    })?;
+    match job.summary.track.failure() {
+        Some(e) => Err(e.into()),
+        None => Ok(()),
+    }
+}
+
+/// Arguments of `plc-ack`.
+#[derive(Debug, clap::Args)]
+pub struct AckArgs {
+    /// The PLC's endpoint.
+    #[arg(long, default_value = DEFAULT_ENDPOINT)]
+    pub endpoint: String,
+    /// Security and identity.
+    #[command(flatten)]
+    pub security: SecurityArgs,
+}
+
+/// Runs `plc-ack`: calls the PLC's Acknowledge method.
+pub fn ack(args: &AckArgs) -> Result<()> {
+    let params = args.security.link(&args.endpoint)?;
+    let rt = runtime()?;
+    rt.block_on(async {
+        let link = Link::open(&params).await?;
+        let r = link.acknowledge().await;
+        link.close().await;
+        r
+    })?;
+    crate::say!("acknowledged on {}", args.endpoint);
+    Ok(())
+}
+
+/// `pki` subcommands.
+#[derive(Debug, clap::Subcommand)]
+pub enum PkiCommand {
+    /// Make the plc and workstation certificates (keeping existing ones),
+    /// have each trust the other, and make the operator's password file.
+    Init {
+        /// PKI folder.
+        #[arg(long, default_value = "pki")]
+        dir: PathBuf,
+        /// Extra host names or addresses the PLC's certificate names.
+        #[arg(long = "host")]
+        hosts: Vec<String>,
+    },
+    /// Add a peer's certificate (DER or PEM) to an application's trust list.
+    Trust {
+        /// The application's folder (e.g. pki/workstation).
+        #[arg(long)]
+        dir: PathBuf,
+        /// The certificate to trust.
+        cert: PathBuf,
+    },
+}
+
+/// Runs `pki`.
+pub fn pki_cmd(cmd: &PkiCommand) -> Result<()> {
+    match cmd {
+        PkiCommand::Init { dir, hosts } => {
+            let r = pki::init(dir, hosts)?;
+            for p in &r.made {
+                crate::say!("made {}", p.display());
+            }
+            for p in &r.trusted {
+                crate::say!("trusted {}", p.display());
+            }
+            if let Some(p) = r.password_file {
+                crate::say!("operator password in {} (mode 0600)", p.display());
+            }
+        }
+        PkiCommand::Trust { dir, cert } => {
+            let to = pki::trust(dir, cert)?;
+            crate::say!("trusted {}", to.display());
+        }
+    }
+    Ok(())
+}

@@ -1,0 +1,204 @@
+//! Application-instance certificates and trust lists, laid out as
+//! async-opcua (and most OPC UA stacks) expect: per application a folder
+//! with `own/cert.der`, `private/private.pem`, `trusted/` and `rejected/`.
+//!
+//! `autoshovel pki init DIR` makes `DIR/plc` and `DIR/workstation`, each
+//! trusting the other, and the operator's password file; `autoshovel pki
+//! trust` adds a peer's certificate to a trust list. A certificate a peer
+//! presents that is not in the trust list is refused and copied to
+//! `rejected/`, from where a person moves it to `trusted/` after checking it.
+
+use std::fs;
+use std::path::{Path, PathBuf};
+
+use opcua::crypto::{CertificateStore, X509Data, X509};
+use opcua::types::ApplicationDescription;
+use rand::Rng;
+
+use crate::error::LinkError;
+
+/// The two applications of the link.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum Role {
+    /// The PLC (or `plc-sim`): the OPC UA server.
+    Plc,
+    /// The workstation (`drive`): the OPC UA client.
+    Workstation,
+}
+
+impl Role {
+    /// Folder name under the PKI root.
+    pub fn dir_name(self) -> &'static str {
+        match self {
+            Role::Plc => "plc",
+            Role::Workstation => "workstation",
+        }
+    }
+
+    /// The application URI in the certificate.
+    pub fn application_uri(self) -> &'static str {
+        match self {
+            Role::Plc => "urn:autoshovel:plc-sim",
+            Role::Workstation => "urn:autoshovel:workstation",
+        }
+    }
+
+    /// The application name.
+    pub fn application_name(self) -> &'static str {
+        match self {
+            Role::Plc => "autoshovel plc-sim",
+            Role::Workstation => "autoshovel workstation",
+        }
+    }
+
+    /// The other end.
+    pub fn peer(self) -> Role {
+        match self {
+            Role::Plc => Role::Workstation,
+            Role::Workstation => Role::Plc,
+        }
+    }
+}
+
+/// Name of the operator's password file under the PKI root.
+pub const PASSWORD_FILE: &str = "operator.password";
+/// The user name `pki init` sets up.
+pub const OPERATOR: &str = "operator";
+
+fn pki_err(path: &Path, why: impl Into<String>) -> LinkError {
+    LinkError::Pki {
+        path: path.to_path_buf(),
+        why: why.into(),
+    }
+}
+
+/// The folder of `role` under `root`.
+pub fn role_dir(root: &Path, role: Role) -> PathBuf {
+    root.join(role.dir_name())
+}
+
+/// The certificate of `role` under `root`.
+pub fn own_cert(root: &Path, role: Role) -> PathBuf {
+    role_dir(root, role).join("own").join("cert.der")
+}
+
+/// Makes `role`'s certificate and key under `root` unless they exist;
+/// `hosts` are the DNS names and addresses the certificate names (a client
+/// checks the server's against the endpoint's host). Returns whether it
+/// made them.
+pub fn ensure(root: &Path, role: Role, hosts: &[String]) -> Result<bool, LinkError> {
+    let dir = role_dir(root, role);
+    let store = CertificateStore::new(&dir);
+    store.ensure_pki_path().map_err(|e| pki_err(&dir, e))?;
+    if store.own_certificate_path().exists() && store.own_private_key_path().exists() {
+        return Ok(false);
+    }
+    let desc = ApplicationDescription {
+        application_uri: role.application_uri().into(),
+        application_name: role.application_name().into(),
+        ..Default::default()
+    };
+    let mut names: Vec<String> = vec!["localhost".into(), "127.0.0.1".into()];
+    names.extend(hosts.iter().cloned());
+    names.extend(X509Data::computer_hostnames());
+    names.sort();
+    names.dedup();
+    let mut data = X509Data::from((desc, Some(names)));
+    data.key_size = 2048;
+    data.certificate_duration_days = 3 * 365;
+    data.organization = "autoshovel".into();
+    store
+        .create_and_store_application_instance_cert(&data, false)
+        .map_err(|e| pki_err(&store.own_certificate_path(), e))?;
+    Ok(true)
+}
+
+/// Adds the certificate at `cert` (DER or PEM) to the trust list of the
+/// application folder `dir`; returns where it went.
+pub fn trust(dir: &Path, cert: &Path) -> Result<PathBuf, LinkError> {
+    let bytes = fs::read(cert).map_err(|e| pki_err(cert, e.to_string()))?;
+    let x = X509::from_der(&bytes)
+        .or_else(|_| X509::from_pem(&bytes))
+        .map_err(|e| pki_err(cert, format!("not an X.509 certificate (DER or PEM): {e}")))?;
+    let store = CertificateStore::new(dir);
+    store.ensure_pki_path().map_err(|e| pki_err(dir, e))?;
+    let to = store
+        .trusted_certs_dir()
+        .join(CertificateStore::cert_file_name(&x));
+    let der = x.to_der().map_err(|e| pki_err(cert, e.to_string()))?;
+    fs::write(&to, der).map_err(|e| pki_err(&to, e.to_string()))?;
+    Ok(to)
+}
+
+/// What `init` did.
+#[derive(Debug, Clone, Default)]
+pub struct InitReport {
+    /// Certificates made.
+    pub made: Vec<PathBuf>,
+    /// Certificates added to trust lists.
+    pub trusted: Vec<PathBuf>,
+    /// The password file, if it was made.
+    pub password_file: Option<PathBuf>,
+}
+
+/// Makes both applications' certificates under `root` (keeping any that
+/// exist), has each trust the other, and makes the operator's password
+/// file (mode 0600) unless it exists.
+pub fn init(root: &Path, hosts: &[String]) -> Result<InitReport, LinkError> {
+    let mut report = InitReport::default();
+    for role in [Role::Plc, Role::Workstation] {
+        if ensure(root, role, hosts)? {
+            report.made.push(own_cert(root, role));
+        }
+    }
+    for role in [Role::Plc, Role::Workstation] {
+        let peer = own_cert(root, role.peer());
+        report.trusted.push(trust(&role_dir(root, role), &peer)?);
+    }
+    let pw = root.join(PASSWORD_FILE);
+    if !pw.exists() {
+        let mut rng = rand::rngs::OsRng;
+        const CHARS: &[u8] = b"abcdefghijkmnpqrstuvwxyzABCDEFGHJKLMNPQRSTUVWXYZ23456789";
+        let secret: String = (0..24)
+            .map(|_| CHARS[rng.gen_range(0..CHARS.len())] as char)
+            .collect();
+        write_secret(&pw, &secret)?;
+        report.password_file = Some(pw);
+    }
+    Ok(report)
+}
+
+fn write_secret(path: &Path, secret: &str) -> Result<(), LinkError> {
+    #[cfg(unix)]
+    {
+        use std::io::Write;
+        use std::os::unix::fs::OpenOptionsExt;
+        let mut f = fs::OpenOptions::new()
+            .write(true)
+            .create_new(true)
+            .mode(0o600)
+            .open(path)
+            .map_err(|e| pki_err(path, e.to_string()))?;
+        f.write_all(secret.as_bytes())
+            .map_err(|e| pki_err(path, e.to_string()))
+    }
+    #[cfg(not(unix))]
+    {
+        fs::write(path, secret).map_err(|e| pki_err(path, e.to_string()))
+    }
+}
+
+/// Reads a password file (its first line).
+pub fn read_password(path: &Path) -> Result<String, LinkError> {
+    let s = fs::read_to_string(path).map_err(|e| {
+        pki_err(
+            path,
+            format!("{e}; `autoshovel pki init` makes it, or pass --password-file"),
+        )
+    })?;
+    let line = s.lines().next().unwrap_or("").trim().to_string();
+    if line.is_empty() {
+        return Err(pki_err(path, "the password file is empty"));
+    }
+    Ok(line)
+}

@@ -1,0 +1,139 @@
+//! The simulated network in front of `plc-sim`: a TCP relay between the
+//! public port and the OPC UA server's own, which can cut every connection
+//! and refuse new ones for a while (pulling the cable), or hold back the
+//! server's replies (a slow link). It passes bytes and knows nothing of the
+//! protocol; it tells the PLC when a workstation's connection ends, as a
+//! PLC's communication processor does.
+
+use std::net::SocketAddr;
+use std::sync::atomic::{AtomicU64, Ordering};
+use std::sync::Arc;
+use std::time::Duration;
+
+use tokio::io::{AsyncReadExt, AsyncWriteExt};
+use tokio::net::{TcpListener, TcpStream};
+use tokio::sync::watch;
+use tokio::time::Instant;
+
+/// The relay's switches, shared with the PLC.
+#[derive(Debug)]
+pub struct RelayControl {
+    /// Connections are refused and cut until this instant.
+    cut_until: watch::Sender<Option<Instant>>,
+    /// Server → client bytes are held this long [µs].
+    delay_us: AtomicU64,
+    /// Number of connections that have ended (either side, or cut).
+    pub closed: AtomicU64,
+}
+
+impl RelayControl {
+    fn new() -> Self {
+        Self {
+            cut_until: watch::channel(None).0,
+            delay_us: AtomicU64::new(0),
+            closed: AtomicU64::new(0),
+        }
+    }
+
+    /// Cuts every connection now and refuses new ones for `d`.
+    pub fn cut(&self, d: Duration) {
+        self.cut_until.send_replace(Some(Instant::now() + d));
+    }
+
+    /// Holds the server's replies back by `d` (zero: no delay).
+    pub fn delay(&self, d: Duration) {
+        self.delay_us.store(
+            d.as_micros().min(u64::MAX as u128) as u64,
+            Ordering::Relaxed,
+        );
+    }
+
+    fn is_cut(&self) -> bool {
+        matches!(*self.cut_until.borrow(), Some(t) if Instant::now() < t)
+    }
+}
+
+/// Starts a relay from `listener` to `upstream`; `on_close` is called each
+/// time a relayed connection ends.
+pub fn spawn(
+    listener: TcpListener,
+    upstream: SocketAddr,
+    on_close: Arc<dyn Fn() + Send + Sync>,
+) -> Arc<RelayControl> {
+    let control = Arc::new(RelayControl::new());
+    let ctl = control.clone();
+    tokio::spawn(async move {
+        loop {
+            let Ok((client, _)) = listener.accept().await else {
+                continue;
+            };
+            if ctl.is_cut() {
+                drop(client);
+                continue;
+            }
+            let ctl = ctl.clone();
+            let on_close = on_close.clone();
+            tokio::spawn(async move {
+                if let Ok(server) = TcpStream::connect(upstream).await {
+                    pipe(client, server, &ctl).await;
+                }
+                ctl.closed.fetch_add(1, Ordering::Relaxed);
+                on_close();
+            });
+        }
+    });
+    control
+}
+
+async fn pipe(client: TcpStream, server: TcpStream, ctl: &RelayControl) {
+    let _ = client.set_nodelay(true);
+    let _ = server.set_nodelay(true);
+    let (mut cr, mut cw) = client.into_split();
+    let (mut sr, mut sw) = server.into_split();
+    let mut cut = ctl.cut_until.subscribe();
+    let up = async {
+        let mut buf = vec![0u8; 64 * 1024];
+        loop {
+            match cr.read(&mut buf).await {
+                Ok(0) | Err(_) => break,
+                Ok(n) => {
+                    if sw.write_all(&buf[..n]).await.is_err() {
+                        break;
+                    }
+                }
+            }
+        }
+    };
+    let down = async {
+        let mut buf = vec![0u8; 64 * 1024];
+        loop {
+            match sr.read(&mut buf).await {
+                Ok(0) | Err(_) => break,
+                Ok(n) => {
+                    let d = ctl.delay_us.load(Ordering::Relaxed);
+                    if d > 0 {
+                        tokio::time::sleep(Duration::from_micros(d)).await;
+                    }
+                    if cw.write_all(&buf[..n]).await.is_err() {
+                        break;
+                    }
+                }
+            }
+        }
+    };
+    let cut_now = async {
+        loop {
+            if ctl.is_cut() {
+                break;
+            }
+            if cut.changed().await.is_err() {
+                std::future::pending::<()>().await;
+            }
+        }
+    };
+    tokio::select! {
+        _ = up => {}
+        _ = down => {}
+        _ = cut_now => {}
+    }
+}

@@ -1,0 +1,537 @@
+//! `autoshovel plc-sim`: the simulated PLC ([`crate::plc::Plc`]) behind an
+//! OPC UA server (async-opcua) on the model of [`crate::model`], with the
+//! network relay of [`crate::relay`] in front for link faults.
+//!
+//! Security: endpoints Basic256Sha256 and Aes256-Sha256-RsaPss, both
+//! SignAndEncrypt, with the PLC's application-instance certificate and a
+//! trust list (`pki/plc/trusted`); a client certificate not in the list is
+//! refused and copied to `pki/plc/rejected`. Security None is offered only
+//! with `insecure` (and then logged loudly). The operator's user name and
+//! password are needed to write and to call methods; an anonymous session
+//! may browse and read (an HMI's view), never write.
+
+use std::collections::BTreeMap;
+use std::net::SocketAddr;
+use std::path::PathBuf;
+use std::sync::{Arc, Mutex, MutexGuard};
+use std::time::Duration;
+
+use async_trait::async_trait;
+use opcua::crypto::{SecurityPolicy, Thumbprint};
+use opcua::server::address_space::{AccessLevel, MethodBuilder, VariableBuilder};
+use opcua::server::authenticator::{AuthManager, DefaultAuthenticator, Password, UserToken};
+use opcua::server::diagnostics::NamespaceMetadata;
+use opcua::server::node_manager::memory::{simple_node_manager, SimpleNodeManager};
+use opcua::server::{
+    ServerBuilder, ServerEndpoint, ServerHandle, ServerUserToken, ANONYMOUS_USER_TOKEN_ID,
+};
+use opcua::types::{
+    DataTypeId, DataValue, DateTime, Error as UaError, MessageSecurityMode, NodeId, ObjectId,
+    StatusCode, UAString, UserTokenPolicy, Variant,
+};
+use tokio::net::TcpListener;
+use tokio::time::Instant;
+
+use crate::error::LinkError;
+use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, FOLDERS, INJECT_FAULT, NAMESPACE_URI};
+use crate::pki::{self, Role};
+use crate::plc::{FaultKind, Plc, PlcParams};
+
+/// How `plc-sim` is reached and secured.
+#[derive(Debug, Clone)]
+pub struct ServeParams {
+    /// Host name or address to listen on (and to name in endpoint URLs).
+    pub host: String,
+    /// Port (0: any free one).
+    pub port: u16,
+    /// PKI root (holding `plc/` and `workstation/`).
+    pub pki: PathBuf,
+    /// Also offer security None.
+    pub insecure: bool,
+    /// User name and password allowed to write.
+    pub users: Vec<(String, String)>,
+}
+
+/// Ticks of 100 ns per second (OPC UA DateTime).
+const TICKS_PER_S: f64 = 1e7;
+
+/// A running `plc-sim`.
+pub struct PlcServer {
+    /// The PLC.
+    pub plc: Arc<Mutex<Plc>>,
+    handle: ServerHandle,
+    relay: Arc<crate::relay::RelayControl>,
+    addr: SocketAddr,
+    host: String,
+    epoch_ticks: i64,
+    wall0: Instant,
+    loop_task: tokio::task::JoinHandle<()>,
+}
+
+fn nid(ns: u16, id: &str) -> NodeId {
+    NodeId::new(ns, id)
+}
+
+fn lock(plc: &Mutex<Plc>) -> MutexGuard<'_, Plc> {
+    // A panic while holding the lock would leave a PLC we cannot trust;
+    // its data are still readable, and the next loop zeroes the motors.
+    plc.lock().unwrap_or_else(|e| e.into_inner())
+}
+
+/// Anonymous sessions may read and browse, not write or call.
+struct PlcAuth {
+    inner: DefaultAuthenticator,
+}
+
+#[async_trait]
+impl AuthManager for PlcAuth {
+    async fn authenticate_anonymous_token(&self, endpoint: &ServerEndpoint) -> Result<(), UaError> {
+        self.inner.authenticate_anonymous_token(endpoint).await
+    }
+
+    async fn authenticate_username_identity_token(
+        &self,
+        endpoint: &ServerEndpoint,
+        username: &str,
+        password: &Password,
+    ) -> Result<UserToken, UaError> {
+        self.inner
+            .authenticate_username_identity_token(endpoint, username, password)
+            .await
+    }
+
+    async fn authenticate_x509_identity_token(
+        &self,
+        endpoint: &ServerEndpoint,
+        signing_thumbprint: &Thumbprint,
+    ) -> Result<UserToken, UaError> {
+        self.inner
+            .authenticate_x509_identity_token(endpoint, signing_thumbprint)
+            .await
+    }
+
+    fn effective_user_access_level(
+        &self,
+        token: &UserToken,
+        user_access_level: AccessLevel,
+        _node_id: &NodeId,
+    ) -> AccessLevel {
+        if token.is_anonymous() {
+            user_access_level & !AccessLevel::CURRENT_WRITE
+        } else {
+            user_access_level
+        }
+    }
+
+    fn is_user_executable(&self, token: &UserToken, _method_id: &NodeId) -> bool {
+        !token.is_anonymous()
+    }
+
+    fn user_token_policies(&self, endpoint: &ServerEndpoint) -> Vec<UserTokenPolicy> {
+        self.inner.user_token_policies(endpoint)
+    }
+}
+
+fn initial(ty: Ty) -> Variant {
+    match ty {
+        Ty::Double => Variant::Double(0.0),
+        Ty::UInt32 => Variant::UInt32(0),
+        Ty::UInt64 => Variant::UInt64(0),
+        Ty::Byte => Variant::Byte(0),
+        Ty::Boolean => Variant::Boolean(false),
+        Ty::DateTime => Variant::DateTime(Box::new(DateTime::null())),
+        Ty::String => Variant::String(UAString::from("")),
+    }
+}
+
+fn data_type(ty: Ty) -> DataTypeId {
+    match ty {
+        Ty::Double => DataTypeId::Double,
+        Ty::UInt32 => DataTypeId::UInt32,
+        Ty::UInt64 => DataTypeId::UInt64,
+        Ty::Byte => DataTypeId::Byte,
+        Ty::Boolean => DataTypeId::Boolean,
+        Ty::DateTime => DataTypeId::DateTime,
+        Ty::String => DataTypeId::String,
+    }
+}
+
+impl PlcServer {
+    /// Starts the server and the PLC loop.
+    pub async fn start(plc: PlcParams, serve: ServeParams) -> Result<PlcServer, LinkError> {
+        let addr_text = format!("{}:{}", serve.host, serve.port);
+        let serve_err = |why: String| LinkError::Serve {
+            addr: addr_text.clone(),
+            why,
+        };
+        pki::ensure(&serve.pki, Role::Plc, std::slice::from_ref(&serve.host))?;
+        let public = TcpListener::bind((serve.host.as_str(), serve.port))
+            .await
+            .map_err(|e| serve_err(e.to_string()))?;
+        let addr = public.local_addr().map_err(|e| serve_err(e.to_string()))?;
+        let inner = TcpListener::bind("127.0.0.1:0")
+            .await
+            .map_err(|e| serve_err(e.to_string()))?;
+        let inner_addr = inner.local_addr().map_err(|e| serve_err(e.to_string()))?;
+
+        let mut users = BTreeMap::new();
+        let mut token_ids: Vec<String> = vec![ANONYMOUS_USER_TOKEN_ID.to_string()];
+        for (u, p) in &serve.users {
+            users.insert(
+                u.clone(),
+                ServerUserToken::user_pass(u.as_str(), p.as_str()),
+            );
+            token_ids.push(u.clone());
+        }
+        let ids: Vec<&str> = token_ids.iter().map(String::as_str).collect();
+        let mut builder = ServerBuilder::new()
+            .application_name(Role::Plc.application_name())
+            .application_uri(Role::Plc.application_uri())
+            .product_uri("urn:autoshovel")
+            .pki_dir(pki::role_dir(&serve.pki, Role::Plc))
+            .create_sample_keypair(false)
+            .trust_client_certs(false)
+            .host(serve.host.clone())
+            .port(addr.port())
+            .discovery_urls(vec![format!("opc.tcp://{}:{}/", serve.host, addr.port())])
+            .with_node_manager(simple_node_manager(
+                NamespaceMetadata {
+                    namespace_uri: NAMESPACE_URI.to_owned(),
+                    ..Default::default()
+                },
+                "shovel",
+            ))
+            .with_authenticator(Arc::new(PlcAuth {
+                inner: DefaultAuthenticator::new(users.clone()),
+            }))
+            .add_endpoint(
+                "basic256sha256",
+                (
+                    "/",
+                    SecurityPolicy::Basic256Sha256,
+                    MessageSecurityMode::SignAndEncrypt,
+                    &ids as &[&str],
+                ),
+            )
+            .add_endpoint(
+                "aes256sha256rsapss",
+                (
+                    "/",
+                    SecurityPolicy::Aes256Sha256RsaPss,
+                    MessageSecurityMode::SignAndEncrypt,
+                    &ids as &[&str],
+                ),
+            )
+            .default_endpoint("basic256sha256");
+        for (k, v) in users {
+            builder = builder.add_user_token(k, v);
+        }
+        if serve.insecure {
+            eprintln!(
+                "plc-sim: WARNING: security None offered on {addr} (--insecure): setpoints travel unsigned and unencrypted"
+            );
+            builder = builder.add_endpoint(
+                "none",
+                (
+                    "/",
+                    SecurityPolicy::None,
+                    MessageSecurityMode::None,
+                    &ids as &[&str],
+                ),
+            );
+        }
+        let (server, handle) = builder.build().map_err(serve_err)?;
+        let manager = handle
+            .node_managers()
+            .get_of_type::<SimpleNodeManager>()
+            .ok_or_else(|| serve_err("node manager missing".into()))?;
+        let ns = handle
+            .get_namespace_index(NAMESPACE_URI)
+            .ok_or_else(|| serve_err("namespace missing".into()))?;
+
+        let plc = Arc::new(Mutex::new(Plc::new(plc)));
+        build_address_space(&manager, ns, &plc);
+
+        tokio::spawn(server.run_with(inner));
+        let plc_c = plc.clone();
+        let relay = crate::relay::spawn(
+            public,
+            inner_addr,
+            Arc::new(move || lock(&plc_c).link_dropped()),
+        );
+
+        let epoch_ticks = DateTime::now().ticks();
+        let wall0 = Instant::now();
+        let loop_task = tokio::spawn(run_loop(
+            plc.clone(),
+            manager,
+            handle.clone(),
+            ns,
+            relay.clone(),
+            epoch_ticks,
+            wall0,
+        ));
+        Ok(PlcServer {
+            plc,
+            handle,
+            relay,
+            addr,
+            host: serve.host,
+            epoch_ticks,
+            wall0,
+            loop_task,
+        })
+    }
+
+    /// The endpoint URL.
+    pub fn endpoint(&self) -> String {
+        format!("opc.tcp://{}:{}/", self.host, self.addr.port())
+    }
+
+    /// The address listened on.
+    pub fn addr(&self) -> SocketAddr {
+        self.addr
+    }
+
+    /// Wall-clock seconds since start.
+    pub fn wall_s(&self) -> f64 {
+        self.wall0.elapsed().as_secs_f64()
+    }
+
+    /// The machine clock's origin as OPC UA DateTime ticks.
+    pub fn epoch_ticks(&self) -> i64 {
+        self.epoch_ticks
+    }
+
+    /// Injects a fault now.
+    pub fn inject(&self, fault: FaultKind) {
+        lock(&self.plc).inject(fault);
+    }
+
+    /// Cuts the network now for `d` (as the `link-cut` fault).
+    pub fn cut(&self, d: Duration) {
+        self.relay.cut(d);
+    }
+
+    /// Stops the server.
+    pub async fn stop(self) {
+        self.loop_task.abort();
+        self.handle.cancel();
+    }
+}
+
+fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mutex<Plc>>) {
+    {
+        let space = manager.address_space();
+        let mut space = space.write();
+        for f in FOLDERS {
+            let parent = model::parent(f);
+            let parent_id = if parent.is_empty() {
+                ObjectId::ObjectsFolder.into()
+            } else {
+                nid(ns, parent)
+            };
+            space.add_folder(&nid(ns, f), model::leaf(f), model::leaf(f), &parent_id);
+        }
+        for v in model::VARIABLES {
+            let mut b = VariableBuilder::new(&nid(ns, v.id), model::leaf(v.id), model::leaf(v.id))
+                .data_type(data_type(v.ty))
+                .value(initial(v.ty))
+                .description(format!(
+                    "{}{}",
+                    v.doc,
+                    if v.unit.is_empty() {
+                        String::new()
+                    } else {
+                        format!(" [{}]", v.unit)
+                    }
+                ))
+                .organized_by(nid(ns, model::parent(v.id)));
+            if v.writer == Writer::Workstation {
+                b = b.writable();
+            }
+            b.insert(&mut *space);
+        }
+        MethodBuilder::new(&nid(ns, ACKNOWLEDGE), "Acknowledge", "Acknowledge")
+            .component_of(nid(ns, model::parent(ACKNOWLEDGE)))
+            .executable(true)
+            .user_executable(true)
+            .insert(&mut *space);
+        MethodBuilder::new(&nid(ns, INJECT_FAULT), "InjectFault", "InjectFault")
+            .component_of(nid(ns, model::parent(INJECT_FAULT)))
+            .executable(true)
+            .user_executable(true)
+            .input_args(
+                &mut *space,
+                &nid(ns, "Shovel.Simulator.InjectFault.InputArguments"),
+                &[
+                    ("Kind", DataTypeId::String).into(),
+                    ("Value", DataTypeId::Double).into(),
+                ],
+            )
+            .insert(&mut *space);
+    }
+    let inner = manager.inner();
+    for (var, right) in [(Var::LeftSetpoint, false), (Var::RightSetpoint, true)] {
+        let p = plc.clone();
+        inner.add_write_callback(nid(ns, model::spec(var).id), move |dv, _| match dv.value {
+            Some(Variant::Double(v)) => match lock(&p).write_setpoint(right, v) {
+                Ok(()) => StatusCode::Good,
+                Err(_) => StatusCode::BadOutOfRange,
+            },
+            _ => StatusCode::BadTypeMismatch,
+        });
+    }
+    let p = plc.clone();
+    inner.add_write_callback(
+        nid(ns, model::spec(Var::Heartbeat).id),
+        move |dv, _| match dv.value {
+            Some(Variant::UInt32(v)) => {
+                lock(&p).write_heartbeat(v);
+                StatusCode::Good
+            }
+            _ => StatusCode::BadTypeMismatch,
+        },
+    );
+    let p = plc.clone();
+    inner.add_write_callback(
+        nid(ns, model::spec(Var::SimStepAck).id),
+        move |dv, _| match dv.value {
+            Some(Variant::UInt64(v)) => {
+                lock(&p).write_step_ack(v);
+                StatusCode::Good
+            }
+            _ => StatusCode::BadTypeMismatch,
+        },
+    );
+    let p = plc.clone();
+    inner.add_method_callback(nid(ns, ACKNOWLEDGE), move |_| {
+        lock(&p)
+            .acknowledge()
+            .map(|_| Vec::new())
+            .map_err(|_| StatusCode::BadInvalidState)
+    });
+    let p = plc.clone();
+    inner.add_method_callback(nid(ns, INJECT_FAULT), move |args| {
+        let (Some(Variant::String(kind)), Some(Variant::Double(v))) = (args.first(), args.get(1))
+        else {
+            return Err(StatusCode::BadInvalidArgument);
+        };
+        let f = FaultKind::parse(kind.as_ref(), *v).map_err(|_| StatusCode::BadInvalidArgument)?;
+        lock(&p).inject(f);
+        Ok(Vec::new())
+    });
+}
+
+async fn run_loop(
+    plc: Arc<Mutex<Plc>>,
+    manager: Arc<SimpleNodeManager>,
+    handle: ServerHandle,
+    ns: u16,
+    relay: Arc<crate::relay::RelayControl>,
+    epoch_ticks: i64,
+    wall0: Instant,
+) {
+    let mut iv = tokio::time::interval(Duration::from_millis(1));
+    iv.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
+    let stamp = |t_s: f64| DateTime::from(epoch_ticks + (t_s * TICKS_PER_S).round() as i64);
+    let ids: BTreeMap<Var, NodeId> = model::VARIABLES
+        .iter()
+        .map(|v| (v.var, nid(ns, v.id)))
+        .collect();
+    let mut published_once = false;
+    loop {
+        iv.tick().await;
+        let mut values: Vec<(Var, Variant)> = Vec::with_capacity(32);
+        let network;
+        {
+            let mut p = lock(&plc);
+            p.run_to(wall0.elapsed().as_secs_f64());
+            network = std::mem::take(&mut p.network);
+            let t = p.machine.time_s();
+            let r = p.readings();
+            let sp = p.setpoints();
+            values.extend([
+                (Var::PlcTime, Variant::DateTime(Box::new(stamp(t)))),
+                (Var::LeftSpeed, Variant::Double(r[0].speed_rpm)),
+                (Var::LeftFrequency, Variant::Double(r[0].frequency_hz)),
+                (Var::LeftCurrent, Variant::Double(r[0].current_a)),
+                (Var::LeftVoltage, Variant::Double(r[0].voltage_v)),
+                (Var::RightSpeed, Variant::Double(r[1].speed_rpm)),
+                (Var::RightFrequency, Variant::Double(r[1].frequency_hz)),
+                (Var::RightCurrent, Variant::Double(r[1].current_a)),
+                (Var::RightVoltage, Variant::Double(r[1].voltage_v)),
+                (Var::LeftSetpoint, Variant::Double(sp.left_rpm)),
+                (Var::RightSetpoint, Variant::Double(sp.right_rpm)),
+                (Var::Mode, Variant::Byte(p.mode())),
+                (Var::FaultActive, Variant::Boolean(p.fault.is_some())),
+                (
+                    Var::FaultCode,
+                    Variant::UInt32(p.fault.as_ref().map(|f| f.0).unwrap_or(0)),
+                ),
+                (
+                    Var::FaultText,
+                    Variant::String(UAString::from(
+                        p.fault.as_ref().map(|f| f.1.as_str()).unwrap_or(""),
+                    )),
+                ),
+                (Var::SimStep, Variant::UInt64(p.step())),
+            ]);
+            let (truth, travelled) = p.truth();
+            values.extend([
+                (Var::SimTrueX, Variant::Double(truth.x)),
+                (Var::SimTrueY, Variant::Double(truth.y)),
+                (Var::SimTrueTheta, Variant::Double(truth.theta)),
+                (Var::SimTravelled, Variant::Double(travelled)),
+            ]);
+            if !published_once {
+                let c = p.params.setup.crawler;
+                values.push((Var::MaxSpeed, Variant::Double(c.motor_max_rpm)));
+                values.push((Var::MaxAccel, Variant::Double(c.motor_max_accel_rpm_per_s)));
+                published_once = true;
+            }
+            if p.take_fix_changed() {
+                if let Some(f) = p.fix() {
+                    values.extend([
+                        (Var::RtkEast, Variant::Double(f.east_m)),
+                        (Var::RtkNorth, Variant::Double(f.north_m)),
+                        (
+                            Var::RtkHeading,
+                            Variant::Double(f.heading_north_cw_rad.to_degrees()),
+                        ),
+                        (Var::RtkQuality, Variant::Byte(4)),
+                        (Var::RtkTime, Variant::DateTime(Box::new(stamp(f.time_s)))),
+                    ]);
+                }
+            }
+        }
+        for f in network {
+            match f {
+                FaultKind::LinkCut { duration_s } => {
+                    relay.cut(Duration::from_secs_f64(duration_s));
+                }
+                FaultKind::Delay {
+                    delay_s,
+                    duration_s,
+                } => {
+                    relay.delay(Duration::from_secs_f64(delay_s));
+                    let r = relay.clone();
+                    tokio::spawn(async move {
+                        tokio::time::sleep(Duration::from_secs_f64(duration_s)).await;
+                        r.delay(Duration::ZERO);
+                    });
+                }
+                _ => {}
+            }
+        }
+        let now = DateTime::now();
+        let _ = manager.set_values(
+            handle.subscriptions(),
+            values.into_iter().map(|(v, val)| {
+                let mut dv = DataValue::new_at(val, now);
+                dv.source_timestamp = Some(now);
+                (&ids[&v], None, dv)
+            }),
+        );
+    }
+}
