@@ -216,7 +216,7 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
         } else {
             Clock::Scaled(args.time_scale)
         },
-        heartbeat_timeout: Duration::from_millis(300),
+        heartbeat_timeout: autoshovel_link::HEARTBEAT_TIMEOUT,
         auto: !args.manual,
         schedule,
     };

@@ -24,7 +24,7 @@ use opcua::client::{ClientBuilder, IdentityToken, Session};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
     AttributeId, CallMethodRequest, DataTypeId, DataValue, MessageSecurityMode, NodeId,
-    ReadValueId, StatusCode, TimestampsToReturn, UserTokenPolicy, Variant, WriteValue,
+    ReadValueId, StatusCode, TimestampsToReturn, Variant, WriteValue,
 };
 use serde::Serialize;
 use tokio::time::Instant;
@@ -162,28 +162,44 @@ impl Link {
             .session_timeout(5_000)
             .client()
             .map_err(|e| connect_err(&p.endpoint, e.join("; ")))?;
-        let (identity, policy) = match &p.user {
-            Some((u, pw)) => (
-                IdentityToken::UserName(u.clone(), pw.clone().into()),
-                UserTokenPolicy {
-                    token_type: opcua::types::UserTokenType::UserName,
-                    ..Default::default()
-                },
-            ),
-            None => (IdentityToken::Anonymous, UserTokenPolicy::anonymous()),
+        let identity = match &p.user {
+            Some((u, pw)) => IdentityToken::UserName(u.clone(), pw.clone().into()),
+            None => IdentityToken::Anonymous,
         };
-        let _ = policy;
-        let connect = client.connect_to_matching_endpoint(
-            (
-                p.endpoint.as_str(),
-                p.policy.policy().to_str(),
-                p.policy.mode(),
-            ),
-            identity,
-        );
-        let (session, event_loop) = tokio::time::timeout(p.connect_timeout, connect)
-            .await
-            .map_err(|_| connect_err(&p.endpoint, "no answer (is plc-sim running there?)"))?
+        // The endpoint as the server describes it, but reached at the URL
+        // the user gave (the server may sit behind a relay, a NAT or a
+        // port forward and name an address the workstation cannot use).
+        let found = tokio::time::timeout(
+            p.connect_timeout,
+            client.get_server_endpoints_from_url(p.endpoint.as_str()),
+        )
+        .await
+        .map_err(|_| connect_err(&p.endpoint, "no answer (is plc-sim running there?)"))?
+        .map_err(|e| connect_err(&p.endpoint, explain(&e.to_string(), &p.pki)))?;
+        let policy_uri = p.policy.policy().to_uri();
+        let mut endpoint = found
+            .into_iter()
+            .find(|e| {
+                e.security_policy_uri.as_ref() == policy_uri && e.security_mode == p.policy.mode()
+            })
+            .ok_or_else(|| {
+                connect_err(
+                    &p.endpoint,
+                    format!(
+                        "the server offers no {} {:?} endpoint{}",
+                        p.policy.policy(),
+                        p.policy.mode(),
+                        if p.policy == Policy::None {
+                            " (start plc-sim with --insecure)"
+                        } else {
+                            ""
+                        }
+                    ),
+                )
+            })?;
+        endpoint.endpoint_url = p.endpoint.as_str().into();
+        let (session, event_loop) = client
+            .connect_to_endpoint_directly(endpoint, identity)
             .map_err(|e| connect_err(&p.endpoint, explain(&e.to_string(), &p.pki)))?;
         let event_loop = event_loop.spawn();
         let ok = tokio::time::timeout(p.connect_timeout, session.wait_for_connection())
@@ -597,6 +613,12 @@ pub struct DriveRun {
 /// Ticks of 100 ns per second.
 const TICKS: f64 = 1e7;
 
+/// On the link the workstation treats a pose as stale this much before the
+/// scenario's `pose_timeout_s`: the margin covers a poll (5 ms) and the
+/// setpoint write's round trip, so the setpoints are zero by the time the
+/// pose is `pose_timeout_s` old.
+pub const STALE_MARGIN_S: f64 = 0.05;
+
 /// Drives `setup`'s legs on the PLC behind `link` with `controller`;
 /// `stop` set (Ctrl-C) zeroes the setpoints and ends the run.
 pub async fn drive(
@@ -747,7 +769,9 @@ async fn run_loop(
     let wall = || wall0.elapsed().as_secs_f64();
     let origin = first.clock_ticks;
     let secs = |ticks: i64| (ticks - origin) as f64 / TICKS;
-    let mut ws = Workstation::new(&setup.legs, setup.crawler, setup.sim, controller, t_limit_s);
+    let mut sp = setup.sim;
+    sp.pose_timeout_s = (sp.pose_timeout_s - STALE_MARGIN_S).max(0.0);
+    let mut ws = Workstation::new(&setup.legs, setup.crawler, sp, controller, t_limit_s);
     let mut eval = Evaluator::new();
     let mut samples: Vec<Sample> = Vec::new();
     let mut link_events = Vec::new();
@@ -886,7 +910,13 @@ async fn run_loop(
             && matches!(state.quality, 4 | 5);
         let new_step = state.step.is_some() && state.step != last_step;
         let overdue = t - last_tick_t >= 1.5 * control_dt - 1e-9;
-        if !(new_fix || new_step || overdue) {
+        // A pose older than the timeout zeroes the setpoints at once, not
+        // at the next control period.
+        let last_fix_t = secs(last_fix_ticks);
+        let goes_stale = last_fix_ticks != 0
+            && t - last_fix_t > sp.pose_timeout_s + 1e-6
+            && last_tick_t - last_fix_t <= sp.pose_timeout_s + 1e-6;
+        if !(new_fix || new_step || overdue || goes_stale) {
             tokio::time::sleep(Duration::from_millis(if state.step.is_some() {
                 1
             } else {

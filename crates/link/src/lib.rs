@@ -18,5 +18,5 @@ pub mod server;
 
 pub use drive::{drive, DriveRun, Link, LinkEvent, LinkParams, Policy};
 pub use error::LinkError;
-pub use plc::{Clock, FaultKind, Plc, PlcParams};
+pub use plc::{Clock, FaultKind, Plc, PlcParams, HEARTBEAT_TIMEOUT};
 pub use server::{PlcServer, ServeParams};

@@ -137,6 +137,12 @@ pub struct PlcEvent {
     pub message: String,
 }
 
+/// The PLC's heartbeat timeout: 250 ms, so that with the workstation's
+/// heartbeat every 50 ms the motors are commanded to zero within 300 ms of
+/// the link going quiet (the heartbeat was at most 50 ms old then), and a
+/// heartbeat older than 300 ms is never obeyed.
+pub const HEARTBEAT_TIMEOUT: Duration = Duration::from_millis(250);
+
 /// How the machine's clock runs.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub enum Clock {
@@ -155,7 +161,7 @@ pub struct PlcParams {
     pub setup: Setup,
     /// How time runs.
     pub clock: Clock,
-    /// Heartbeat timeout (300 ms).
+    /// Heartbeat timeout: [`HEARTBEAT_TIMEOUT`].
     pub heartbeat_timeout: Duration,
     /// Start in auto (else manual: setpoints ignored).
     pub auto: bool,
@@ -192,6 +198,9 @@ pub struct Plc {
     pub events: Vec<PlcEvent>,
     /// Wall time [s] at which each fault latched.
     pub stops: Vec<f64>,
+    /// Machine time [s] of each write that brought the setpoints from
+    /// moving to both zero (the workstation's own stops).
+    pub zeroed_at: Vec<f64>,
     /// Network faults due now, for the server to carry out.
     pub network: Vec<FaultKind>,
     moved_while_faulted: bool,
@@ -231,6 +240,7 @@ impl Plc {
             next_fault: 0,
             events: Vec::new(),
             stops: Vec::new(),
+            zeroed_at: Vec::new(),
             network: Vec::new(),
             moved_while_faulted: false,
             wall_s: 0.0,
@@ -322,10 +332,14 @@ impl Plc {
         if self.fault.is_some() {
             return Ok(());
         }
+        let was_moving = self.setpoints != TrackCommand::STOP;
         if right {
             self.setpoints.right_rpm = rpm;
         } else {
             self.setpoints.left_rpm = rpm;
+        }
+        if was_moving && self.setpoints == TrackCommand::STOP {
+            self.zeroed_at.push(self.machine.time_s());
         }
         Ok(())
     }

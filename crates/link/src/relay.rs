@@ -1,7 +1,8 @@
 //! The simulated network in front of `plc-sim`: a TCP relay between the
-//! public port and the OPC UA server's own, which can cut every connection
-//! and refuse new ones for a while (pulling the cable), or hold back the
-//! server's replies (a slow link). It passes bytes and knows nothing of the
+//! public port and the OPC UA server's own, which can cut the link for a
+//! while (pulling the cable: nothing passes either way and nobody is told;
+//! bytes sent meanwhile arrive after, as TCP's retransmissions deliver them
+//! once the cable is back) or hold back the server's replies (a slow link). It passes bytes and knows nothing of the
 //! protocol; it tells the PLC when a workstation's connection ends, as a
 //! PLC's communication processor does.
 
@@ -35,7 +36,7 @@ impl RelayControl {
         }
     }
 
-    /// Cuts every connection now and refuses new ones for `d`.
+    /// Cuts the link now for `d`: nothing passes either way until then.
     pub fn cut(&self, d: Duration) {
         self.cut_until.send_replace(Some(Instant::now() + d));
     }
@@ -48,8 +49,15 @@ impl RelayControl {
         );
     }
 
-    fn is_cut(&self) -> bool {
-        matches!(*self.cut_until.borrow(), Some(t) if Instant::now() < t)
+    /// Sleeps until the cut (if any) is over.
+    async fn wait_while_cut(&self) {
+        loop {
+            let until = *self.cut_until.borrow();
+            match until {
+                Some(t) if Instant::now() < t => tokio::time::sleep_until(t).await,
+                _ => return,
+            }
+        }
     }
 }
 
@@ -67,13 +75,10 @@ pub fn spawn(
             let Ok((client, _)) = listener.accept().await else {
                 continue;
             };
-            if ctl.is_cut() {
-                drop(client);
-                continue;
-            }
             let ctl = ctl.clone();
             let on_close = on_close.clone();
             tokio::spawn(async move {
+                ctl.wait_while_cut().await;
                 if let Ok(server) = TcpStream::connect(upstream).await {
                     pipe(client, server, &ctl).await;
                 }
@@ -90,13 +95,13 @@ async fn pipe(client: TcpStream, server: TcpStream, ctl: &RelayControl) {
     let _ = server.set_nodelay(true);
     let (mut cr, mut cw) = client.into_split();
     let (mut sr, mut sw) = server.into_split();
-    let mut cut = ctl.cut_until.subscribe();
     let up = async {
         let mut buf = vec![0u8; 64 * 1024];
         loop {
             match cr.read(&mut buf).await {
                 Ok(0) | Err(_) => break,
                 Ok(n) => {
+                    ctl.wait_while_cut().await;
                     if sw.write_all(&buf[..n]).await.is_err() {
                         break;
                     }
@@ -114,6 +119,7 @@ async fn pipe(client: TcpStream, server: TcpStream, ctl: &RelayControl) {
                     if d > 0 {
                         tokio::time::sleep(Duration::from_micros(d)).await;
                     }
+                    ctl.wait_while_cut().await;
                     if cw.write_all(&buf[..n]).await.is_err() {
                         break;
                     }
@@ -121,19 +127,8 @@ async fn pipe(client: TcpStream, server: TcpStream, ctl: &RelayControl) {
             }
         }
     };
-    let cut_now = async {
-        loop {
-            if ctl.is_cut() {
-                break;
-            }
-            if cut.changed().await.is_err() {
-                std::future::pending::<()>().await;
-            }
-        }
-    };
     tokio::select! {
         _ = up => {}
         _ = down => {}
-        _ = cut_now => {}
     }
 }
