@@ -139,13 +139,13 @@ macro_rules! var {
 /// The model's variables, in the order of the docs' table.
 pub const VARIABLES: &[VarSpec] = &[
     var!(LeftSetpoint, "Shovel.Crawler.Left.SpeedSetpoint", Double, "rpm", Workstation,
-        "Left track motor speed setpoint; positive drives the machine forward; |value| ≤ MaxSpeed"),
+        "Left track motor speed setpoint; positive drives the machine forward; magnitude ≤ MaxSpeed"),
     var!(LeftSpeed, "Shovel.Crawler.Left.Speed", Double, "rpm", Plc, "Left motor actual speed (inverter)"),
     var!(LeftFrequency, "Shovel.Crawler.Left.Frequency", Double, "Hz", Plc, "Left inverter output frequency"),
     var!(LeftCurrent, "Shovel.Crawler.Left.Current", Double, "A", Plc, "Left motor current"),
     var!(LeftVoltage, "Shovel.Crawler.Left.Voltage", Double, "V", Plc, "Left motor voltage"),
     var!(RightSetpoint, "Shovel.Crawler.Right.SpeedSetpoint", Double, "rpm", Workstation,
-        "Right track motor speed setpoint; positive drives the machine forward; |value| ≤ MaxSpeed"),
+        "Right track motor speed setpoint; positive drives the machine forward; magnitude ≤ MaxSpeed"),
     var!(RightSpeed, "Shovel.Crawler.Right.Speed", Double, "rpm", Plc, "Right motor actual speed (inverter)"),
     var!(RightFrequency, "Shovel.Crawler.Right.Frequency", Double, "Hz", Plc, "Right inverter output frequency"),
     var!(RightCurrent, "Shovel.Crawler.Right.Current", Double, "A", Plc, "Right motor current"),
@@ -159,7 +159,7 @@ pub const VARIABLES: &[VarSpec] = &[
     var!(RtkTime, "Shovel.Rtk.Timestamp", DateTime, "", Plc, "The receiver's timestamp of the fix (UTC)"),
     var!(PlcTime, "Shovel.Clock", DateTime, "", Plc, "The PLC's clock (UTC); a pose's age is Clock − Rtk.Timestamp"),
     var!(Heartbeat, "Shovel.Workstation.Heartbeat", UInt32, "", Workstation,
-        "Counter the workstation changes at least every 100 ms; unchanged for 300 ms: the PLC stops and latches a fault"),
+        "Counter the workstation changes every 50 ms; unchanged for 250 ms: the PLC ramps the motors to zero and latches a fault"),
     var!(Mode, "Shovel.Mode", Byte, "", Plc, "0 manual (setpoints ignored), 1 auto (setpoints obeyed)"),
     var!(FaultActive, "Shovel.Fault.Active", Boolean, "", Plc,
         "A latched fault: motors ramped to zero, setpoints ignored until Acknowledge"),
@@ -268,6 +268,16 @@ pub fn markdown_table() -> String {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn the_docs_show_the_model_as_it_is() {
+        let doc = include_str!("../../../docs/link.md");
+        assert!(
+            doc.contains(&markdown_table()),
+            "docs/link.md's table differs from model::VARIABLES; paste:\n{}",
+            markdown_table()
+        );
+    }
 
     #[test]
     fn every_variable_sits_in_a_folder_and_ids_are_unique() {
