@@ -263,21 +263,22 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
                 break;
             }
         }
-        let p = server.plc.lock().unwrap_or_else(|e| e.into_inner());
-        let s = serde_json::json!({
-            "job": "plc-sim",
-            "scenario": scenario.name,
-            "seed": args.seed,
-            "endpoint": server.endpoint(),
-            "machine_time_s": p.machine.time_s(),
-            "travelled_m": p.machine.travelled_m(),
-            "fault": p.fault.as_ref().map(|f| f.1.clone()),
-            "faults_latched": p.stops.len(),
-            "moved_while_faulted": p.moved_while_faulted(),
-            "events": p.events,
-            "success": !p.moved_while_faulted(),
-        });
-        drop(p);
+        let s = {
+            let p = server.plc.lock().unwrap_or_else(|e| e.into_inner());
+            serde_json::json!({
+                "job": "plc-sim",
+                "scenario": scenario.name,
+                "seed": args.seed,
+                "endpoint": server.endpoint(),
+                "machine_time_s": p.machine.time_s(),
+                "travelled_m": p.machine.travelled_m(),
+                "fault": p.fault.as_ref().map(|f| f.1.clone()),
+                "faults_latched": p.stops.len(),
+                "moved_while_faulted": p.moved_while_faulted(),
+                "events": p.events,
+                "success": !p.moved_while_faulted(),
+            })
+        };
         server.stop().await;
         Ok::<_, anyhow::Error>(s)
     })?;

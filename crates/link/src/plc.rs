@@ -60,7 +60,7 @@ impl FaultKind {
     /// A fault from its name and one number: the duration [s] (for
     /// `rtk-jump`, the offset [m]; for `delay`, the delay [s] lasting 5 s).
     pub fn parse(name: &str, value: f64) -> Result<FaultKind, String> {
-        if !value.is_finite() || value < 0.0 || value > 3600.0 {
+        if !value.is_finite() || !(0.0..=3600.0).contains(&value) {
             return Err(format!(
                 "fault {name}: value {value} is not a duration in 0 ..= 3600 s"
             ));
