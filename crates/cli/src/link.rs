@@ -12,10 +12,10 @@ use std::time::Duration;
 use anyhow::{bail, Context, Result};
 use autoshovel_link::drive::{DriveSummary, LinkSummary};
 use autoshovel_link::{
-    pki, Clock, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy, ServeParams,
+    pki, Clock, DriveOptions, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy,
+    ServeParams,
 };
 use autoshovel_track::scenario::{resolve, TrackScenario};
-use autoshovel_track::sim::worst_case;
 use autoshovel_track::{ControllerKind, ControllerRun, Tracking};
 
 use crate::output::{out_dir, Job};
@@ -318,12 +318,28 @@ pub struct DriveArgs {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write.
+    /// The MCAP run log (default: OUT/drive.mcap, or drive-<UTC time>.mcap here).
+    #[arg(long)]
+    pub log: Option<PathBuf>,
+    /// Replace existing files in the output (and the log) that autoshovel did not write.
     #[arg(long)]
     pub force: bool,
     /// Print the summary JSON alone on stdout.
     #[arg(long)]
     pub json: bool,
+}
+
+fn default_log(out: Option<&Path>, stem: &str) -> PathBuf {
+    match out {
+        Some(dir) => dir.join(format!("{stem}.mcap")),
+        None => {
+            let secs = std::time::SystemTime::now()
+                .duration_since(std::time::UNIX_EPOCH)
+                .map(|d| d.as_secs())
+                .unwrap_or(0);
+            PathBuf::from(format!("{stem}-{secs}.mcap"))
+        }
+    }
 }
 
 /// Runs `drive`.
@@ -347,7 +363,24 @@ pub fn drive(args: &DriveArgs) -> Result<()> {
     params.ack_timeout = Duration::from_secs_f64(args.ack_timeout);
     let kind: ControllerKind = args.controller.into();
     let mut ctl = kind.build(&scenario.controllers);
-    let (t_limit, _, _) = worst_case(&scenario.setup);
+    let log_path = args
+        .log
+        .clone()
+        .unwrap_or_else(|| default_log(args.out.as_deref(), "drive"));
+    if let Some(dir) = &args.out {
+        std::fs::create_dir_all(dir).with_context(|| format!("--out {}", dir.display()))?;
+    }
+    let mut log = autoshovel_link::RunLog::create(
+        &log_path,
+        &[
+            ("job", "drive".to_string()),
+            ("scenario", scenario.name.clone()),
+            ("endpoint", args.endpoint.clone()),
+            ("controller", format!("{kind:?}")),
+            ("seed", args.seed.to_string()),
+        ],
+        args.force,
+    )?;
     let rt = runtime()?;
     DRIVE_STOP.store(false, Ordering::Relaxed);
     DRIVE_ACTIVE.store(true, Ordering::Relaxed);
@@ -364,23 +397,21 @@ pub fn drive(args: &DriveArgs) -> Result<()> {
             }
         });
         let link = Link::open(&params).await?;
-        let r = autoshovel_link::drive(
-            &link,
-            &scenario.setup,
-            ctl.as_mut(),
-            t_limit,
-            params.ack_timeout,
-            params.link_timeout,
-            stop,
-        )
-        .await;
+        let mut opts = DriveOptions::new(&scenario.setup, &params);
+        opts.stop = stop;
+        let r = autoshovel_link::drive(&link, &scenario.setup, ctl.as_mut(), &opts, Some(&mut log))
+            .await;
         link.close().await;
         watcher.abort();
         r
     });
     DRIVE_ACTIVE.store(false, Ordering::Relaxed);
+    // The log is kept whatever happened: it is the record of the run.
+    let logged = log.finish();
     let run = got?;
-    let link_summary = LinkSummary::of(&run, &params);
+    let log_path = logged?;
+    let mut link_summary = LinkSummary::of(&run, &params);
+    link_summary.log = Some(log_path.display().to_string());
     let tracking = Tracking {
         runs: vec![ControllerRun {
             kind,
@@ -504,4 +535,124 @@ pub fn pki_cmd(cmd: &PkiCommand) -> Result<()> {
         }
     }
     Ok(())
+}
+
+/// Arguments of `replay`.
+#[derive(Debug, clap::Args)]
+pub struct ReplayArgs {
+    /// A `drive` MCAP log, or a CSV of RTK fixes (t_s, east_m, north_m, heading_deg) with --path.
+    pub log: PathBuf,
+    /// For a CSV: the planned path, as `track` takes a scenario (built-in or TOML).
+    #[arg(long)]
+    pub path: Option<String>,
+    /// Write summary.json, CSV and plots here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write.
+    #[arg(long)]
+    pub force: bool,
+    /// Print the summary JSON alone on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// The `replay` job's summary.
+#[derive(Debug, Clone, serde::Serialize)]
+pub struct ReplaySummary {
+    /// `"replay"`.
+    pub job: &'static str,
+    /// The record replayed.
+    pub source: String,
+    /// What the deviations are measured on.
+    pub measured_on: &'static str,
+    /// The metrics (as `track` and `drive` report them).
+    #[serde(flatten)]
+    pub metrics: autoshovel_track::Metrics,
+    /// Workstation events found in the record.
+    pub events: Vec<autoshovel_track::sim::Event>,
+    /// Whether the run completed.
+    pub success: bool,
+}
+
+/// Runs `replay`.
+pub fn replay(args: &ReplayArgs) -> Result<()> {
+    use autoshovel_link::replay::{read_rtk_csv, replay_mcap, replay_rtk};
+    let is_csv = args
+        .log
+        .extension()
+        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
+    let (r, scenario) = if is_csv {
+        let Some(path) = &args.path else {
+            bail!(
+                "{}: a CSV of fixes needs --path (the planned path: a built-in or a scenario TOML)",
+                args.log.display()
+            );
+        };
+        let sc = scenario_of(path, Some(NoiseArg::Off), 1)?;
+        let rows = read_rtk_csv(&args.log)?;
+        (
+            replay_rtk(
+                &rows,
+                sc.setup.legs.clone(),
+                &args.log.display().to_string(),
+            ),
+            Some(sc),
+        )
+    } else {
+        if args.path.is_some() {
+            bail!("--path is for a CSV of fixes; an MCAP log carries its own path");
+        }
+        (replay_mcap(&args.log)?, None)
+    };
+    let out = out_dir(args.out.as_deref(), &[Some(args.log.as_path())], args.force)?;
+    let scenario = scenario.unwrap_or_else(|| {
+        let mut sc = resolve("straight", Some(autoshovel_track::Noise::Off), 1)
+            .expect("a built-in scenario");
+        sc.name = format!("replay of {}", args.log.display());
+        sc.setup.legs = r.legs.clone();
+        sc.setup.start = r
+            .run
+            .samples
+            .first()
+            .map(|s| s.truth)
+            .unwrap_or(sc.setup.start);
+        sc.map = None;
+        sc
+    });
+    let summary = ReplaySummary {
+        job: "replay",
+        source: r.source.clone(),
+        measured_on: r.measured_on,
+        metrics: r.run.metrics,
+        events: r.run.events.clone(),
+        success: r.run.metrics.completed,
+    };
+    let tracking = Tracking {
+        runs: vec![ControllerRun {
+            kind: ControllerKind::Fuzzy,
+            name: "replay",
+            gains: ControllerKind::Fuzzy.build(&Default::default()).gains(),
+            run: r.run,
+            sim_time_ms: 0.0,
+        }],
+        main: 0,
+        compare: false,
+    };
+    let job = Job::finish(summary, out.as_ref(), |dir, written| {
+        autoshovel_figures::track::write(dir, &scenario, &tracking, written)
+            .context("writing the replay figures")
+    })?;
+    job.report(args.json, |s: &ReplaySummary| {
+        let m = &s.metrics;
+        crate::say!(
+            "replay {} (on {}): max dev {:.3} m, mean dev {:.3} m, final pos err {:.3} m, final heading err {:.2} deg, completed {}",
+            s.source,
+            s.measured_on,
+            m.max_centroid_dev_m,
+            m.mean_centroid_dev_m,
+            m.final_position_error_m,
+            m.final_heading_error_deg,
+            m.completed
+        );
+    })
 }

@@ -64,6 +64,8 @@ enum Command {
     PlcSim(link::PlcSimArgs),
     /// The workstation: drive a PLC (or plc-sim) along a path over secure OPC UA.
     Drive(link::DriveArgs),
+    /// Recompute the tracking metrics (Figs. 13–14) from a drive's MCAP log or a CSV of RTK fixes.
+    Replay(link::ReplayArgs),
     /// Acknowledge a PLC's latched fault (the machine must be at rest).
     PlcAck(link::AckArgs),
     /// Certificates and trust lists for the machine link.
@@ -156,6 +158,7 @@ fn main() -> ExitCode {
         Command::PlcSim(args) => link::plc_sim(&args),
         Command::Drive(args) => link::drive(&args),
         Command::PlcAck(args) => link::ack(&args),
+        Command::Replay(args) => link::replay(&args),
         Command::Pki(cmd) => link::pki_cmd(&cmd),
         Command::Demo { out, json, force } => demo::run(&out, json, force),
     };

@@ -30,8 +30,25 @@ use serde::Serialize;
 use tokio::time::Instant;
 
 use crate::error::LinkError;
+use crate::log::{topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, RtkMsg, RunLog, TickMsg};
 use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, NAMESPACE_URI};
 use crate::pki::{self, Role};
+
+/// Messages of any type through one logging closure.
+mod erased {
+    use crate::error::LinkError;
+    use crate::log::RunLog;
+
+    pub trait Msg {
+        fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError>;
+    }
+
+    impl<T: serde::Serialize> Msg for T {
+        fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError> {
+            log.write(topic, t, self)
+        }
+    }
+}
 
 /// The security policy asked for.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize)]
@@ -379,13 +396,24 @@ impl Link {
             Var::Mode,
             Var::MaxSpeed,
             Var::MaxAccel,
+            Var::LeftFrequency,
+            Var::LeftCurrent,
+            Var::LeftVoltage,
+            Var::RightFrequency,
+            Var::RightCurrent,
+            Var::RightVoltage,
             Var::SimStep,
             Var::SimTrueX,
             Var::SimTrueY,
             Var::SimTrueTheta,
             Var::SimTravelled,
         ];
-        let n = if self.simulator { VARS.len() } else { 13 };
+        // The Simulator folder's five come last.
+        let n = if self.simulator {
+            VARS.len()
+        } else {
+            VARS.len() - 5
+        };
         let ids: Vec<ReadValueId> = VARS[..n].iter().map(|v| self.id(*v).into()).collect();
         let got = self
             .session
@@ -410,6 +438,18 @@ impl Link {
             mode: r.byte(Var::Mode)?,
             max_rpm: r.f64(Var::MaxSpeed)?,
             max_accel: r.f64(Var::MaxAccel)?,
+            motors: [
+                [
+                    r.f64(Var::LeftFrequency)?,
+                    r.f64(Var::LeftCurrent)?,
+                    r.f64(Var::LeftVoltage)?,
+                ],
+                [
+                    r.f64(Var::RightFrequency)?,
+                    r.f64(Var::RightCurrent)?,
+                    r.f64(Var::RightVoltage)?,
+                ],
+            ],
             step: if self.simulator {
                 Some(r.u64(Var::SimStep)?)
             } else {
@@ -521,6 +561,8 @@ pub struct PlcState {
     pub max_rpm: f64,
     /// Acceleration limit [rpm/s].
     pub max_accel: f64,
+    /// Inverter frequency [Hz], current [A], voltage [V] (left, right).
+    pub motors: [[f64; 3]; 2],
     /// Lockstep step (simulator only).
     pub step: Option<u64>,
     /// Truth pose and distance (simulator only).
@@ -619,17 +661,47 @@ const TICKS: f64 = 1e7;
 /// pose is `pose_timeout_s` old.
 pub const STALE_MARGIN_S: f64 = 0.05;
 
-/// Drives `setup`'s legs on the PLC behind `link` with `controller`;
-/// `stop` set (Ctrl-C) zeroes the setpoints and ends the run.
+/// How long a drive may take and wait, and its stop switch.
+#[derive(Debug, Clone)]
+pub struct DriveOptions {
+    /// Give up after this much machine time [s].
+    pub t_limit_s: f64,
+    /// Give up waiting for a fault's acknowledgement after this long.
+    pub ack_timeout: Duration,
+    /// Give up when the link stays down this long.
+    pub link_timeout: Duration,
+    /// Set (by Ctrl-C) to zero the setpoints and end the run.
+    pub stop: Arc<AtomicBool>,
+}
+
+impl DriveOptions {
+    /// The options for `setup` (its time limit) with `params`' timeouts.
+    pub fn new(setup: &Setup, params: &LinkParams) -> Self {
+        Self {
+            t_limit_s: autoshovel_track::sim::worst_case(setup).0,
+            ack_timeout: params.ack_timeout,
+            link_timeout: params.link_timeout,
+            stop: Arc::new(AtomicBool::new(false)),
+        }
+    }
+}
+
+/// Drives `setup`'s legs on the PLC behind `link` with `controller`,
+/// logging to `log` when given; `opts.stop` set (Ctrl-C) zeroes the
+/// setpoints and ends the run.
 pub async fn drive(
     link: &Link,
     setup: &Setup,
     controller: &mut dyn Controller,
-    t_limit_s: f64,
-    ack_timeout: Duration,
-    link_timeout: Duration,
-    stop: Arc<AtomicBool>,
+    opts: &DriveOptions,
+    mut log: Option<&mut RunLog>,
 ) -> Result<DriveRun, LinkError> {
+    let (t_limit_s, ack_timeout, link_timeout, stop) = (
+        opts.t_limit_s,
+        opts.ack_timeout,
+        opts.link_timeout,
+        opts.stop.clone(),
+    );
     let first = link.read_state().await?;
     check_machine(link, setup, &first)?;
     if first.mode != model::mode::AUTO {
@@ -646,6 +718,16 @@ pub async fn drive(
                 first.fault_text, link.endpoint
             ),
         });
+    }
+    if let Some(log) = log.as_deref_mut() {
+        log.set_origin_ticks(first.clock_ticks);
+        log.write(
+            topic::PATH,
+            0.0,
+            &PathMsg {
+                legs: setup.legs.iter().map(LegMsg::of).collect(),
+            },
+        )?;
     }
     // Heartbeat: its own task, every 50 ms, but it counts on only while
     // the control loop has come round within the last 200 ms: a stalled
@@ -685,6 +767,7 @@ pub async fn drive(
         &stop,
         first,
         &|| alive.store(clock.elapsed().as_millis() as u64, Ordering::Relaxed),
+        log.as_deref_mut(),
     )
     .await;
     // Whatever happened: zero setpoints, then stop the heartbeat.
@@ -764,7 +847,16 @@ async fn run_loop(
     stop: &AtomicBool,
     first: PlcState,
     alive: &dyn Fn(),
+    mut log: Option<&mut RunLog>,
 ) -> Result<DriveRun, LinkError> {
+    let mut log_error: Option<LinkError> = None;
+    let mut logw = |topic: &'static str, t: f64, msg: &dyn erased::Msg| {
+        if let Some(l) = log.as_deref_mut() {
+            if let Err(e) = msg.write(l, topic, t) {
+                log_error.get_or_insert(e);
+            }
+        }
+    };
     let wall0 = Instant::now();
     let wall = || wall0.elapsed().as_secs_f64();
     let origin = first.clock_ticks;
@@ -936,6 +1028,20 @@ async fn run_loop(
         });
         last_step = state.step;
         last_tick_t = t;
+        if let Some(f) = fix {
+            logw(
+                topic::RTK,
+                f.time_s,
+                &RtkMsg {
+                    t_s: f.time_s,
+                    east_m: state.east_m,
+                    north_m: state.north_m,
+                    heading_deg: state.heading_deg,
+                    quality: state.quality,
+                },
+            );
+        }
+        logw(topic::MOTORS, t, &MotorsMsg::of(t, &state));
         let tick = ws.tick(t, fix, (state.left_rpm, state.right_rpm));
         for d in &tick.decisions {
             if let Some(p) = last_measured {
@@ -944,6 +1050,23 @@ async fn run_loop(
             last_measured = Some(d.measured);
             let (truth, travelled) = state.truth.unwrap_or((d.measured, travelled_measured));
             samples.push(eval.sample(&setup.legs, d, t, truth, travelled));
+            logw(
+                topic::TICK,
+                t,
+                &TickMsg {
+                    t_s: t,
+                    leg: d.leg,
+                    measured: d.measured.into(),
+                    truth: state.truth.map(|(p, _)| p.into()),
+                    travelled_m: travelled,
+                    d_m: d.dev.d_m,
+                    d0_m: d.dev.d0_m,
+                    speed_ref_mps: d.speed_ref_mps,
+                    steer_rpm: d.steer_rpm,
+                    left_rpm: d.command.left_rpm,
+                    right_rpm: d.command.right_rpm,
+                },
+            );
         }
         let t0 = Instant::now();
         let ack = if tick.status == Status::Running {
@@ -980,6 +1103,44 @@ async fn run_loop(
     ));
     let completed = status == Status::Finished;
     let metrics = measure(&samples, setup, end, travelled, t_end, completed);
+    for e in &ws.events {
+        logw(
+            topic::EVENT,
+            e.t_s,
+            &EventMsg {
+                t_s: e.t_s,
+                source: "workstation".into(),
+                kind: e.kind.into(),
+                message: e.message.clone(),
+            },
+        );
+    }
+    for e in &link_events {
+        logw(
+            topic::EVENT,
+            t_end,
+            &EventMsg {
+                t_s: e.wall_s,
+                source: "link".into(),
+                kind: e.kind.into(),
+                message: e.message.clone(),
+            },
+        );
+    }
+    logw(
+        topic::SUMMARY,
+        t_end,
+        &EndMsg {
+            t_s: t_end,
+            end: end.into(),
+            travelled_m: travelled,
+            completed,
+            metrics,
+        },
+    );
+    if let Some(e) = log_error {
+        return Err(e);
+    }
     let mut events: Vec<Event> = ws.events;
     events.sort_by(|a, b| {
         a.t_s
@@ -1052,6 +1213,8 @@ pub struct LinkSummary {
     pub read_ms: Quantiles,
     /// Round trip of the setpoint write [ms].
     pub write_ms: Quantiles,
+    /// The MCAP run log.
+    pub log: Option<String>,
 }
 
 impl LinkSummary {
@@ -1070,6 +1233,7 @@ impl LinkSummary {
             events: run.link_events.clone(),
             read_ms: Quantiles::of(&run.read_ms),
             write_ms: Quantiles::of(&run.write_ms),
+            log: None,
         }
     }
 }

@@ -14,6 +14,14 @@ pub enum LinkError {
         /// What happened.
         why: String,
     },
+    /// A run log could not be written or read.
+    #[error("{path}: {why}")]
+    Log {
+        /// The file.
+        path: PathBuf,
+        /// What happened.
+        why: String,
+    },
     /// No OPC UA session could be opened.
     #[error("{endpoint}: {why}")]
     Connect {

@@ -10,13 +10,16 @@
 
 pub mod drive;
 pub mod error;
+pub mod log;
 pub mod model;
 pub mod pki;
 pub mod plc;
 pub mod relay;
+pub mod replay;
 pub mod server;
 
-pub use drive::{drive, DriveRun, Link, LinkEvent, LinkParams, Policy};
+pub use drive::{drive, DriveOptions, DriveRun, Link, LinkEvent, LinkParams, Policy};
 pub use error::LinkError;
+pub use log::RunLog;
 pub use plc::{Clock, FaultKind, Plc, PlcParams, HEARTBEAT_TIMEOUT};
 pub use server::{PlcServer, ServeParams};

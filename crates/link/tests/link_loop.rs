@@ -12,11 +12,11 @@ use std::sync::{Arc, OnceLock};
 use std::time::Duration;
 
 use autoshovel_link::{
-    drive, pki, Clock, FaultKind, Link, LinkParams, PlcParams, PlcServer, ServeParams,
-    HEARTBEAT_TIMEOUT,
+    drive, pki, Clock, DriveOptions, FaultKind, Link, LinkParams, PlcParams, PlcServer, RunLog,
+    ServeParams, HEARTBEAT_TIMEOUT,
 };
 use autoshovel_track::scenario::resolve;
-use autoshovel_track::sim::{simulate, worst_case, Run};
+use autoshovel_track::sim::{simulate, Run};
 use autoshovel_track::{ControllerKind, Noise, Setup};
 use rand::{Rng, SeedableRng};
 
@@ -73,22 +73,16 @@ fn rt() -> tokio::runtime::Runtime {
 }
 
 fn over_link(setup: &Setup, clock: Clock) -> Run {
+    over_link_logged(setup, clock, None)
+}
+
+fn over_link_logged(setup: &Setup, clock: Clock, log: Option<&mut RunLog>) -> Run {
     rt().block_on(async {
         let (server, params) = start(setup, clock, Vec::new()).await;
         let link = Link::open(&params).await.unwrap();
         let mut ctl = ControllerKind::Fuzzy.build(&Default::default());
-        let (t_limit, _, _) = worst_case(setup);
-        let r = drive(
-            &link,
-            setup,
-            ctl.as_mut(),
-            t_limit,
-            Duration::from_secs(5),
-            Duration::from_secs(5),
-            Arc::new(AtomicBool::new(false)),
-        )
-        .await
-        .unwrap();
+        let opts = DriveOptions::new(setup, &params);
+        let r = drive(&link, setup, ctl.as_mut(), &opts, log).await.unwrap();
         link.close().await;
         server.stop().await;
         assert!(r.truth, "plc-sim offers the simulator's truth");
@@ -134,6 +128,24 @@ fn lockstep_drive_reproduces_the_in_process_run() {
             "{name}: same ticks"
         );
     }
+}
+
+#[test]
+fn replay_of_the_drive_log_gives_the_drive_metrics() {
+    let sc = resolve("v-shape", Some(Noise::Rtk), 5).unwrap();
+    let dir = tempfile::tempdir().unwrap();
+    let path = dir.path().join("drive.mcap");
+    let mut log = RunLog::create(&path, &[("scenario", "v-shape".into())], false).unwrap();
+    let run = over_link_logged(&sc.setup, Clock::Lockstep, Some(&mut log));
+    log.finish().unwrap();
+    let r = autoshovel_link::replay::replay_mcap(&path).unwrap();
+    assert_eq!(r.measured_on, "simulator truth");
+    assert_eq!(r.run.samples.len(), run.samples.len());
+    let (a, b) = (&run.metrics, &r.run.metrics);
+    // JSON carries every f64 to the last bit.
+    assert_eq!(a, b);
+    // An existing log is never overwritten.
+    assert!(RunLog::create(&path, &[], false).is_err());
 }
 
 #[test]
@@ -195,15 +207,13 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
         let link = Link::open(&params).await.unwrap();
         let mut ctl = ControllerKind::Fuzzy.build(&Default::default());
         let stop = Arc::new(AtomicBool::new(false));
-        let driving = drive(
-            &link,
-            &setup,
-            ctl.as_mut(),
-            1e9,
-            Duration::from_secs(30),
-            Duration::from_secs(30),
-            stop.clone(),
-        );
+        let opts = DriveOptions {
+            t_limit_s: 1e9,
+            ack_timeout: Duration::from_secs(30),
+            link_timeout: Duration::from_secs(30),
+            stop: stop.clone(),
+        };
+        let driving = drive(&link, &setup, ctl.as_mut(), &opts, None);
         let plc = server.plc.clone();
         let cutter = async {
             let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(2026);
@@ -305,15 +315,13 @@ fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
         let link = Link::open(&params).await.unwrap();
         let mut ctl = ControllerKind::Fuzzy.build(&Default::default());
         let stop = Arc::new(AtomicBool::new(false));
-        let driving = drive(
-            &link,
-            &setup,
-            ctl.as_mut(),
-            1e9,
-            Duration::from_secs(30),
-            Duration::from_secs(30),
-            stop.clone(),
-        );
+        let opts = DriveOptions {
+            t_limit_s: 1e9,
+            ack_timeout: Duration::from_secs(30),
+            link_timeout: Duration::from_secs(30),
+            stop: stop.clone(),
+        };
+        let driving = drive(&link, &setup, ctl.as_mut(), &opts, None);
         let plc = server.plc.clone();
         let watcher = async {
             loop {
