@@ -702,23 +702,14 @@ pub async fn drive(
         opts.link_timeout,
         opts.stop.clone(),
     );
-    let first = link.read_state().await?;
-    check_machine(link, setup, &first)?;
-    if first.mode != model::mode::AUTO {
-        return Err(LinkError::Manual {
-            endpoint: link.endpoint.clone(),
-        });
-    }
-    if first.fault {
-        return Err(LinkError::Refused {
-            endpoint: link.endpoint.clone(),
-            what: "start".into(),
-            status: format!(
-                "the PLC has a latched fault ({}); acknowledge it at rest with `autoshovel plc-ack --endpoint {}`",
-                first.fault_text, link.endpoint
-            ),
-        });
-    }
+    let first = match start_checks(link, setup).await {
+        Ok(s) => s,
+        Err(e) => {
+            // Whatever the PLC holds, it holds zero setpoints from us.
+            let _ = zero_setpoints(link).await;
+            return Err(e);
+        }
+    };
     if let Some(log) = log.as_deref_mut() {
         log.set_origin_ticks(first.clock_ticks);
         log.write(
@@ -783,6 +774,29 @@ pub async fn drive(
         });
     }
     Ok(run)
+}
+
+/// The PLC's state at the start, after checking the machine, the mode and the fault.
+async fn start_checks(link: &Link, setup: &Setup) -> Result<PlcState, LinkError> {
+    let first = link.read_state().await?;
+    plausible(link, &first)?;
+    check_machine(link, setup, &first)?;
+    if first.mode != model::mode::AUTO {
+        return Err(LinkError::Manual {
+            endpoint: link.endpoint.clone(),
+        });
+    }
+    if first.fault {
+        return Err(LinkError::Refused {
+            endpoint: link.endpoint.clone(),
+            what: "start".into(),
+            status: format!(
+                "the PLC has a latched fault ({}); acknowledge it at rest with `autoshovel plc-ack --endpoint {}`",
+                first.fault_text, link.endpoint
+            ),
+        });
+    }
+    Ok(first)
 }
 
 /// Writes zero setpoints, three tries.

@@ -27,7 +27,7 @@ use opcua::server::{
 };
 use opcua::types::{
     DataTypeId, DataValue, DateTime, Error as UaError, MessageSecurityMode, NodeId, ObjectId,
-    StatusCode, UAString, UserTokenPolicy, Variant,
+    QualifiedName, StatusCode, UAString, UserTokenPolicy, Variant,
 };
 use tokio::net::TcpListener;
 use tokio::time::Instant;
@@ -331,45 +331,62 @@ fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mute
             } else {
                 nid(ns, parent)
             };
-            space.add_folder(&nid(ns, f), model::leaf(f), model::leaf(f), &parent_id);
+            space.add_folder(
+                &nid(ns, f),
+                QualifiedName::new(ns, model::leaf(f)),
+                model::leaf(f),
+                &parent_id,
+            );
         }
         for v in model::VARIABLES {
-            let mut b = VariableBuilder::new(&nid(ns, v.id), model::leaf(v.id), model::leaf(v.id))
-                .data_type(data_type(v.ty))
-                .value(initial(v.ty))
-                .description(format!(
-                    "{}{}",
-                    v.doc,
-                    if v.unit.is_empty() {
-                        String::new()
-                    } else {
-                        format!(" [{}]", v.unit)
-                    }
-                ))
-                .organized_by(nid(ns, model::parent(v.id)));
+            let mut b = VariableBuilder::new(
+                &nid(ns, v.id),
+                QualifiedName::new(ns, model::leaf(v.id)),
+                model::leaf(v.id),
+            )
+            .data_type(data_type(v.ty))
+            .value(initial(v.ty))
+            .description(format!(
+                "{}{}",
+                v.doc,
+                if v.unit.is_empty() {
+                    String::new()
+                } else {
+                    format!(" [{}]", v.unit)
+                }
+            ))
+            .organized_by(nid(ns, model::parent(v.id)));
             if v.writer == Writer::Workstation {
                 b = b.writable();
             }
             b.insert(&mut *space);
         }
-        MethodBuilder::new(&nid(ns, ACKNOWLEDGE), "Acknowledge", "Acknowledge")
-            .component_of(nid(ns, model::parent(ACKNOWLEDGE)))
-            .executable(true)
-            .user_executable(true)
-            .insert(&mut *space);
-        MethodBuilder::new(&nid(ns, INJECT_FAULT), "InjectFault", "InjectFault")
-            .component_of(nid(ns, model::parent(INJECT_FAULT)))
-            .executable(true)
-            .user_executable(true)
-            .input_args(
-                &mut *space,
-                &nid(ns, "Shovel.Simulator.InjectFault.InputArguments"),
-                &[
-                    ("Kind", DataTypeId::String).into(),
-                    ("Value", DataTypeId::Double).into(),
-                ],
-            )
-            .insert(&mut *space);
+        MethodBuilder::new(
+            &nid(ns, ACKNOWLEDGE),
+            QualifiedName::new(ns, "Acknowledge"),
+            "Acknowledge",
+        )
+        .component_of(nid(ns, model::parent(ACKNOWLEDGE)))
+        .executable(true)
+        .user_executable(true)
+        .insert(&mut *space);
+        MethodBuilder::new(
+            &nid(ns, INJECT_FAULT),
+            QualifiedName::new(ns, "InjectFault"),
+            "InjectFault",
+        )
+        .component_of(nid(ns, model::parent(INJECT_FAULT)))
+        .executable(true)
+        .user_executable(true)
+        .input_args(
+            &mut *space,
+            &nid(ns, "Shovel.Simulator.InjectFault.InputArguments"),
+            &[
+                ("Kind", DataTypeId::String).into(),
+                ("Value", DataTypeId::Double).into(),
+            ],
+        )
+        .insert(&mut *space);
     }
     let inner = manager.inner();
     for (var, right) in [(Var::LeftSetpoint, false), (Var::RightSetpoint, true)] {
