@@ -85,6 +85,91 @@ pub fn track(
     })
 }
 
+/// `drive`: `scenario` driven over the link of `params` with `controller`,
+/// the run logged to `log_path` (kept whatever happens: it is the record),
+/// the same figures as `track`; `stop` set (Ctrl-C) zeroes the setpoints
+/// and ends the run.
+#[allow(clippy::too_many_arguments)]
+pub fn drive(
+    rt: &tokio::runtime::Runtime,
+    scenario: &TrackScenario,
+    controller: ControllerKind,
+    params: &autoshovel_link::LinkParams,
+    log_path: &Path,
+    overwrite_log: bool,
+    out: Option<&OutDir>,
+    stop: &'static std::sync::atomic::AtomicBool,
+) -> Result<Job<autoshovel_link::drive::DriveSummary>> {
+    use autoshovel_link::drive::{DriveSummary, LinkSummary};
+    use autoshovel_link::{DriveOptions, Link, RunLog};
+    use autoshovel_track::{ControllerRun, Tracking};
+    use std::sync::atomic::Ordering;
+    if let Some(dir) = log_path.parent().filter(|d| !d.as_os_str().is_empty()) {
+        std::fs::create_dir_all(dir).with_context(|| format!("{}", dir.display()))?;
+    }
+    let mut ctl = controller.build(&scenario.controllers);
+    let t0 = std::time::Instant::now();
+    let got = rt.block_on(async {
+        let opts = DriveOptions::new(&scenario.setup, params);
+        let flag = opts.stop.clone();
+        let watcher = tokio::spawn(async move {
+            loop {
+                if stop.load(Ordering::Relaxed) {
+                    flag.store(true, Ordering::Relaxed);
+                }
+                tokio::time::sleep(std::time::Duration::from_millis(5)).await;
+            }
+        });
+        let link = Link::open(params).await?;
+        // The log starts once the link is up: it is the record of a run.
+        let mut log = match RunLog::create(
+            log_path,
+            &[
+                ("job", "drive".to_string()),
+                ("scenario", scenario.name.clone()),
+                ("endpoint", params.endpoint.clone()),
+                ("controller", format!("{controller:?}")),
+                ("seed", scenario.setup.rtk.seed.to_string()),
+            ],
+            overwrite_log,
+        ) {
+            Ok(l) => l,
+            Err(e) => {
+                link.close().await;
+                return Err(e);
+            }
+        };
+        let r = autoshovel_link::drive(&link, &scenario.setup, ctl.as_mut(), &opts, Some(&mut log))
+            .await;
+        link.close().await;
+        watcher.abort();
+        // The log is kept whatever happened.
+        let logged = log.finish();
+        let run = r?;
+        Ok::<_, autoshovel_link::LinkError>((run, logged?))
+    });
+    let (run, log_path) = got?;
+    let mut link = LinkSummary::of(&run, params);
+    link.log = Some(log_path.display().to_string());
+    let tracking = Tracking {
+        runs: vec![ControllerRun {
+            kind: controller,
+            name: ctl.name(),
+            gains: ctl.gains(),
+            run: run.run,
+            sim_time_ms: t0.elapsed().as_secs_f64() * 1e3,
+        }],
+        main: 0,
+        compare: false,
+    };
+    let mut track = tracking.summary(scenario);
+    track.job = "drive";
+    Job::finish(DriveSummary { track, link }, out, |dir, written| {
+        figures::track::write(dir, scenario, &tracking, written)
+            .context("writing the drive figures")
+    })
+}
+
 /// Reads `input` (with a progress bar when `progress`) and perceives it;
 /// errors name the file.
 pub fn read_and_perceive(

@@ -6,14 +6,12 @@
 
 use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
-use std::sync::Arc;
 use std::time::Duration;
 
 use anyhow::{bail, Context, Result};
-use autoshovel_link::drive::{DriveSummary, LinkSummary};
+use autoshovel_link::drive::DriveSummary;
 use autoshovel_link::{
-    pki, Clock, DriveOptions, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy,
-    ServeParams,
+    pki, Clock, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy, ServeParams,
 };
 use autoshovel_track::scenario::{resolve, TrackScenario};
 use autoshovel_track::{ControllerKind, ControllerRun, Tracking};
@@ -103,7 +101,8 @@ fn first_use(root: &Path) -> Result<()> {
     Ok(())
 }
 
-fn runtime() -> Result<tokio::runtime::Runtime> {
+/// The async runtime of the link's commands.
+pub fn runtime() -> Result<tokio::runtime::Runtime> {
     tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
         .enable_all()
@@ -274,6 +273,7 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
                 "travelled_m": p.machine.travelled_m(),
                 "fault": p.fault.as_ref().map(|f| f.1.clone()),
                 "faults_latched": p.stops.len(),
+            "setpoints_zeroed_at_s": p.zeroed_at,
                 "moved_while_faulted": p.moved_while_faulted(),
                 "events": p.events,
                 "success": !p.moved_while_faulted(),
@@ -361,84 +361,31 @@ pub fn drive(args: &DriveArgs) -> Result<()> {
     let mut params = args.security.link(&args.endpoint)?;
     params.link_timeout = Duration::from_secs_f64(args.link_timeout);
     params.ack_timeout = Duration::from_secs_f64(args.ack_timeout);
-    let kind: ControllerKind = args.controller.into();
-    let mut ctl = kind.build(&scenario.controllers);
     let log_path = args
         .log
         .clone()
         .unwrap_or_else(|| default_log(args.out.as_deref(), "drive"));
-    if let Some(dir) = &args.out {
-        std::fs::create_dir_all(dir).with_context(|| format!("--out {}", dir.display()))?;
-    }
-    let mut log = autoshovel_link::RunLog::create(
-        &log_path,
-        &[
-            ("job", "drive".to_string()),
-            ("scenario", scenario.name.clone()),
-            ("endpoint", args.endpoint.clone()),
-            ("controller", format!("{kind:?}")),
-            ("seed", args.seed.to_string()),
-        ],
-        args.force,
-    )?;
     let rt = runtime()?;
     DRIVE_STOP.store(false, Ordering::Relaxed);
     DRIVE_ACTIVE.store(true, Ordering::Relaxed);
-    let stop = Arc::new(AtomicBool::new(false));
-    let stop_c = stop.clone();
-    let t0 = std::time::Instant::now();
-    let got = rt.block_on(async {
-        let watcher = tokio::spawn(async move {
-            loop {
-                if DRIVE_STOP.load(Ordering::Relaxed) {
-                    stop_c.store(true, Ordering::Relaxed);
-                }
-                tokio::time::sleep(Duration::from_millis(5)).await;
-            }
-        });
-        let link = Link::open(&params).await?;
-        let mut opts = DriveOptions::new(&scenario.setup, &params);
-        opts.stop = stop;
-        let r = autoshovel_link::drive(&link, &scenario.setup, ctl.as_mut(), &opts, Some(&mut log))
-            .await;
-        link.close().await;
-        watcher.abort();
-        r
-    });
+    let job = crate::jobs::drive(
+        &rt,
+        &scenario,
+        args.controller.into(),
+        &params,
+        &log_path,
+        args.force,
+        out.as_ref(),
+        &DRIVE_STOP,
+    );
     DRIVE_ACTIVE.store(false, Ordering::Relaxed);
-    // The log is kept whatever happened: it is the record of the run.
-    let logged = log.finish();
-    let run = got?;
-    let log_path = logged?;
-    let mut link_summary = LinkSummary::of(&run, &params);
-    link_summary.log = Some(log_path.display().to_string());
-    let tracking = Tracking {
-        runs: vec![ControllerRun {
-            kind,
-            name: ctl.name(),
-            gains: ctl.gains(),
-            run: run.run,
-            sim_time_ms: t0.elapsed().as_secs_f64() * 1e3,
-        }],
-        main: 0,
-        compare: false,
-    };
-    let mut track = tracking.summary(&scenario);
-    track.job = "drive";
-    let summary = DriveSummary {
-        track,
-        link: link_summary,
-    };
-    for e in summary.track.events.iter().filter(|e| e.is_safety()) {
+    let job = job?;
+    for e in job.summary.track.events.iter().filter(|e| e.is_safety()) {
         eprintln!("safety: t = {:.2} s: {} ({})", e.t_s, e.message, e.kind);
     }
-    for e in &summary.link.events {
+    for e in &job.summary.link.events {
         eprintln!("link: wall {:.2} s: {} ({})", e.wall_s, e.message, e.kind);
     }
-    let job = Job::finish(summary, out.as_ref(), |dir, written| {
-        autoshovel_figures::track::write(dir, &scenario, &tracking, written)
-            .context("writing the drive figures")
-    })?;
     job.report(args.json, |s: &DriveSummary| {
         let m = &s.track.run.metrics;
         crate::say!(

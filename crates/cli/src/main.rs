@@ -166,6 +166,13 @@ fn main() -> ExitCode {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
+            // Interrupted (Ctrl-C), after zeroing the setpoints: the shell's 128 + SIGINT.
+            if matches!(
+                e.downcast_ref::<autoshovel_link::LinkError>(),
+                Some(autoshovel_link::LinkError::Interrupted { .. })
+            ) {
+                return ExitCode::from(130);
+            }
             ExitCode::FAILURE
         }
     }

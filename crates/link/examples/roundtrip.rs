@@ -1,0 +1,88 @@
+//! Round trips on loopback OPC UA (Basic256Sha256 SignAndEncrypt, the
+//! operator's session): the workstation's state read (one Read of the 18
+//! nodes it needs) and its setpoint write (one Write of both setpoints),
+//! N times each (default 2000; `ROUNDTRIPS` sets it), printed as p50 / p99 /
+//! max. BENCHMARKS.md keeps the figures; `cargo bench -p autoshovel-link`
+//! measures the same calls with criterion.
+
+use std::time::{Duration, Instant};
+
+use autoshovel_link::drive::Quantiles;
+use autoshovel_link::{
+    pki, Clock, Link, LinkParams, PlcParams, PlcServer, ServeParams, HEARTBEAT_TIMEOUT,
+};
+use autoshovel_track::scenario::resolve;
+use autoshovel_track::TrackCommand;
+
+fn main() {
+    let n: usize = std::env::var("ROUNDTRIPS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(2000);
+    let dir = std::env::temp_dir().join(format!("autoshovel-roundtrip-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&dir);
+    pki::init(&dir, &[]).expect("pki");
+    let pw = pki::read_password(&dir.join(pki::PASSWORD_FILE)).expect("password");
+    let sc = resolve("straight", None, 1).expect("built-in");
+    let rt = tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .expect("runtime");
+    let (read, write) = rt.block_on(async {
+        let server = PlcServer::start(
+            PlcParams {
+                setup: sc.setup.clone(),
+                clock: Clock::Scaled(1.0),
+                heartbeat_timeout: HEARTBEAT_TIMEOUT,
+                auto: false,
+                schedule: Vec::new(),
+            },
+            ServeParams {
+                host: "127.0.0.1".into(),
+                port: 0,
+                pki: dir.clone(),
+                insecure: false,
+                users: vec![(pki::OPERATOR.into(), pw.clone())],
+            },
+        )
+        .await
+        .expect("plc-sim");
+        let mut p = LinkParams::new(
+            &server.endpoint(),
+            dir.clone(),
+            Some((pki::OPERATOR.into(), pw)),
+        );
+        p.connect_timeout = Duration::from_secs(20);
+        let link = Link::open(&p).await.expect("session");
+        let mut read = Vec::with_capacity(n);
+        let mut write = Vec::with_capacity(n);
+        for i in 0..n {
+            let t = Instant::now();
+            link.read_state().await.expect("read");
+            read.push(t.elapsed().as_secs_f64() * 1e3);
+            let cmd = TrackCommand {
+                left_rpm: (i % 100) as f64,
+                right_rpm: 0.0,
+            };
+            let t = Instant::now();
+            link.write_setpoints(cmd, None).await.expect("write");
+            write.push(t.elapsed().as_secs_f64() * 1e3);
+        }
+        link.close().await;
+        server.stop().await;
+        (Quantiles::of(&read), Quantiles::of(&write))
+    });
+    let _ = std::fs::remove_dir_all(&dir);
+    println!("loopback OPC UA, Basic256Sha256 SignAndEncrypt, {n} round trips each");
+    println!("| call | p50 [ms] | p99 [ms] | max [ms] |\n|---|---|---|---|");
+    for (name, q) in [
+        ("state read (18 nodes)", read),
+        ("setpoint write (2 nodes)", write),
+    ] {
+        println!("| {name} | {:.3} | {:.3} | {:.3} |", q.p50, q.p99, q.max);
+        assert_eq!(q.n, n);
+        // A 10 Hz control loop needs both well inside its 100 ms period.
+        assert!(q.p50 < 50.0, "{name}: p50 {:.1} ms", q.p50);
+    }
+}
