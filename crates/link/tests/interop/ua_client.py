@@ -69,6 +69,7 @@ async def main():
             out["write_out_of_range"] = "Good"
         except ua.UaStatusCodeError as e:
             out["write_out_of_range"] = type(e).__name__
+        await asyncio.sleep(0.2)  # the PLC publishes its state every millisecond
         out["fault_after"] = await node("Shovel.Fault.Active").read_value()
     c = await session(endpoint, pki)
     async with c:
