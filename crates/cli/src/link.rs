@@ -162,6 +162,9 @@ pub struct PlcSimArgs {
     /// Also offer security None (logged loudly).
     #[arg(long)]
     pub insecure: bool,
+    /// The MCAP run log of the machine (default: plc-sim-<unix time>-<pid>.mcap here).
+    #[arg(long)]
+    pub log: Option<PathBuf>,
     /// Print the PLC's summary JSON alone on stdout at the end.
     #[arg(long)]
     pub json: bool,
@@ -226,11 +229,24 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
         insecure: args.insecure,
         users: vec![(pki::OPERATOR.to_string(), password)],
     };
+    let log_path = args
+        .log
+        .clone()
+        .unwrap_or_else(|| default_log(None, "plc-sim"));
+    let log = autoshovel_link::RunLog::create(
+        &log_path,
+        &[
+            ("job", "plc-sim".to_string()),
+            ("scenario", scenario.name.clone()),
+            ("seed", args.seed.to_string()),
+        ],
+        false,
+    )?;
     let rt = runtime()?;
     DRIVE_STOP.store(false, Ordering::Relaxed);
     DRIVE_ACTIVE.store(true, Ordering::Relaxed);
     let summary = rt.block_on(async {
-        let server = PlcServer::start(params, serve).await?;
+        let server = PlcServer::start_logged(params, serve, Some(log)).await?;
         eprintln!(
             "plc-sim: {} on {} ({}; machine of scenario {}, seed {}); Ctrl-C to stop",
             if args.lockstep { "lockstep" } else { "running" },
@@ -279,7 +295,10 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
                 "success": !p.moved_while_faulted(),
             })
         };
-        server.stop().await;
+        let mut s = s;
+        if let Some(done) = server.stop().await {
+            s["log"] = serde_json::json!(done?.display().to_string());
+        }
         Ok::<_, anyhow::Error>(s)
     })?;
     if args.json {
@@ -318,7 +337,7 @@ pub struct DriveArgs {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// The MCAP run log (default: OUT/drive.mcap, or drive-<UTC time>.mcap here).
+    /// The MCAP run log (default: OUT/drive.mcap, or drive-<unix time>-<pid>.mcap here).
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// Replace existing files in the output (and the log) that autoshovel did not write.
@@ -337,7 +356,7 @@ fn default_log(out: Option<&Path>, stem: &str) -> PathBuf {
                 .duration_since(std::time::UNIX_EPOCH)
                 .map(|d| d.as_secs())
                 .unwrap_or(0);
-            PathBuf::from(format!("{stem}-{secs}.mcap"))
+            PathBuf::from(format!("{stem}-{secs}-{}.mcap", std::process::id()))
         }
     }
 }

@@ -13,9 +13,18 @@ use common::*;
 
 /// Starts `plc-sim` on a free port with `args`; returns it and its endpoint.
 fn plc_sim(pki: &Path, args: &[&str]) -> (Child, String) {
+    let log = pki.with_file_name(format!(
+        "plc-{}.mcap",
+        std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .unwrap()
+            .as_nanos()
+    ));
     let mut child = Command::new(bin())
         .args(["plc-sim", "--port", "0", "--pki"])
         .arg(pki)
+        .arg("--log")
+        .arg(log)
         .args(args)
         .stdin(Stdio::null())
         .stdout(Stdio::piped())
@@ -210,7 +219,13 @@ fn ctrl_c_zeroes_the_setpoints_before_drive_exits() {
 fn the_link_refuses_what_it_must_and_names_it() {
     let d = TempDir::new("link-bad");
     let pki = d.path().join("pki");
-    run(&["pki".as_ref(), "init".as_ref(), "--dir".as_ref(), pki.as_os_str()]).ok();
+    run(&[
+        "pki".as_ref(),
+        "init".as_ref(),
+        "--dir".as_ref(),
+        pki.as_os_str(),
+    ])
+    .ok();
     let log = d.path().join("x.mcap");
     // Unreachable endpoint: named, no log left behind.
     let r = run(&[
@@ -246,7 +261,20 @@ fn the_link_refuses_what_it_must_and_names_it() {
         (vec!["--fault", "link-cut@2:1e9"], "link-cut@2:1e9"),
         (vec!["--time-scale", "0"], "--time-scale 0"),
     ] {
-        let mut a = vec!["plc-sim", "--port", "0", "--duration", "1"];
+        let pki_s = pki.to_str().unwrap();
+        let log_s = d.path().join("p.mcap");
+        let log_s = log_s.to_str().unwrap();
+        let mut a = vec![
+            "plc-sim",
+            "--port",
+            "0",
+            "--duration",
+            "1",
+            "--pki",
+            pki_s,
+            "--log",
+            log_s,
+        ];
         a.extend(args);
         let r = run(&a).fails();
         assert!(r.error_message().contains(want), "{}", r.stderr);

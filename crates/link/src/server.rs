@@ -33,6 +33,7 @@ use tokio::net::TcpListener;
 use tokio::time::Instant;
 
 use crate::error::LinkError;
+use crate::log::{topic, EventMsg, MotorsMsg, PoseMsg, RtkMsg, RunLog};
 use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, FOLDERS, INJECT_FAULT, NAMESPACE_URI};
 use crate::pki::{self, Role};
 use crate::plc::{FaultKind, Plc, PlcParams};
@@ -66,6 +67,7 @@ pub struct PlcServer {
     epoch_ticks: i64,
     wall0: Instant,
     loop_task: tokio::task::JoinHandle<()>,
+    log: Arc<Mutex<Option<RunLog>>>,
 }
 
 fn nid(ns: u16, id: &str) -> NodeId {
@@ -159,6 +161,16 @@ fn data_type(ty: Ty) -> DataTypeId {
 impl PlcServer {
     /// Starts the server and the PLC loop.
     pub async fn start(plc: PlcParams, serve: ServeParams) -> Result<PlcServer, LinkError> {
+        Self::start_logged(plc, serve, None).await
+    }
+
+    /// Starts the server and the PLC loop, logging the machine (fixes,
+    /// truth, setpoints, inverter readings at each fix; every event) to `log`.
+    pub async fn start_logged(
+        plc: PlcParams,
+        serve: ServeParams,
+        log: Option<RunLog>,
+    ) -> Result<PlcServer, LinkError> {
         let addr_text = format!("{}:{}", serve.host, serve.port);
         let serve_err = |why: String| LinkError::Serve {
             addr: addr_text.clone(),
@@ -262,6 +274,10 @@ impl PlcServer {
 
         let epoch_ticks = DateTime::now().ticks();
         let wall0 = Instant::now();
+        let log = Arc::new(Mutex::new(log.map(|mut l| {
+            l.set_origin_ticks(epoch_ticks);
+            l
+        })));
         let loop_task = tokio::spawn(run_loop(
             plc.clone(),
             manager,
@@ -270,6 +286,7 @@ impl PlcServer {
             relay.clone(),
             epoch_ticks,
             wall0,
+            log.clone(),
         ));
         Ok(PlcServer {
             plc,
@@ -280,6 +297,7 @@ impl PlcServer {
             epoch_ticks,
             wall0,
             loop_task,
+            log,
         })
     }
 
@@ -314,9 +332,14 @@ impl PlcServer {
     }
 
     /// Stops the server.
-    pub async fn stop(self) {
+    /// Stops the server; finishes the log (its path, or the error that
+    /// stopped it) when there is one.
+    pub async fn stop(self) -> Option<Result<std::path::PathBuf, LinkError>> {
         self.loop_task.abort();
+        let _ = self.loop_task.await;
         self.handle.cancel();
+        let log = self.log.lock().unwrap_or_else(|e| e.into_inner()).take();
+        log.map(RunLog::finish)
     }
 }
 
@@ -448,7 +471,9 @@ async fn run_loop(
     relay: Arc<crate::relay::RelayControl>,
     epoch_ticks: i64,
     wall0: Instant,
+    log: Arc<Mutex<Option<RunLog>>>,
 ) {
+    let mut logged_events = 0usize;
     let mut iv = tokio::time::interval(Duration::from_millis(1));
     iv.set_missed_tick_behavior(tokio::time::MissedTickBehavior::Skip);
     let stamp = |t_s: f64| DateTime::from(epoch_ticks + (t_s * TICKS_PER_S).round() as i64);
@@ -507,7 +532,17 @@ async fn run_loop(
                 values.push((Var::MaxAccel, Variant::Double(c.motor_max_accel_rpm_per_s)));
                 published_once = true;
             }
-            if p.take_fix_changed() {
+            let fix_changed = p.take_fix_changed();
+            let mut guard = log.lock().unwrap_or_else(|e| e.into_inner());
+            if let Some(l) = guard.as_mut() {
+                // A log that fails stops logging, never the PLC.
+                if let Err(e) = log_machine(l, &p, fix_changed, &mut logged_events) {
+                    eprintln!("plc-sim: the run log stopped: {e}");
+                    *guard = None;
+                }
+            }
+            drop(guard);
+            if fix_changed {
                 if let Some(f) = p.fix() {
                     values.extend([
                         (Var::RtkEast, Variant::Double(f.east_m)),
@@ -551,4 +586,74 @@ async fn run_loop(
             }),
         );
     }
+}
+
+fn log_machine(
+    l: &mut RunLog,
+    p: &Plc,
+    fix_changed: bool,
+    logged_events: &mut usize,
+) -> Result<(), LinkError> {
+    let t = p.machine.time_s();
+    for e in &p.events[*logged_events..] {
+        l.write(
+            topic::EVENT,
+            e.t_s,
+            &EventMsg {
+                t_s: e.t_s,
+                source: "plc".into(),
+                kind: e.kind.into(),
+                message: e.message.clone(),
+            },
+        )?;
+    }
+    *logged_events = p.events.len();
+    if !fix_changed {
+        return Ok(());
+    }
+    if let Some(f) = p.fix() {
+        l.write(
+            topic::RTK,
+            t,
+            &RtkMsg {
+                t_s: f.time_s,
+                east_m: f.east_m,
+                north_m: f.north_m,
+                heading_deg: f.heading_north_cw_rad.to_degrees(),
+                quality: 4,
+            },
+        )?;
+    }
+    let (truth, travelled) = p.truth();
+    l.write(
+        topic::TRUTH,
+        t,
+        &serde_json::json!({ "t_s": t, "pose": PoseMsg::from(truth), "travelled_m": travelled }),
+    )?;
+    let sp = p.setpoints();
+    l.write(
+        topic::SETPOINTS,
+        t,
+        &serde_json::json!({ "t_s": t, "left_rpm": sp.left_rpm, "right_rpm": sp.right_rpm, "obeyed": p.effective_command() == sp }),
+    )?;
+    let r = p.readings();
+    l.write(
+        topic::MOTORS,
+        t,
+        &MotorsMsg {
+            t_s: t,
+            left: [
+                r[0].speed_rpm,
+                r[0].frequency_hz,
+                r[0].current_a,
+                r[0].voltage_v,
+            ],
+            right: [
+                r[1].speed_rpm,
+                r[1].frequency_hz,
+                r[1].current_a,
+                r[1].voltage_v,
+            ],
+        },
+    )
 }
