@@ -1055,7 +1055,25 @@ async fn run_loop(
                 },
             );
         }
-        logw(topic::MOTORS, t, &MotorsMsg::of(t, &state));
+        logw(
+            topic::MOTORS,
+            t,
+            &MotorsMsg {
+                t_s: t,
+                left: [
+                    state.left_rpm,
+                    state.motors[0][0],
+                    state.motors[0][1],
+                    state.motors[0][2],
+                ],
+                right: [
+                    state.right_rpm,
+                    state.motors[1][0],
+                    state.motors[1][1],
+                    state.motors[1][2],
+                ],
+            },
+        );
         let tick = ws.tick(t, fix, (state.left_rpm, state.right_rpm));
         for d in &tick.decisions {
             if let Some(p) = last_measured {

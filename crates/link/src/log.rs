@@ -149,17 +149,6 @@ pub struct MotorsMsg {
     pub right: [f64; 4],
 }
 
-impl MotorsMsg {
-    /// Of a state read at `t_s`.
-    pub fn of(t_s: f64, s: &crate::drive::PlcState) -> Self {
-        Self {
-            t_s,
-            left: [s.left_rpm, s.motors[0][0], s.motors[0][1], s.motors[0][2]],
-            right: [s.right_rpm, s.motors[1][0], s.motors[1][1], s.motors[1][2]],
-        }
-    }
-}
-
 /// The end of a drive: where the machine stopped, and the metrics.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EndMsg {

@@ -7,9 +7,8 @@
 
 use autoshovel_core::Pose2;
 
-use crate::plant::{Crawler, CrawlerParams, SlipParams, TrackCommand};
+use crate::plant::{Crawler, CrawlerParams, SlipParams, TrackCommand, AT_REST_RPM};
 use crate::sensor::{Rtk, RtkFix, RtkParams};
-use crate::workstation::AT_REST_RPM;
 
 /// Plant, receiver and clock.
 #[derive(Debug, Clone)]

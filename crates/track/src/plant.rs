@@ -12,6 +12,9 @@
 use autoshovel_core::{wrap_angle, Pose2};
 use serde::{Deserialize, Serialize};
 
+/// Below this motor speed [rpm] the machine counts as at rest.
+pub const AT_REST_RPM: f64 = 1.0;
+
 /// Machine parameters of the crawler (defaults: SPEC §3, 1:7 prototype).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]

@@ -9,7 +9,7 @@
 //! deviation from the path, convergence distance, final position and heading error.
 
 use autoshovel_core::{angle_diff, Pose2};
-use serde::{Deserialize, Serialize};
+use serde::Serialize;
 
 use crate::controller::Controller;
 use crate::geometry::{deviations, RefLeg};
@@ -17,58 +17,7 @@ use crate::machine::Machine;
 use crate::plant::{CrawlerParams, SlipParams, TrackCommand};
 use crate::sensor::RtkParams;
 use crate::workstation::{Decision, Status, Workstation};
-
-/// Closed-loop settings.
-#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-#[serde(default, deny_unknown_fields)]
-pub struct SimParams {
-    /// Plant integration step [s].
-    pub plant_dt_s: f64,
-    /// Control loop rate [Hz] (the RTK delivers fixes at its own rate).
-    pub control_rate_hz: f64,
-    /// Cruise centroid speed [m/s].
-    pub speed_mps: f64,
-    /// Acceleration and braking of the speed profile [m/s²].
-    pub accel_mps2: f64,
-    /// Slowest speed before the end of a leg [m/s].
-    pub creep_mps: f64,
-    /// Preview distance L at standstill [W eq. 21] [m].
-    pub preview_m: f64,
-    /// Growth of L with speed [s].
-    pub preview_gain_s: f64,
-    /// Within `terminal_zone_m` of a leg's end, L is at least this [m]: the
-    /// preview then runs onto the path's continued last tangent, so the
-    /// machine lines up with it as it stops (at creep speed L would shrink
-    /// to where centimetre RTK noise hides the heading).
-    pub terminal_preview_m: f64,
-    /// See `terminal_preview_m` [m].
-    pub terminal_zone_m: f64,
-    /// Stop when the newest fix is older than this [s].
-    pub pose_timeout_s: f64,
-    /// Largest plausible speed over ground; a fix implying more is a jump [m/s].
-    pub max_plausible_speed_mps: f64,
-    /// Give up after this much simulated time per metre of path (plus 30 s).
-    pub time_per_m_limit_s: f64,
-}
-
-impl Default for SimParams {
-    fn default() -> Self {
-        Self {
-            plant_dt_s: 0.001,
-            control_rate_hz: 10.0,
-            speed_mps: 0.5,
-            accel_mps2: 0.5,
-            creep_mps: 0.05,
-            preview_m: 0.19,
-            preview_gain_s: 0.42,
-            terminal_preview_m: 1.0,
-            terminal_zone_m: 2.0,
-            pose_timeout_s: 0.3,
-            max_plausible_speed_mps: 5.0,
-            time_per_m_limit_s: 20.0,
-        }
-    }
-}
+pub use crate::workstation::{Event, SimParams};
 
 /// A sample of the run at one control tick.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -97,28 +46,6 @@ pub struct Sample {
     pub command: TrackCommand,
     /// Distance travelled so far [m].
     pub travelled_m: f64,
-}
-
-/// Something the safety layer or the runner did.
-#[derive(Debug, Clone, PartialEq, Serialize)]
-pub struct Event {
-    /// Time [s].
-    pub t_s: f64,
-    /// Kind: "stale-pose", "pose-jump", "pose-recovered", "leg-end", "timeout".
-    pub kind: &'static str,
-    /// Human text.
-    pub message: String,
-}
-
-impl Event {
-    /// Kind of the event that closes each leg normally.
-    pub const LEG_END: &'static str = "leg-end";
-
-    /// Whether the safety layer or the runner intervened (every event but
-    /// the normal end of a leg).
-    pub fn is_safety(&self) -> bool {
-        self.kind != Self::LEG_END
-    }
 }
 
 /// Measures of a run (SPEC §3, §6).
