@@ -758,7 +758,7 @@ pub async fn drive(
         &stop,
         first,
         &|| alive.store(clock.elapsed().as_millis() as u64, Ordering::Relaxed),
-        log.as_deref_mut(),
+        log,
     )
     .await;
     // Whatever happened: zero setpoints, then stop the heartbeat.

@@ -463,6 +463,9 @@ fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mute
     });
 }
 
+// The loop's eight inputs are the server's parts it publishes; a struct
+// holding them would only be unpacked again here.
+#[allow(clippy::too_many_arguments)]
 async fn run_loop(
     plc: Arc<Mutex<Plc>>,
     manager: Arc<SimpleNodeManager>,

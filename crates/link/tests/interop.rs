@@ -132,22 +132,23 @@ fn python_asyncua_client_browses_reads_and_writes_securely() {
         }
         assert_eq!(v["setpoint_type"], "Double");
         assert_eq!(v["max_rpm"], 3000.0);
-        let plc = server.plc.lock().unwrap();
-        // The pose it read is the receiver's (at rest: the start fix).
-        let fix = plc.fix().unwrap();
-        assert_eq!(v["east_m"].as_f64().unwrap(), fix.east_m);
-        assert_eq!(v["quality"], 4);
-        // The operator's write was taken; the out-of-range one was refused
-        // and latched a fault, which zeroed the setpoints.
-        assert_eq!(v["write_in_range"], "Good");
-        assert_eq!(plc.setpoints().left_rpm, 0.0, "cleared by the fault");
-        assert_eq!(v["write_out_of_range"], "BadOutOfRange");
-        assert_eq!(v["fault_after"], true);
-        assert!(plc.events.iter().any(|e| e.kind == "setpoint-rejected"));
-        // Anonymous may read, not write.
-        assert!(v["anonymous_read_east"].is_number());
-        assert_ne!(v["anonymous_write"], "Good", "{v}");
-        drop(plc);
+        {
+            let plc = server.plc.lock().unwrap();
+            // The pose it read is the receiver's (at rest: the start fix).
+            let fix = plc.fix().unwrap();
+            assert_eq!(v["east_m"].as_f64().unwrap(), fix.east_m);
+            assert_eq!(v["quality"], 4);
+            // The operator's write was taken; the out-of-range one was refused
+            // and latched a fault, which zeroed the setpoints.
+            assert_eq!(v["write_in_range"], "Good");
+            assert_eq!(plc.setpoints().left_rpm, 0.0, "cleared by the fault");
+            assert_eq!(v["write_out_of_range"], "BadOutOfRange");
+            assert_eq!(v["fault_after"], true);
+            assert!(plc.events.iter().any(|e| e.kind == "setpoint-rejected"));
+            // Anonymous may read, not write.
+            assert!(v["anonymous_read_east"].is_number());
+            assert_ne!(v["anonymous_write"], "Good", "{v}");
+        }
         server.stop().await;
     });
 }
@@ -258,8 +259,7 @@ fn a_plc_with_a_wrong_type_a_nan_or_other_limits_is_refused_by_node() {
             let opts = DriveOptions::new(&sc.setup, &p);
             let e = drive(&link, &sc.setup, ctl.as_mut(), &opts, None)
                 .await
-                .err()
-                .expect("refused");
+                .expect_err("refused");
             assert!(
                 matches!(&e, LinkError::BadValue { node, .. } if node.ends_with("Shovel.Crawler.Left.Speed")),
                 "{e}"
@@ -280,8 +280,7 @@ fn a_plc_with_a_wrong_type_a_nan_or_other_limits_is_refused_by_node() {
             let opts = DriveOptions::new(&setup, &p);
             let e = drive(&link, &setup, ctl.as_mut(), &opts, None)
                 .await
-                .err()
-                .expect("refused");
+                .expect_err("refused");
             assert!(matches!(e, LinkError::Mismatch { .. }), "{e}");
             assert!(e.to_string().contains("MotorMaxSpeed"), "{e}");
             link.close().await;
