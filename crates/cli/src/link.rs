@@ -162,7 +162,7 @@ pub struct PlcSimArgs {
     /// Also offer security None (logged loudly).
     #[arg(long)]
     pub insecure: bool,
-    /// The MCAP run log of the machine (default: plc-sim-<unix time>-<pid>.mcap here).
+    /// The MCAP run log of the machine (default: plc-sim-UNIXTIME-PID.mcap here).
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// Print the PLC's summary JSON alone on stdout at the end.
@@ -337,7 +337,7 @@ pub struct DriveArgs {
     /// Write summary.json, CSV and plots here.
     #[arg(long)]
     pub out: Option<PathBuf>,
-    /// The MCAP run log (default: OUT/drive.mcap, or drive-<unix time>-<pid>.mcap here).
+    /// The MCAP run log (default: OUT/drive.mcap, or drive-UNIXTIME-PID.mcap here).
     #[arg(long)]
     pub log: Option<PathBuf>,
     /// Replace existing files in the output (and the log) that autoshovel did not write.
