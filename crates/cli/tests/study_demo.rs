@@ -180,6 +180,7 @@ fn demo_writes_index_and_summary() {
     assert_eq!(
         keys,
         [
+            "drive fig9a over OPC UA",
             "perceive convex-concave pile",
             "perceive typical pile",
             "plan-dig --all-surfaces",
@@ -215,6 +216,13 @@ fn demo_writes_index_and_summary() {
             "{key}"
         );
     }
+    // The run over the link repeats the in-process run (lockstep).
+    let (link, local) = (&jobs["drive fig9a over OPC UA"], &jobs["track fig9a fuzzy"]);
+    assert_eq!(link["success"], true);
+    assert_eq!(link["link"]["policy"], "basic256-sha256");
+    let dev = |v: &serde_json::Value| v["max_centroid_dev_m"].as_f64().unwrap();
+    assert!((dev(link) - dev(local)).abs() < 1e-6, "{link} vs {local}");
+    assert!(out.join("drive-fig9a").join("drive.mcap").exists());
     assert_eq!(
         jobs["track curve --compare"]["compare"]
             .as_array()
