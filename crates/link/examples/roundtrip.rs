@@ -2,8 +2,10 @@
 //! operator's session): the workstation's state read (one Read of the 18
 //! nodes it needs) and its setpoint write (one Write of both setpoints),
 //! N times each (default 2000; `ROUNDTRIPS` sets it), printed as p50 / p99 /
-//! max. BENCHMARKS.md keeps the figures; `cargo bench -p autoshovel-link`
-//! measures the same calls with criterion.
+//! max. With `PEER=python` (and `AUTOSHOVEL_PYTHON` a python with asyncua)
+//! it then runs the peer, `crates/link/peer/asyncua_roundtrip.py`, against
+//! the same server in the same run. BENCHMARKS.md keeps the figures;
+//! `cargo bench -p autoshovel-link` measures the same calls with criterion.
 
 use std::time::{Duration, Instant};
 
@@ -29,7 +31,7 @@ fn main() {
         .enable_all()
         .build()
         .expect("runtime");
-    let (read, write) = rt.block_on(async {
+    let (read, write, peer) = rt.block_on(async {
         let server = PlcServer::start(
             PlcParams {
                 setup: sc.setup.clone(),
@@ -51,7 +53,7 @@ fn main() {
         let mut p = LinkParams::new(
             &server.endpoint(),
             dir.clone(),
-            Some((pki::OPERATOR.into(), pw)),
+            Some((pki::OPERATOR.into(), pw.clone())),
         );
         p.connect_timeout = Duration::from_secs(20);
         let link = Link::open(&p).await.expect("session");
@@ -70,8 +72,29 @@ fn main() {
             write.push(t.elapsed().as_secs_f64() * 1e3);
         }
         link.close().await;
+        let mut peer = String::new();
+        if std::env::var("PEER").as_deref() == Ok("python") {
+            let py = std::env::var("AUTOSHOVEL_PYTHON").unwrap_or_else(|_| "python3".into());
+            let script =
+                std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("peer/asyncua_roundtrip.py");
+            let (endpoint, dir, pw, n) = (server.endpoint(), dir.clone(), pw.clone(), n);
+            let out = tokio::task::spawn_blocking(move || {
+                std::process::Command::new(py)
+                    .arg(script)
+                    .arg(endpoint)
+                    .arg(dir)
+                    .arg(pw)
+                    .arg(n.to_string())
+                    .output()
+                    .expect("the peer runs")
+            })
+            .await
+            .expect("peer task");
+            peer = String::from_utf8_lossy(&out.stdout).into_owned();
+            eprint!("{}", String::from_utf8_lossy(&out.stderr));
+        }
         server.stop().await;
-        (Quantiles::of(&read), Quantiles::of(&write))
+        (Quantiles::of(&read), Quantiles::of(&write), peer)
     });
     let _ = std::fs::remove_dir_all(&dir);
     println!("loopback OPC UA, Basic256Sha256 SignAndEncrypt, {n} round trips each");
@@ -85,4 +108,5 @@ fn main() {
         // A 10 Hz control loop needs both well inside its 100 ms period.
         assert!(q.p50 < 50.0, "{name}: p50 {:.1} ms", q.p50);
     }
+    print!("{peer}");
 }
