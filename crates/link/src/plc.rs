@@ -509,3 +509,111 @@ impl Plc {
         (self.machine.truth(), self.machine.travelled_m())
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use autoshovel_track::scenario::resolve;
+    use autoshovel_track::Noise;
+
+    fn plc(clock: Clock) -> Plc {
+        let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
+        Plc::new(PlcParams {
+            setup: sc.setup,
+            clock,
+            heartbeat_timeout: HEARTBEAT_TIMEOUT,
+            auto: true,
+            schedule: Vec::new(),
+        })
+    }
+
+    #[test]
+    fn the_watchdog_latches_and_only_an_acknowledgement_at_rest_clears_it() {
+        let mut p = plc(Clock::Scaled(1.0));
+        p.write_heartbeat(1);
+        p.write_setpoint(false, 1000.0).unwrap();
+        p.write_setpoint(true, 1000.0).unwrap();
+        // 0.24 s with heartbeats every 20 ms: moving, no fault.
+        let mut t = 0.0;
+        for k in 0..12 {
+            t += 0.02;
+            p.run_to(t);
+            p.write_heartbeat(2 + k);
+        }
+        assert!(p.fault.is_none() && !p.machine.at_rest());
+        // Silence: latched once the heartbeat is older than 250 ms, not before.
+        let last = t;
+        while p.fault.is_none() {
+            t += 0.001;
+            p.run_to(t);
+        }
+        let waited = t - last;
+        assert!(waited > 0.25 && waited <= 0.252, "{waited}");
+        assert_eq!(p.effective_command(), TrackCommand::STOP);
+        // Still turning: the acknowledgement is refused.
+        assert!(p.acknowledge().is_err());
+        // New setpoints and heartbeats do not restart it.
+        p.write_heartbeat(100);
+        p.write_setpoint(false, 2000.0).unwrap();
+        for _ in 0..2000 {
+            t += 0.001;
+            p.run_to(t);
+        }
+        assert!(p.machine.at_rest() && p.fault.is_some() && !p.moved_while_faulted());
+        p.acknowledge().unwrap();
+        assert!(p.fault.is_none() && p.setpoints() == TrackCommand::STOP);
+    }
+
+    #[test]
+    fn nonsense_setpoints_are_refused_and_latch_a_fault() {
+        let mut p = plc(Clock::Scaled(1.0));
+        p.write_heartbeat(1);
+        assert!(p.write_setpoint(true, f64::NAN).is_err());
+        assert_eq!(
+            p.fault.as_ref().map(|f| f.0),
+            Some(fault_code::SETPOINT_REJECTED)
+        );
+        let mut p = plc(Clock::Scaled(1.0));
+        assert!(p.write_setpoint(false, 3000.1).is_err());
+        assert!(p.fault.is_some());
+    }
+
+    #[test]
+    fn injected_rtk_faults_do_what_they_say() {
+        let mut p = plc(Clock::Lockstep);
+        p.write_heartbeat(1);
+        let step = |p: &mut Plc| {
+            let s = p.step();
+            p.write_step_ack(s);
+            p.run_to(0.0);
+        };
+        step(&mut p);
+        let stamp = p.fix().unwrap().time_s;
+        p.inject(FaultKind::RtkFreeze { duration_s: 0.35 });
+        for _ in 0..3 {
+            step(&mut p);
+            assert_eq!(p.fix().unwrap().time_s, stamp, "timestamp frozen");
+        }
+        for _ in 0..2 {
+            step(&mut p);
+        }
+        assert!(p.fix().unwrap().time_s > stamp, "thawed");
+        let before = p.fix().unwrap();
+        p.inject(FaultKind::RtkDropout { duration_s: 0.25 });
+        step(&mut p);
+        step(&mut p);
+        assert_eq!(p.fix().unwrap(), before, "no fixes in a dropout");
+        p.inject(FaultKind::RtkJump { offset_m: 3.0 });
+        step(&mut p);
+        let jumped = p.fix().unwrap();
+        assert!(
+            (jumped.east_m - p.truth().0.x - 3.0).abs() < 1e-9,
+            "{jumped:?}"
+        );
+        step(&mut p);
+        assert!(
+            (p.fix().unwrap().east_m - p.truth().0.x).abs() < 1e-9,
+            "one fix only"
+        );
+    }
+}
