@@ -378,3 +378,30 @@ fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
         "every zeroing before the pose was 300 ms old: {ages:?}"
     );
 }
+
+#[test]
+fn a_delay_fault_holds_the_plcs_replies_back_for_its_length() {
+    let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
+    rt().block_on(async {
+        let (server, params) = start(&sc.setup, Clock::Scaled(1.0), Vec::new()).await;
+        let link = Link::open(&params).await.unwrap();
+        async fn time(link: &Link) -> f64 {
+            let t = std::time::Instant::now();
+            link.read_state().await.unwrap();
+            t.elapsed().as_secs_f64()
+        }
+        let before = time(&link).await;
+        server.inject(FaultKind::Delay {
+            delay_s: 0.2,
+            duration_s: 1.0,
+        });
+        tokio::time::sleep(Duration::from_millis(20)).await;
+        let during = time(&link).await;
+        tokio::time::sleep(Duration::from_millis(1500)).await;
+        let after = time(&link).await;
+        assert!(during >= 0.2, "held back: {during} s");
+        assert!(before < 0.1 && after < 0.1, "{before} {after}");
+        link.close().await;
+        server.stop().await;
+    });
+}
