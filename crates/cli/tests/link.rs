@@ -116,6 +116,42 @@ fn plc_sim_and_drive_run_the_loop_and_replay_gives_its_metrics() {
         assert_eq!(a, b, "{k}: replay gives the drive's figure");
         assert!((a - c).abs() < 1e-6, "{k}: lockstep drive {a} vs track {c}");
     }
+    // A real machine's record: the run's track as a CSV of receiver fixes
+    // (heading north-clockwise, columns in another order, one extra column)
+    // replayed against the planned path gives the same deviations.
+    let text = std::fs::read_to_string(out.join("track.csv")).unwrap();
+    let mut lines = text.lines();
+    let head: Vec<&str> = lines.next().unwrap().split(',').collect();
+    let col = |n: &str| head.iter().position(|h| *h == n).unwrap();
+    let (ct, cx, cy, ch) = (col("t_s"), col("x_m"), col("y_m"), col("heading_deg"));
+    let mut csv = String::from("heading_deg,north_m,east_m,quality,t_s\n");
+    let mut last_t = f64::NEG_INFINITY;
+    for l in lines {
+        let c: Vec<&str> = l.split(',').collect();
+        let t: f64 = c[ct].parse().unwrap();
+        if t <= last_t {
+            continue; // a leg's end and the next leg's start share a tick
+        }
+        last_t = t;
+        let phi = (90.0 - c[ch].parse::<f64>().unwrap()).rem_euclid(360.0);
+        csv.push_str(&format!("{phi},{},{},4,{t}\n", c[cy], c[cx]));
+    }
+    let fixes = out.with_file_name("fixes.csv");
+    std::fs::write(&fixes, csv).unwrap();
+    let from_csv = run(&[
+        "replay".as_ref(),
+        fixes.as_os_str(),
+        "--path".as_ref(),
+        "fig9a".as_ref(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(from_csv["measured_on"], "rtk fixes");
+    for k in ["max_centroid_dev_m", "mean_centroid_dev_m"] {
+        let (a, b) = (dj[k].as_f64().unwrap(), from_csv[k].as_f64().unwrap());
+        assert!((a - b).abs() < 1e-6, "{k}: drive {a} vs CSV replay {b}");
+    }
     // plc-sim is still up: stop it by its own clock.
     let mut sim = sim;
     let _ = sim.kill();
