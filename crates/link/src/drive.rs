@@ -23,15 +23,15 @@ use autoshovel_track::{Controller, RtkFix, Setup, Status, TrackCommand, Workstat
 use opcua::client::{ClientBuilder, IdentityToken, Session};
 use opcua::crypto::SecurityPolicy;
 use opcua::types::{
-    AttributeId, CallMethodRequest, DataTypeId, DataValue, MessageSecurityMode, NodeId,
-    ReadValueId, StatusCode, TimestampsToReturn, Variant, WriteValue,
+    AttributeId, CallMethodRequest, DataValue, MessageSecurityMode, NodeId, ReadValueId,
+    StatusCode, TimestampsToReturn, Variant, WriteValue,
 };
 use serde::Serialize;
 use tokio::time::Instant;
 
 use crate::error::LinkError;
 use crate::log::{topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, RtkMsg, RunLog, TickMsg};
-use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, NAMESPACE_URI};
+use crate::model::{self, Var, Writer, ACKNOWLEDGE, NAMESPACE_URI};
 use crate::pki::{self, Role};
 
 /// Messages of any type through one logging closure.
@@ -281,7 +281,7 @@ impl Link {
             if v.writer == Writer::Simulator {
                 sim_nodes += 1;
             }
-            let want: NodeId = type_id(v.ty).into();
+            let want: NodeId = v.ty.data_type_id().into();
             match dv.value {
                 Some(Variant::NodeId(ref t)) if **t == want => {}
                 other => {
@@ -483,18 +483,6 @@ fn write(node_id: NodeId, v: Variant) -> WriteValue {
         attribute_id: AttributeId::Value as u32,
         index_range: Default::default(),
         value: DataValue::value_only(v),
-    }
-}
-
-fn type_id(ty: Ty) -> DataTypeId {
-    match ty {
-        Ty::Double => DataTypeId::Double,
-        Ty::UInt32 => DataTypeId::UInt32,
-        Ty::UInt64 => DataTypeId::UInt64,
-        Ty::Byte => DataTypeId::Byte,
-        Ty::Boolean => DataTypeId::Boolean,
-        Ty::DateTime => DataTypeId::DateTime,
-        Ty::String => DataTypeId::String,
     }
 }
 

@@ -36,6 +36,20 @@ pub enum Ty {
 }
 
 impl Ty {
+    /// The OPC UA data type node of the type.
+    pub fn data_type_id(self) -> opcua::types::DataTypeId {
+        use opcua::types::DataTypeId as D;
+        match self {
+            Ty::Double => D::Double,
+            Ty::UInt32 => D::UInt32,
+            Ty::UInt64 => D::UInt64,
+            Ty::Byte => D::Byte,
+            Ty::Boolean => D::Boolean,
+            Ty::DateTime => D::DateTime,
+            Ty::String => D::String,
+        }
+    }
+
     /// The OPC UA name of the type.
     pub fn name(self) -> &'static str {
         match self {

@@ -146,18 +146,6 @@ fn initial(ty: Ty) -> Variant {
     }
 }
 
-fn data_type(ty: Ty) -> DataTypeId {
-    match ty {
-        Ty::Double => DataTypeId::Double,
-        Ty::UInt32 => DataTypeId::UInt32,
-        Ty::UInt64 => DataTypeId::UInt64,
-        Ty::Byte => DataTypeId::Byte,
-        Ty::Boolean => DataTypeId::Boolean,
-        Ty::DateTime => DataTypeId::DateTime,
-        Ty::String => DataTypeId::String,
-    }
-}
-
 impl PlcServer {
     /// Starts the server and the PLC loop.
     pub async fn start(plc: PlcParams, serve: ServeParams) -> Result<PlcServer, LinkError> {
@@ -367,7 +355,7 @@ fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mute
                 QualifiedName::new(ns, model::leaf(v.id)),
                 model::leaf(v.id),
             )
-            .data_type(data_type(v.ty))
+            .data_type(v.ty.data_type_id())
             .value(initial(v.ty))
             .description(format!(
                 "{}{}",
