@@ -170,26 +170,6 @@ pub struct PlcSimArgs {
     pub json: bool,
 }
 
-fn parse_fault(s: &str) -> Result<(f64, FaultKind)> {
-    let (kind, rest) = s
-        .split_once('@')
-        .with_context(|| format!("--fault {s}: expected KIND@SECONDS[:VALUE]"))?;
-    let (at, value) = match rest.split_once(':') {
-        Some((a, v)) => (a, v),
-        None => (rest, "1"),
-    };
-    let at: f64 = at
-        .parse()
-        .ok()
-        .filter(|t: &f64| t.is_finite() && *t >= 0.0)
-        .with_context(|| format!("--fault {s}: time {at:?} is not a number of seconds ≥ 0"))?;
-    let value: f64 = value
-        .parse()
-        .with_context(|| format!("--fault {s}: value {value:?} is not a number"))?;
-    let f = FaultKind::parse(kind, value).map_err(|e| anyhow::anyhow!("--fault {s}: {e}"))?;
-    Ok((at, f))
-}
-
 /// Runs `plc-sim`.
 pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
     if !(args.time_scale.is_finite() && args.time_scale > 0.0 && args.time_scale <= 100.0) {
@@ -202,7 +182,7 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
     let schedule = args
         .faults
         .iter()
-        .map(|f| parse_fault(f))
+        .map(|f| FaultKind::parse_spec(f).map_err(|e| anyhow::anyhow!("--fault {e}")))
         .collect::<Result<Vec<_>>>()?;
     first_use(&args.pki)?;
     let password = pki::read_password(
@@ -522,24 +502,6 @@ pub struct ReplayArgs {
     pub json: bool,
 }
 
-/// The `replay` job's summary.
-#[derive(Debug, Clone, serde::Serialize)]
-pub struct ReplaySummary {
-    /// `"replay"`.
-    pub job: &'static str,
-    /// The record replayed.
-    pub source: String,
-    /// What the deviations are measured on.
-    pub measured_on: &'static str,
-    /// The metrics (as `track` and `drive` report them).
-    #[serde(flatten)]
-    pub metrics: autoshovel_track::Metrics,
-    /// Workstation events found in the record.
-    pub events: Vec<autoshovel_track::sim::Event>,
-    /// Whether the run completed.
-    pub success: bool,
-}
-
 /// Runs `replay`.
 pub fn replay(args: &ReplayArgs) -> Result<()> {
     use autoshovel_link::replay::{read_rtk_csv, replay_mcap, replay_rtk};
@@ -585,14 +547,7 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         sc.map = None;
         sc
     });
-    let summary = ReplaySummary {
-        job: "replay",
-        source: r.source.clone(),
-        measured_on: r.measured_on,
-        metrics: r.run.metrics,
-        events: r.run.events.clone(),
-        success: r.run.metrics.completed,
-    };
+    let summary = r.summary();
     let tracking = Tracking {
         runs: vec![ControllerRun {
             kind: ControllerKind::Fuzzy,
@@ -608,7 +563,7 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         autoshovel_figures::track::write(dir, &scenario, &tracking, written)
             .context("writing the replay figures")
     })?;
-    job.report(args.json, |s: &ReplaySummary| {
+    job.report(args.json, |s: &autoshovel_link::replay::ReplaySummary| {
         let m = &s.metrics;
         crate::say!(
             "replay {} (on {}): max dev {:.3} m, mean dev {:.3} m, final pos err {:.3} m, final heading err {:.2} deg, completed {}",

@@ -57,6 +57,25 @@ impl FaultKind {
     pub const NAMES: &'static [&'static str] =
         &["rtk-dropout", "rtk-jump", "rtk-freeze", "link-cut", "delay"];
 
+    /// A scheduled fault from `KIND@SECONDS[:VALUE]` (VALUE 1 when left
+    /// out); the error names the spec.
+    pub fn parse_spec(s: &str) -> Result<(f64, FaultKind), String> {
+        let (kind, rest) = s
+            .split_once('@')
+            .ok_or_else(|| format!("{s}: expected KIND@SECONDS[:VALUE]"))?;
+        let (at, value) = rest.split_once(':').unwrap_or((rest, "1"));
+        let at: f64 = at
+            .parse()
+            .ok()
+            .filter(|t: &f64| t.is_finite() && *t >= 0.0)
+            .ok_or_else(|| format!("{s}: time {at:?} is not a number of seconds ≥ 0"))?;
+        let value: f64 = value
+            .parse()
+            .map_err(|_| format!("{s}: value {value:?} is not a number"))?;
+        let f = FaultKind::parse(kind, value).map_err(|e| format!("{s}: {e}"))?;
+        Ok((at, f))
+    }
+
     /// A fault from its name and one number: the duration [s] (for
     /// `rtk-jump`, the offset [m]; for `delay`, the delay [s] lasting 5 s).
     pub fn parse(name: &str, value: f64) -> Result<FaultKind, String> {

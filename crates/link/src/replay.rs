@@ -350,3 +350,35 @@ pub fn replay_rtk(rows: &[TrackRow], legs: Vec<RefLeg>, source: &str) -> Replay 
         source: source.to_string(),
     }
 }
+
+/// The `replay` job's summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplaySummary {
+    /// `"replay"`.
+    pub job: &'static str,
+    /// The record replayed.
+    pub source: String,
+    /// What the deviations are measured on.
+    pub measured_on: &'static str,
+    /// The metrics (as `track` and `drive` report them).
+    #[serde(flatten)]
+    pub metrics: autoshovel_track::Metrics,
+    /// Workstation events found in the record.
+    pub events: Vec<Event>,
+    /// Whether the run completed.
+    pub success: bool,
+}
+
+impl Replay {
+    /// The job's summary.
+    pub fn summary(&self) -> ReplaySummary {
+        ReplaySummary {
+            job: "replay",
+            source: self.source.clone(),
+            measured_on: self.measured_on,
+            metrics: self.run.metrics,
+            events: self.run.events.clone(),
+            success: self.run.metrics.completed,
+        }
+    }
+}
