@@ -317,4 +317,10 @@ fn fuzz_regressions() {
     let b = std::fs::read(data.join("fuzz_laz_decoder_index_panic.laz")).unwrap();
     let what = check("decoder panic", Format::Laz, &b).unwrap_err();
     assert!(what.contains("malformed"), "{what}");
+    // Point format 6 whose GPS-time stream keeps asking to switch sequence:
+    // `laz` 0.12.2 recursed once per switch and overflowed the stack (an
+    // abort, not catchable). vendor/laz bounds the switches per point.
+    let b = std::fs::read(data.join("fuzz_laz_point6_gps_recursion.laz")).unwrap();
+    let what = check("gps recursion", Format::Laz, &b).unwrap_err();
+    assert!(what.contains("sequence switches"), "{what}");
 }
