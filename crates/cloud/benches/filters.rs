@@ -108,6 +108,7 @@ const FILTERS: [(&str, Run); 4] = [
             &StatisticalOutlierParams {
                 mean_k: 50,
                 std_mul: 1.0,
+                ..Default::default()
             },
         )
         .unwrap()

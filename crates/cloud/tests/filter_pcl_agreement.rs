@@ -100,7 +100,11 @@ fn radius(input: &str, radius_m: f64, min_neighbors: usize, reference: &str) {
 }
 
 fn statistical(input: &str, mean_k: usize, std_mul: f64, reference: &str) {
-    let params = filter::StatisticalOutlierParams { mean_k, std_mul };
+    let params = filter::StatisticalOutlierParams {
+        mean_k,
+        std_mul,
+        ..Default::default()
+    };
     let ours = filter::statistical_outlier_removal(&cloud(input), &params).expect("filter");
     assert_same_points(&ours, reference);
 }

@@ -55,7 +55,7 @@ fn brute_radius(points: &[Point], radius_m: f64, min_neighbors: usize) -> Vec<us
         .collect()
 }
 
-fn brute_statistical(points: &[Point], k: usize, std_mul: f64) -> Vec<usize> {
+fn brute_statistical(points: &[Point], k: usize, std_mul: f64, both: bool) -> Vec<usize> {
     let dist: Vec<f32> = points
         .iter()
         .map(|p| {
@@ -72,9 +72,20 @@ fn brute_statistical(points: &[Point], k: usize, std_mul: f64) -> Vec<usize> {
         sq += f64::from(d * d);
     }
     let n = dist.len() as f64;
-    let thr = sum / n + std_mul * ((sq - sum * sum / n) / (n - 1.0)).sqrt();
+    let mean = sum / n;
+    let delta = ((sq - sum * sum / n) / (n - 1.0)).sqrt();
+    let thr = mean + std_mul * delta;
     (0..dist.len())
-        .filter(|&i| f64::from(dist[i]) <= thr || thr.is_nan())
+        .filter(|&i| {
+            let d = f64::from(dist[i]);
+            // [RS eq. 16] as printed, |d̄_i − d̄| > α·δ, or PCL's one side
+            let noise = if both {
+                (d - mean).abs() > std_mul * delta
+            } else {
+                d > thr
+            };
+            !noise || thr.is_nan()
+        })
         .collect()
 }
 
@@ -94,10 +105,12 @@ proptest! {
     }
 
     #[test]
-    fn statistical_equals_brute_force(seed in any::<u64>(), n in 20usize..300, k in 1usize..12, s in -0.5f64..2.0) {
+    fn statistical_equals_brute_force(seed in any::<u64>(), n in 20usize..300, k in 1usize..12, s in -0.5f64..2.0, both in any::<bool>()) {
         let cloud = lcg_cloud(n, 1.0, seed);
-        let want = brute_statistical(&cloud.points, k, s);
-        let params = filter::StatisticalOutlierParams { mean_k: k, std_mul: s };
+        let s = if both { s.abs() } else { s };
+        let want = brute_statistical(&cloud.points, k, s, both);
+        let sides = if both { filter::OutlierSides::Both } else { filter::OutlierSides::Above };
+        let params = filter::StatisticalOutlierParams { mean_k: k, std_mul: s, sides };
         match filter::statistical_outlier_removal_indices(&cloud, &params) {
             Ok(got) => prop_assert_eq!(got, want),
             Err(CloudError::Emptied { .. }) => prop_assert!(want.is_empty()),
@@ -226,6 +239,7 @@ fn non_finite_points_are_dropped() {
     let stat = filter::StatisticalOutlierParams {
         mean_k: 8,
         std_mul: 1.0,
+        ..Default::default()
     };
     assert_eq!(
         filter::statistical_outlier_removal(&dirty, &stat).unwrap(),
@@ -283,6 +297,7 @@ fn bad_parameters_name_the_value() {
         &filter::StatisticalOutlierParams {
             mean_k: 0,
             std_mul: 1.0,
+            ..Default::default()
         },
     );
     assert!(what(e.unwrap_err()).contains("mean_k must be at least 1, got 0"));
@@ -291,6 +306,7 @@ fn bad_parameters_name_the_value() {
         &filter::StatisticalOutlierParams {
             mean_k: 100,
             std_mul: 1.0,
+            ..Default::default()
         },
     );
     assert!(what(e.unwrap_err())
@@ -300,6 +316,7 @@ fn bad_parameters_name_the_value() {
         &filter::StatisticalOutlierParams {
             mean_k: 5,
             std_mul: f64::INFINITY,
+            ..Default::default()
         },
     );
     assert!(what(e.unwrap_err()).contains("std_mul must be finite, got inf"));
@@ -429,6 +446,7 @@ fn empty_input_and_emptied_output_are_errors_with_a_hint() {
         &filter::StatisticalOutlierParams {
             mean_k: 5,
             std_mul: -100.0,
+            ..Default::default()
         },
     )
     .unwrap_err();
@@ -580,4 +598,55 @@ fn bilateral_smoothing_leaves_a_plane_alone_and_flattens_noise() {
         }
         last = now;
     }
+}
+
+/// [RS eq. 16] as printed is two-sided: a tight cluster (duplicated returns)
+/// whose mean neighbour distance is far *below* the mean is noise to the
+/// paper's rule and kept by PCL's one-sided rule; the points of the regular
+/// grid are judged the same by both.
+#[test]
+fn the_two_sided_rule_also_drops_what_is_unusually_dense() {
+    let mut points: Vec<Point> = (0..400)
+        .map(|i| [(i % 20) as f32, (i / 20) as f32, 0.0])
+        .collect();
+    let grid = points.len();
+    points.extend((0..30).map(|i| {
+        [
+            30.0 + 0.001 * (i % 6) as f32,
+            30.0 + 0.001 * (i / 6) as f32,
+            0.0,
+        ]
+    }));
+    let cloud = PointCloud::new(points);
+    let params = |sides| filter::StatisticalOutlierParams {
+        mean_k: 8,
+        std_mul: 1.0,
+        sides,
+    };
+    let above =
+        filter::statistical_outlier_removal_indices(&cloud, &params(filter::OutlierSides::Above))
+            .unwrap();
+    let both =
+        filter::statistical_outlier_removal_indices(&cloud, &params(filter::OutlierSides::Both))
+            .unwrap();
+    let cluster = |kept: &[usize]| kept.iter().filter(|&&i| i >= grid).count();
+    assert_eq!(cluster(&above), 30, "PCL's rule keeps the dense cluster");
+    assert_eq!(cluster(&both), 0, "the paper's rule removes it");
+    let grid_of = |kept: &[usize]| {
+        kept.iter()
+            .copied()
+            .filter(|&i| i < grid)
+            .collect::<Vec<_>>()
+    };
+    assert_eq!(grid_of(&above), grid_of(&both));
+    assert!(grid_of(&both).len() > 300);
+    // A negative α means nothing two-sided.
+    let e = filter::statistical_outlier_removal(
+        &cloud,
+        &filter::StatisticalOutlierParams {
+            std_mul: -1.0,
+            ..params(filter::OutlierSides::Both)
+        },
+    );
+    assert!(what(e.unwrap_err()).contains("sides = both"));
 }

@@ -36,8 +36,8 @@ use std::time::Instant;
 
 use autoshovel_cloud::filter::{
     bilateral_normal_smoothing, pass_through, radius_outlier_removal, statistical_outlier_removal,
-    voxel_grid, BilateralParams, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
-    VoxelGridParams,
+    voxel_grid, BilateralParams, OutlierSides, PassThroughParams, RadiusOutlierParams,
+    StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_cloud::PointCloud;
 use autoshovel_core::config::{self, TomlFile};
@@ -197,6 +197,9 @@ pub struct StatisticalStage {
     pub mean_k: usize,
     /// Threshold factor α of `[RS eq. 16]`.
     pub std_mul: f64,
+    /// `"above"` (PCL's one-sided rule, the default) or `"both"`
+    /// (`[RS eq. 16]` as printed, |d̄_i − d̄| > α·δ).
+    pub sides: OutlierSides,
 }
 
 /// Voxel grid settings (`[RS eq. 17]`–`[RS eq. 18]`).
@@ -283,6 +286,7 @@ impl Default for StatisticalStage {
             enabled: true,
             mean_k: 20,
             std_mul: 2.0,
+            sides: OutlierSides::Above,
         }
     }
 }
@@ -809,6 +813,7 @@ pub fn perceive_with(
                     &StatisticalOutlierParams {
                         mean_k: p.statistical.mean_k,
                         std_mul: p.statistical.std_mul,
+                        sides: p.statistical.sides,
                     },
                 )
             }),

@@ -38,6 +38,7 @@ pub use radius_outlier::{
     radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams,
 };
 pub use statistical_outlier::{
-    statistical_outlier_removal, statistical_outlier_removal_indices, StatisticalOutlierParams,
+    statistical_outlier_removal, statistical_outlier_removal_indices, OutlierSides,
+    StatisticalOutlierParams,
 };
 pub use voxel_grid::{voxel_grid, VoxelGridParams};

@@ -3,6 +3,13 @@
 //! sample standard deviation δ ([RS eq. 14], with n − 1); d̄_i ~ N(d̄, δ²) ([RS eq. 15]);
 //! a point is noise when d̄_i − d̄ > α·δ ([RS eq. 16], one-sided as in PCL).
 //!
+//! The paper writes eq. 16 two-sided, |d̄_i − d̄| > α·δ: it would also drop
+//! points whose neighbours are unusually *close* (dense clusters, duplicated
+//! returns, the near field of a LiDAR). PCL, Open3D and CloudCompare all cut
+//! one side only, and so does [`OutlierSides::Above`], the default; the
+//! paper's rule is [`OutlierSides::Both`]. With α ≥ 0 the two differ only in
+//! the points with d̄_i < d̄ − α·δ.
+//!
 //! Semantics of PCL 1.13.0's `pcl::StatisticalOutlierRemoval<PointT>`, followed
 //! to the bit (`filters/include/pcl/filters/impl/statistical_outlier_removal.hpp`,
 //! `applyFilterIndices`; the floating-point operations below were also read
@@ -44,8 +51,22 @@ use super::common::{bad, emptied, empty_input, gather, on_finite_points};
 use super::kdtree::KdTree;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
+use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "statistical outlier removal";
+
+/// Which deviations of [RS eq. 16] make a point noise.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum OutlierSides {
+    /// d̄_i − d̄ > α·δ: only points far from their neighbours (PCL's
+    /// `StatisticalOutlierRemoval`, Open3D, CloudCompare). The default.
+    #[default]
+    Above,
+    /// |d̄_i − d̄| > α·δ: also points unusually close to their neighbours,
+    /// as [RS eq. 16] is printed.
+    Both,
+}
 
 /// Parameters of [`statistical_outlier_removal`] ([RS eq. 14]–[RS eq. 16]).
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -55,6 +76,8 @@ pub struct StatisticalOutlierParams {
     pub mean_k: usize,
     /// The threshold factor α of [RS eq. 16] (PCL's `std_mul_`, `-std_dev_mul`).
     pub std_mul: f64,
+    /// One-sided as PCL (the default) or two-sided as [RS eq. 16] prints it.
+    pub sides: OutlierSides,
 }
 
 impl Default for StatisticalOutlierParams {
@@ -64,6 +87,7 @@ impl Default for StatisticalOutlierParams {
         Self {
             mean_k: 50,
             std_mul: 1.0,
+            sides: OutlierSides::Above,
         }
     }
 }
@@ -80,6 +104,15 @@ impl StatisticalOutlierParams {
             return Err(bad(
                 FILTER,
                 format!("std_mul must be finite, got {}", short(self.std_mul)),
+            ));
+        }
+        if self.sides == OutlierSides::Both && self.std_mul < 0.0 {
+            return Err(bad(
+                FILTER,
+                format!(
+                    "std_mul must be at least 0 with sides = both (|d̄_i − d̄| > α·δ), got {}",
+                    short(self.std_mul)
+                ),
             ));
         }
         Ok(())
@@ -111,7 +144,7 @@ pub fn statistical_outlier_removal_indices(
 ///     (0..100).map(|i| [(i % 10) as f32 * 0.01, (i / 10) as f32 * 0.01, 0.0]).collect();
 /// points.push([0.05, 0.05, 1.0]);
 /// let cloud = PointCloud::new(points);
-/// let params = filter::StatisticalOutlierParams { mean_k: 8, std_mul: 1.0 };
+/// let params = filter::StatisticalOutlierParams { mean_k: 8, std_mul: 1.0, ..Default::default() };
 /// let kept = filter::statistical_outlier_removal(&cloud, &params).unwrap();
 /// assert!(kept.points.iter().all(|p| p[2] == 0.0));
 /// ```
@@ -161,12 +194,21 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
     let mean = sum / n;
     let variance = (sq_sum - sum * sum / n) / (n - 1.0);
     // [RS eq. 15]: d̄_i ~ N(d̄, δ²), so the cut sits at d̄ + α·δ.
-    let threshold = mean + params.std_mul * variance.sqrt();
-    // [RS eq. 16]: removed when d̄_i > threshold; a NaN threshold removes nothing.
+    let spread = params.std_mul * variance.sqrt();
+    let threshold = mean + spread;
+    // [RS eq. 16]: removed when d̄_i > threshold (PCL), or also when
+    // d̄_i < d̄ − α·δ (two-sided); a NaN threshold removes nothing.
+    let low = match params.sides {
+        OutlierSides::Above => f64::NEG_INFINITY,
+        OutlierSides::Both => mean - spread,
+    };
     Ok(distances
         .iter()
         .enumerate()
-        .filter(|(_, &d)| f64::from(d) <= threshold || threshold.is_nan())
+        .filter(|(_, &d)| {
+            let d = f64::from(d);
+            threshold.is_nan() || (d <= threshold && d >= low)
+        })
         .map(|(i, _)| i)
         .collect())
 }
