@@ -35,12 +35,14 @@
 
 pub mod dynamics;
 mod error;
+pub mod estimate;
 pub mod ground;
 pub mod kinematics;
 pub mod level1;
 pub mod obstacle;
 pub mod paper;
 pub mod plan;
+mod planner;
 pub mod preimage;
 pub mod profile;
 pub mod quintic;

@@ -29,22 +29,19 @@ use serde::Serialize;
 
 use crate::dynamics::Dynamics;
 use crate::error::{ExcavateError, Result};
+use crate::estimate::{BoulderEstimate, Touch};
 use crate::ground::Ground;
 use crate::kinematics::{Backhoe, Joints};
-use crate::level1::{plan_level1, EndLevel, Level1Plan, StepFound, StepSearch};
+use crate::level1::Level1Plan;
 use crate::obstacle::Envelope;
-use crate::preimage::{decide, gamma_rad, AvoidSide};
+use crate::planner::{PlannedSegment, Planner};
+use crate::preimage::AvoidSide;
 use crate::profile::MachineProfile;
 use crate::scenario::{Scenario, MAX_SIM_STEPS, SIM_STEP_BYTES};
-use crate::search::{forward_search, SearchParams, SearchPath};
-use crate::segment::{Motion, MotionState, Segment, SegmentKind};
-use crate::simulate::{Contact, SoilSim};
-use crate::smooth::smooth_detour;
-use crate::volume::{disc_area_below, strip, swept_area};
-
-/// How many grid steps past the boulder a detour may be extended to let the
-/// re-plan clear it.
-const MAX_DETOUR_EXTENSION: usize = 12;
+use crate::search::SearchPath;
+use crate::segment::{MotionState, SegmentKind};
+use crate::simulate::{SoilSim, TorqueSensor};
+use crate::volume::{counted_volume, strip};
 
 /// One boulder met.
 #[derive(Debug, Clone, Serialize)]
@@ -57,12 +54,22 @@ pub struct ContactReport {
     pub point_m: [f64; 2],
     /// V_c, tip velocity at the contact [m/s].
     pub velocity_m_s: [f64; 2],
-    /// F_f, the boulder's push on the tooth [N].
+    /// F_f, the boulder's push on the tooth, in the simulator [N].
     pub force_n: [f64; 2],
-    /// γ, clockwise from V_c to F_f (see [`crate::preimage`]) [deg].
+    /// F̂, the force the planner estimated from the measured torque jump [N].
+    pub measured_force_n: [f64; 2],
+    /// n̂, the rock's normal the planner estimated from F̂.
+    pub estimated_normal: [f64; 2],
+    /// The envelope's true outward normal there (simulator).
+    pub true_normal: [f64; 2],
+    /// γ from V_c to F̂ as the planner reads it (see [`crate::preimage`]) [deg].
     pub gamma_deg: f64,
     /// The preimage rule's choice.
     pub decision: AvoidSide,
+    /// Index of the planner's boulder estimate this touch refined or started.
+    pub estimate: usize,
+    /// That estimate after the touch: the envelope planned round.
+    pub estimated_envelope: Envelope,
 }
 
 /// One executed sample.
@@ -80,6 +87,8 @@ pub struct Sample {
     pub attitude_rad: f64,
     /// Joint torques from the Lagrange dynamics [N·m].
     pub torques_nm: [f64; 3],
+    /// The same as the machine measures them, with the sensor's noise [N·m].
+    pub measured_torques_nm: [f64; 3],
     /// Digging resistance on the tooth (soil, plus the boulder at a contact) [N].
     pub digging_force_n: [f64; 2],
     /// Its magnitude [N].
@@ -132,9 +141,13 @@ pub struct DetourReport {
     pub search: SearchPath,
     /// The smoothed detour, densely sampled [m].
     pub smoothed_m: Vec<[f64; 2]>,
-    /// Least distance of the smoothed detour from the envelope met, past its
-    /// first tenth (it starts on the rim) [m].
+    /// Least distance of the smoothed detour from the boulder really met
+    /// (simulator), past its first tenth (it starts on the rim) [m].
     pub clearance_m: f64,
+    /// The same from the envelope the planner estimated [m].
+    pub planned_clearance_m: f64,
+    /// The envelope the planner went round.
+    pub estimate: Envelope,
     /// Volume counted when it was planned (swept so far and boulders) [m³].
     pub volume_before_replan_m3: f64,
     /// The re-planned path after the detour, sampled in time [m].
@@ -179,6 +192,10 @@ pub struct Excavation {
     pub ground: Ground,
     /// Every boulder of the scenario (the planner learns them by contact), for plots.
     pub obstacles: Vec<Envelope>,
+    /// The boulders as the planner estimated them, with their touches.
+    pub estimates: Vec<BoulderEstimate>,
+    /// The radius the planner assumed at a first touch [m].
+    pub prior_radius_m: f64,
     /// V [m³].
     pub target_volume_m3: f64,
     /// Dug, soil and boulders (module docs) [m³].
@@ -187,6 +204,9 @@ pub struct Excavation {
     pub soil_volume_m3: f64,
     /// Boulders counted as dug [m³].
     pub obstacle_volume_m3: f64,
+    /// What the planner believes it dug: the same count with its estimated
+    /// boulders instead of the real ones [m³].
+    pub believed_volume_m3: f64,
     /// The side chosen at the first contact, if any.
     pub avoid_direction: Option<AvoidSide>,
     /// Every contact, in order.
@@ -230,6 +250,12 @@ pub struct Summary {
     pub soil_volume_m3: f64,
     /// Boulders counted [m³].
     pub obstacle_volume_m3: f64,
+    /// See [`Excavation::believed_volume_m3`].
+    pub believed_volume_m3: f64,
+    /// See [`Excavation::prior_radius_m`].
+    pub prior_radius_m: f64,
+    /// The boulders as the planner estimated them.
+    pub estimates: Vec<BoulderEstimate>,
     /// Contacts.
     pub contacts: Vec<ContactReport>,
     /// First contact's side (`over`, `under`), or none.
@@ -254,6 +280,16 @@ pub struct Summary {
     pub plan_time_ms: f64,
 }
 
+impl Sample {
+    fn measured_torques(&self) -> Joints {
+        Joints::new(
+            self.measured_torques_nm[0],
+            self.measured_torques_nm[1],
+            self.measured_torques_nm[2],
+        )
+    }
+}
+
 impl Excavation {
     /// The summary (SPEC §6 `plan-excavate`).
     pub fn summary(&self) -> Summary {
@@ -265,6 +301,9 @@ impl Excavation {
             volume_error: self.volume_error(),
             soil_volume_m3: self.soil_volume_m3,
             obstacle_volume_m3: self.obstacle_volume_m3,
+            believed_volume_m3: self.believed_volume_m3,
+            prior_radius_m: self.prior_radius_m,
+            estimates: self.estimates.clone(),
             contacts: self.contacts.clone(),
             avoid_direction: self.avoid_direction,
             duration_s: self.duration_s,
@@ -328,24 +367,40 @@ impl Excavation {
 
 /// Plan and execute a scenario on a machine; the wall time goes into
 /// [`Excavation::plan_time_ms`].
+///
+/// The scenario is split at once: the planner gets [`Scenario::brief`] (the
+/// dig, its settings, the ground) and learns of boulders only through what
+/// the machine measures at a contact; the boulders, the soil and the sensor
+/// noise stay with the simulator, and the result is measured on them.
 pub fn excavate(scenario: &Scenario, profile: &MachineProfile) -> Result<Excavation> {
     let started = Instant::now();
-    let mut run = Run::new(scenario, profile);
+    let machine = Backhoe::new(profile);
+    let world = SoilSim {
+        machine: &machine,
+        ground: &scenario.ground,
+        soil: &scenario.soil,
+        obstacles: &scenario.obstacles,
+        bucket_width_m: profile.bucket.width_m,
+        max_force_n: profile.force.max_digging_force_n,
+    };
+    let planner = Planner::new(scenario.brief(), profile);
+    let mut run = Run::new(scenario, profile, world, planner);
     let mut ex = run.execute()?;
     ex.plan_time_ms = started.elapsed().as_secs_f64() * 1e3;
     Ok(ex)
 }
 
-/// The state of one pass.
+/// One pass: the machine in the simulated soil (truth), the planner fed
+/// with touches, and the record of what happened.
 struct Run<'a> {
     sc: &'a Scenario,
-    machine: Backhoe,
+    world: SoilSim<'a>,
+    sensor: TorqueSensor,
+    planner: Planner<'a>,
     dynamics: Dynamics,
-    max_force_n: f64,
     width_m: f64,
-    attitude: [f64; 3],
-    known: Vec<bool>,
-    first_half_done: bool,
+    /// Boulders of the scenario the tooth has met (truth, for the record).
+    met: Vec<bool>,
     t_s: f64,
     tips: Vec<Vec2>,
     swept_area: f64,
@@ -357,16 +412,20 @@ struct Run<'a> {
 }
 
 impl<'a> Run<'a> {
-    fn new(sc: &'a Scenario, profile: &MachineProfile) -> Self {
+    fn new(
+        sc: &'a Scenario,
+        profile: &MachineProfile,
+        world: SoilSim<'a>,
+        planner: Planner<'a>,
+    ) -> Self {
         Self {
             sc,
-            machine: Backhoe::new(profile),
+            world,
+            sensor: TorqueSensor::new(&sc.sensing),
+            planner,
             dynamics: Dynamics::new(profile),
-            max_force_n: profile.force.max_digging_force_n,
             width_m: profile.bucket.width_m,
-            attitude: sc.level1_request().attitude_rad,
-            known: vec![false; sc.obstacles.len()],
-            first_half_done: false,
+            met: vec![false; sc.obstacles.len()],
             t_s: 0.0,
             tips: Vec::new(),
             swept_area: 0.0,
@@ -380,32 +439,6 @@ impl<'a> Run<'a> {
 
     fn ground(&self) -> &'a Ground {
         &self.sc.ground
-    }
-
-    fn known_envelopes(&self) -> Vec<Envelope> {
-        self.sc
-            .obstacles
-            .iter()
-            .zip(&self.known)
-            .filter(|(_, k)| **k)
-            .map(|(e, _)| *e)
-            .collect()
-    }
-
-    fn step_search<'b>(&'b self, known: &'b [Envelope]) -> StepSearch<'b> {
-        self.sc.step_search(&self.machine, self.width_m, known)
-    }
-
-    fn sample_path(&self, segments: &[Segment]) -> Vec<[f64; 2]> {
-        let dt = self.sc.planner.dt_s;
-        let mut out = Vec::new();
-        for seg in segments {
-            let n = (seg.duration_s() / dt).ceil().max(1.0) as usize;
-            let tips = seg.sample_tips(&self.machine, n);
-            let skip = usize::from(!out.is_empty());
-            out.extend(tips.into_iter().skip(skip).map(|p| [p.x, p.y]));
-        }
-        out
     }
 
     fn execute(&mut self) -> Result<Excavation> {
@@ -422,51 +455,42 @@ impl<'a> Run<'a> {
                 });
             }
         }
-        let req = self.sc.level1_request();
-        let plan = plan_level1(&self.step_search(&[]), &req)?;
-        let mut pending: VecDeque<PlannedSegment> = plan_segments(&plan);
+        let (plan, first) = self.planner.first_plan()?;
+        let mut pending: VecDeque<PlannedSegment> = first.into();
         let planned_s = pending.iter().map(|ps| ps.segment.duration_s()).sum();
         self.check_steps(planned_s, "the level-1 plan")?;
         let level1 = self.level1_report(&plan);
 
         // The first sample, at rest at the start.
-        let first = plan.first.segment.state(&self.machine, 0.0);
+        let machine = self.world.machine;
+        let first = plan.first.segment.state(machine, 0.0);
         self.tips.push(first.tip);
         self.push_sample(0.0, &first, Vec2::zeros(), 0, SegmentKind::Descent, false);
 
-        let machine = self.machine.clone();
         while let Some(ps) = pending.pop_front() {
             let seg_index = self.segments.len();
             let seg = &ps.segment;
-            let from = seg.tip(&self.machine, 0.0);
-            let to = seg.tip(&self.machine, seg.duration_s());
-            let sim = SoilSim {
-                machine: &machine,
-                ground: &sc.ground,
-                soil: &sc.soil,
-                obstacles: &sc.obstacles,
-                bucket_width_m: self.width_m,
-                max_force_n: self.max_force_n,
-            };
+            let from = seg.tip(machine, 0.0);
+            let to = seg.tip(machine, seg.duration_s());
             let after = self.contacts.len();
             self.check_steps(
                 self.t_s + seg.duration_s(),
                 &format!("the dig after {after} contact(s)"),
             )?;
-            let run = sim.advance(seg, sc.planner.dt_s, &self.known);
+            let run = self.world.advance(seg, sc.planner.dt_s);
             let t0 = self.t_s;
             let n = run.states.len();
             for (k, (t, state)) in run.states.iter().enumerate() {
                 let is_contact = run.contact.is_some() && k + 1 == n;
-                let mut force = sim.resistance(state);
+                let mut force = self.world.resistance(state);
                 let soil_force = force.norm();
                 if !is_contact {
                     self.peak_soil_force_n = self.peak_soil_force_n.max(soil_force);
-                    if soil_force > self.max_force_n {
+                    if soil_force > self.world.max_force_n {
                         return Err(ExcavateError::SoilTooHard {
                             t_s: t0 + t,
                             force_n: soil_force,
-                            max_n: self.max_force_n,
+                            max_n: self.world.max_force_n,
                             depth_m: self.ground().depth(state.tip.x, state.tip.y),
                         });
                     }
@@ -495,7 +519,7 @@ impl<'a> Run<'a> {
             match run.contact {
                 None => {
                     if seg.kind == SegmentKind::Descent {
-                        self.first_half_done = true;
+                        self.planner.descent_completed();
                     }
                 }
                 Some(c) => {
@@ -504,194 +528,52 @@ impl<'a> Run<'a> {
                             max: sc.planner.max_contacts,
                         });
                     }
-                    let gamma = gamma_rad(c.velocity, c.force);
-                    let side = decide(gamma);
+                    // What the machine knows of the contact: its joints, tip and
+                    // velocity, and the torques it measured there and a step before.
+                    let k = self.samples.len();
+                    let touch = Touch {
+                        q: c.state.q,
+                        point: c.point,
+                        velocity: c.velocity,
+                        torques_nm: self.samples[k - 1].measured_torques(),
+                        torques_before_nm: self.samples[k.saturating_sub(2)].measured_torques(),
+                    };
+                    let reading = self.planner.read_touch(&touch);
                     self.contacts.push(ContactReport {
                         obstacle: c.obstacle,
                         t_s: t_end,
                         point_m: [c.point.x, c.point.y],
                         velocity_m_s: [c.velocity.x, c.velocity.y],
                         force_n: [c.force.x, c.force.y],
-                        gamma_deg: gamma.to_degrees(),
-                        decision: side,
+                        measured_force_n: reading.force_n,
+                        estimated_normal: reading.normal,
+                        true_normal: [c.normal.x, c.normal.y],
+                        gamma_deg: reading.gamma_rad.to_degrees(),
+                        decision: reading.side,
+                        estimate: reading.estimate,
+                        estimated_envelope: reading.envelope,
                     });
-                    self.known[c.obstacle] = true;
-                    pending = self.replan(&c, side)?.into();
+                    self.met[c.obstacle] = true;
+                    let (detour, rest) =
+                        self.planner
+                            .replan(&touch, &reading, &self.tips, self.swept_area)?;
+                    self.detours.push(DetourReport {
+                        contact: self.contacts.len() - 1,
+                        side: reading.side,
+                        goal_x_m: detour.goal_x_m,
+                        search: detour.search,
+                        clearance_m: f64::NAN, // measured on the truth in `finish`
+                        planned_clearance_m: detour.planned_clearance_m,
+                        estimate: reading.envelope,
+                        smoothed_m: detour.smoothed_m,
+                        volume_before_replan_m3: detour.volume_before_replan_m3,
+                        replanned_m: detour.replanned_m,
+                    });
+                    pending = rest.into();
                 }
             }
         }
         self.finish(level1)
-    }
-
-    /// Detour and re-plan after a contact.
-    fn replan(&mut self, c: &Contact, side: AvoidSide) -> Result<Vec<PlannedSegment>> {
-        let sc = self.sc;
-        let met = sc.obstacles[c.obstacle];
-        let known = self.known_envelopes();
-        let attitude = c.state.q.sum();
-        let params = SearchParams {
-            step_m: sc.dig.step_m,
-            clearance_m: sc.planner.clearance_m,
-            window_m: sc.planner.search_window_m,
-        };
-        let big_r = met.radius_m + params.clearance_m;
-        let impassable = |why: String| ExcavateError::ObstacleImpassable {
-            index: c.obstacle,
-            side,
-            contact_m: [c.point.x, c.point.y],
-            why,
-        };
-        let mut first_err: Option<ExcavateError> = None;
-        for extra in 1..=MAX_DETOUR_EXTENSION {
-            let goal_x = met.center().x - big_r - extra as f64 * params.step_m;
-            let path = forward_search(
-                &self.machine,
-                attitude,
-                c.point,
-                c.normal,
-                &met,
-                side,
-                &known,
-                goal_x,
-                &params,
-            )
-            .map_err(|f| impassable(f.why))?;
-            let detour = smooth_detour(
-                &self.machine,
-                c.point,
-                &path.waypoints,
-                attitude,
-                &known,
-                sc.planner.speed_fraction,
-                sc.planner.min_segment_time_s,
-            )
-            .map_err(impassable)?;
-            let seg = Segment {
-                kind: SegmentKind::Detour,
-                motion: Motion::Detour(detour),
-            };
-            // Volume so far: executed path plus the detour.
-            let det_tips = seg.sample_tips(&self.machine, sc.planner.trapezoids);
-            let mut path_so_far = self.tips.clone();
-            path_so_far.extend(det_tips.iter().skip(1));
-            let area = self.swept_area + swept_area(self.ground(), &det_tips); // [HE eq. 2]
-            let (soil, rock) = self.counted(&path_so_far, area);
-            let current = soil + rock;
-            let end = *det_tips.last().expect("samples");
-            let end_q = seg.end_joints(&self.machine);
-            match self.plan_rest(end, &end_q, current, &known) {
-                Ok(rest) => {
-                    let mut out = vec![PlannedSegment {
-                        segment: seg,
-                        volume_m3: None,
-                        steps: None,
-                    }];
-                    let first_tenth = det_tips.len() / 10;
-                    let clearance = det_tips
-                        .iter()
-                        .skip(first_tenth.max(1))
-                        .map(|p| met.signed_distance(*p))
-                        .fold(f64::INFINITY, f64::min);
-                    let smoothed = match &out[0].segment.motion {
-                        Motion::Detour(d) => (0..=200)
-                            .map(|k| {
-                                let p = d.spline.point(k as f64 / 200.0);
-                                [p.x, p.y]
-                            })
-                            .collect(),
-                        Motion::Joint(_) => Vec::new(),
-                    };
-                    let rest_segments: Vec<Segment> =
-                        rest.iter().map(|r| r.segment.clone()).collect();
-                    self.detours.push(DetourReport {
-                        contact: self.contacts.len() - 1,
-                        side,
-                        goal_x_m: goal_x,
-                        search: path,
-                        smoothed_m: smoothed,
-                        clearance_m: clearance,
-                        volume_before_replan_m3: current,
-                        replanned_m: self.sample_path(&rest_segments),
-                    });
-                    out.extend(rest);
-                    return Ok(out);
-                }
-                Err(e) => {
-                    if first_err.is_none() {
-                        first_err = Some(e);
-                    }
-                }
-            }
-        }
-        Err(first_err.expect("at least one attempt"))
-    }
-
-    /// Level 1 from a detour's end to the remaining volume (module docs).
-    fn plan_rest(
-        &mut self,
-        from: Vec2,
-        from_q: &Joints,
-        current_m3: f64,
-        known: &[Envelope],
-    ) -> Result<Vec<PlannedSegment>> {
-        let d = &self.sc.dig;
-        let search = self.step_search(known);
-        let remaining = d.target_volume_m3 - current_m3;
-        let first_lacks = 0.5 * d.target_volume_m3 - current_m3;
-        let depth_here = self.ground().depth(from.x, from.y);
-        let mut out = Vec::new();
-        let (mut p, mut q, mut left) = (from, *from_q, remaining);
-        if !self.first_half_done && first_lacks > 0.0 && depth_here < d.depth_m {
-            let down = search.search(
-                p,
-                &q,
-                EndLevel::Depth,
-                d.depth_m,
-                self.attitude[1],
-                first_lacks,
-                SegmentKind::Descent,
-                "the re-planned first half (detour end to the dig depth)",
-            )?;
-            p = down.point;
-            q = down.joints;
-            left -= down.volume_m3;
-            out.push(PlannedSegment::from_found(down));
-        }
-        let up = search.search(
-            p,
-            &q,
-            EndLevel::Ground,
-            d.depth_m,
-            self.attitude[2],
-            left,
-            SegmentKind::Rise,
-            "the re-planned rest (up to the ground)",
-        )?;
-        out.push(PlannedSegment::from_found(up));
-        if out.len() == 1 {
-            // Going straight up: the first half is over.
-            self.first_half_done = true;
-        }
-        Ok(out)
-    }
-
-    /// (soil, boulders) volume [m³] of a path with [HE eq. 2] area `area` (module docs).
-    fn counted(&self, path: &[Vec2], area: f64) -> (f64, f64) {
-        let g = self.ground();
-        let mut soil_area = area;
-        let mut rock = 0.0;
-        for (i, e) in self.sc.obstacles.iter().enumerate() {
-            let c = e.center();
-            let probe = Vec2::new(c.x, c.y.min(g.height(c.x) - 1e-6));
-            let inside = e.contains(probe) && inside_dug_region(g, path, probe);
-            if inside {
-                soil_area -= disc_area_below(g, c, e.radius_m);
-            }
-            if inside || self.known[i] {
-                rock += e.area_m2() * self.width_m;
-            }
-        }
-        (soil_area * self.width_m, rock) // [HE eq. 2]: area × h_b
     }
 
     fn push_sample(
@@ -707,6 +589,7 @@ impl<'a> Run<'a> {
         let tau = self
             .dynamics
             .inverse_dynamics(&state.q, &state.qd, &state.qdd, load_kg, force);
+        let measured = self.sensor.measure(&tau);
         self.samples.push(Sample {
             t_s,
             tip_m: [state.tip.x, state.tip.y],
@@ -714,6 +597,7 @@ impl<'a> Run<'a> {
             joint_rates_rad_s: [state.qd[0], state.qd[1], state.qd[2]],
             attitude_rad: state.q.sum(),
             torques_nm: [tau[0], tau[1], tau[2]],
+            measured_torques_nm: [measured[0], measured[1], measured[2]],
             digging_force_n: [force.x, force.y],
             digging_force_magnitude_n: force.norm(),
             load_kg,
@@ -761,10 +645,12 @@ impl<'a> Run<'a> {
             first_step_volume_m3: plan.first.step_volume_m3,
             second_step_volume_m3: plan.second.step_volume_m3,
             durations_s: [segs[0].duration_s(), segs[1].duration_s()],
-            path_m: self.sample_path(&segs),
+            path_m: self.planner.sample_path(&segs),
         }
     }
 
+    /// Measures the pass on the truth: distances from the real boulders and
+    /// the volume with the real boulders.
     fn finish(&mut self, level1: Level1Report) -> Result<Excavation> {
         let sc = self.sc;
         // Never return a path through an obstacle.
@@ -782,7 +668,18 @@ impl<'a> Run<'a> {
                 min_dist = Some(min_dist.map_or(d, |m: f64| m.min(d)));
             }
         }
-        let speed = self.machine.limits.speed_rad_s;
+        // Each detour's clearance from the boulder really met, past its first tenth.
+        for d in &mut self.detours {
+            let real = sc.obstacles[self.contacts[d.contact].obstacle];
+            let first_tenth = (d.smoothed_m.len() / 10).max(1);
+            d.clearance_m = d
+                .smoothed_m
+                .iter()
+                .skip(first_tenth)
+                .map(|p| real.signed_distance(Vec2::new(p[0], p[1])))
+                .fold(f64::INFINITY, f64::min);
+        }
+        let speed = self.world.machine.limits.speed_rad_s;
         let mut ratio = 0.0f64;
         for w in self.samples.windows(2) {
             let dt = w[1].t_s - w[0].t_s;
@@ -800,11 +697,23 @@ impl<'a> Run<'a> {
                 *p = p.max(t.abs());
             }
         }
-        let (soil, rock) = self.counted(&self.tips, self.swept_area);
+        let (soil, rock) = counted_volume(
+            self.ground(),
+            &sc.obstacles,
+            &self.met,
+            &self.tips,
+            self.swept_area,
+            self.width_m,
+        );
+        let prior = self.planner.prior();
+        let (believed_soil, believed_rock) = self.planner.counted(&self.tips, self.swept_area);
         Ok(Excavation {
+            believed_volume_m3: believed_soil + believed_rock,
             scenario: sc.name.clone(),
             ground: sc.ground.clone(),
             obstacles: sc.obstacles.clone(),
+            estimates: self.planner.estimates().boulders().to_vec(),
+            prior_radius_m: prior.radius_m,
             target_volume_m3: sc.dig.target_volume_m3,
             achieved_volume_m3: soil + rock,
             soil_volume_m3: soil,
@@ -823,63 +732,4 @@ impl<'a> Run<'a> {
             plan_time_ms: 0.0,
         })
     }
-}
-
-/// A segment with what its planning said about it.
-struct PlannedSegment {
-    segment: Segment,
-    volume_m3: Option<f64>,
-    steps: Option<usize>,
-}
-
-impl PlannedSegment {
-    fn from_found(f: StepFound) -> Self {
-        Self {
-            segment: f.segment,
-            volume_m3: Some(f.volume_m3),
-            steps: Some(f.steps),
-        }
-    }
-}
-
-fn plan_segments(plan: &Level1Plan) -> VecDeque<PlannedSegment> {
-    [plan.first.clone(), plan.second.clone()]
-        .into_iter()
-        .map(PlannedSegment::from_found)
-        .collect()
-}
-
-/// True when `p` lies in the region between the ground and the tip path
-/// (closed by the vertical at the path's last point and the ground back to
-/// its first), by the crossing-number test.
-fn inside_dug_region(ground: &Ground, path: &[Vec2], p: Vec2) -> bool {
-    let (Some(first), Some(last)) = (path.first(), path.last()) else {
-        return false;
-    };
-    let mut poly: Vec<Vec2> = path.to_vec();
-    poly.push(Vec2::new(last.x, ground.height(last.x)));
-    let (lo, hi) = (last.x.min(first.x), last.x.max(first.x));
-    let mut between: Vec<Vec2> = ground
-        .points
-        .iter()
-        .filter(|v| v[0] > lo && v[0] < hi)
-        .map(|v| Vec2::new(v[0], v[1]))
-        .collect();
-    if last.x > first.x {
-        between.reverse();
-    }
-    poly.extend(between);
-    poly.push(Vec2::new(first.x, ground.height(first.x)));
-    let mut inside = false;
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if (a.y > p.y) != (b.y > p.y) {
-            let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
-            if x > p.x {
-                inside = !inside;
-            }
-        }
-    }
-    inside
 }

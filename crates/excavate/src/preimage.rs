@@ -18,11 +18,20 @@
 //!
 //! The boundary cases γ = 0° and 180° (a head-on hit through the centre,
 //! which the paper leaves open) choose "over": lifting out costs no depth.
+//!
+//! **This reading is an assumption.** Fig. 3, which fixes the sense of γ, is
+//! not in the text we have; the text says only which interval means which
+//! half. [`GammaReading::Clockwise`] (the default) is the reading above: a
+//! boulder that pushes the tip up, to the upper side of its motion, is passed
+//! over, one that pushes it down is passed under (tested on both paper cases
+//! in `tests/paper.rs`). [`GammaReading::Mirrored`] counts γ
+//! counter-clockwise in our frame — the figure read without the mirror — and
+//! so swaps the two: the bucket then dives under a boulder it met on top.
 
 use std::fmt;
 
 use autoshovel_core::Vec2;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 /// The side of an obstacle the bucket passes.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Hash, Serialize)]
@@ -40,6 +49,29 @@ impl fmt::Display for AvoidSide {
             AvoidSide::Over => "over",
             AvoidSide::Under => "under",
         })
+    }
+}
+
+/// Which way γ is counted in our frame (module docs).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum GammaReading {
+    /// Clockwise from V_c to F_f: the paper's counter-clockwise angle in its
+    /// mirrored Fig. 3 (the default).
+    #[default]
+    Clockwise,
+    /// Counter-clockwise from V_c to F_f in our frame.
+    Mirrored,
+}
+
+impl GammaReading {
+    /// γ [rad] in [0, 2π) from the tip velocity to the contact force.
+    pub fn gamma_rad(self, velocity: Vec2, force: Vec2) -> f64 {
+        let g = gamma_rad(velocity, force);
+        match self {
+            GammaReading::Clockwise => g,
+            GammaReading::Mirrored => (std::f64::consts::TAU - g) % std::f64::consts::TAU,
+        }
     }
 }
 
@@ -84,6 +116,20 @@ mod tests {
             decide(gamma_rad(Vec2::new(-1.0, 0.0), Vec2::new(1.0, 0.0))),
             AvoidSide::Over
         );
+    }
+
+    #[test]
+    fn the_mirrored_reading_swaps_the_sides() {
+        let (v, up, down) = (
+            Vec2::new(-1.0, -0.5),
+            Vec2::new(0.4, 1.0),
+            Vec2::new(0.6, -1.0),
+        );
+        let side = |r: GammaReading, f| decide(r.gamma_rad(v, f));
+        assert_eq!(side(GammaReading::Clockwise, up), AvoidSide::Over);
+        assert_eq!(side(GammaReading::Clockwise, down), AvoidSide::Under);
+        assert_eq!(side(GammaReading::Mirrored, up), AvoidSide::Under);
+        assert_eq!(side(GammaReading::Mirrored, down), AvoidSide::Over);
     }
 
     #[test]

@@ -6,9 +6,13 @@
 //! the paper's §3 case (start (7, 0), boulder Ø 0.5 m, depth 0.7 m, step
 //! 0.05 m, 0.9 m³) with the boulder placed so that the preimage rule passes
 //! it over in one and under in the other, and `two-boulders`. Every key is
-//! required except `[ground]` (level ground y = 0 when absent) and the
-//! `[[obstacle]]` tables (none when absent). Errors name the file, the line
-//! and the key.
+//! required except `[ground]` (level ground y = 0 when absent), the
+//! `[[obstacle]]` tables (none when absent), `[sensing]` and the planner's
+//! boulder prior and γ reading (defaults below). Errors name the file, the
+//! line and the key.
+//!
+//! The planner sees only [`Scenario::brief`]: the dig, its settings and the
+//! ground. `[soil]`, `[sensing]` and the boulders are the simulator's.
 //!
 //! ```toml
 //! name = "my-dig"
@@ -39,6 +43,13 @@
 //! max_contacts = 8
 //! refine_volume = false      # true: bisect inside the last step for the exact volume
 //! max_overdig_m = 0.15       # how far a level-1 path may dip below the dig depth
+//! # boulder_radius_m = 0.24  # radius assumed at a first touch (default: 30 % of the bucket)
+//! rock_friction_prior = 0.3  # μ the planner assumes, to turn the force into a normal
+//! gamma_reading = "clockwise" # or "mirrored" (preimage module)
+//!
+//! [sensing]                  # optional: the machine's joint-torque readings
+//! torque_noise_nm = 1000.0   # standard deviation per joint
+//! seed = 0
 //!
 //! [ground]                   # optional polyline, x increasing
 //! points = [[0.0, 0.0], [10.0, 0.0]]
@@ -57,6 +68,7 @@ use crate::ground::Ground;
 use crate::kinematics::Backhoe;
 use crate::level1::{Level1Request, StepSearch};
 use crate::obstacle::Envelope;
+use crate::preimage::GammaReading;
 use crate::soil::Soil;
 use autoshovel_core::config::{self, line_of_key, ConfigError, TomlFile};
 
@@ -132,6 +144,102 @@ pub struct PlannerSpec {
     /// How far a level-1 path may dip below the dig depth (or below its
     /// start, where that is deeper) [m].
     pub max_overdig_m: f64,
+    /// The radius the planner assumes for a boulder touched once, and the
+    /// least it ever estimates [m]; absent: the paper's class, a disc across
+    /// the bucket holding 30 % of its volume ([`crate::estimate`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub boulder_radius_m: Option<f64>,
+    /// μ the planner assumes between tooth and rock, to turn the measured
+    /// force into the rock's normal (the simulator's is `[soil] rock_friction`).
+    #[serde(default = "default_rock_friction_prior")]
+    pub rock_friction_prior: f64,
+    /// Which way γ is counted ([`GammaReading`]).
+    #[serde(default)]
+    pub gamma_reading: GammaReading,
+}
+
+fn default_rock_friction_prior() -> f64 {
+    0.3
+}
+
+/// What the machine's sensors add to the simulator: the joint torques it
+/// measures (cylinder pressures through the linkage) carry Gaussian noise.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct SensingSpec {
+    /// Standard deviation of each measured joint torque [N·m].
+    pub torque_noise_nm: f64,
+    /// Seed of the noise.
+    pub seed: u64,
+}
+
+impl Default for SensingSpec {
+    /// 1 kN·m per joint: about 1 % of the torques a 100 kN digging force
+    /// makes at the joints of a 15 t machine.
+    fn default() -> Self {
+        Self {
+            torque_noise_nm: 1000.0,
+            seed: 0,
+        }
+    }
+}
+
+/// The planner's view of a scenario ([`Scenario::brief`]): the dig, its
+/// settings and the ground line, which a survey gives, and nothing of what is
+/// buried or of the soil's and rock's properties, which only the simulator
+/// holds.
+#[derive(Debug, Clone, Copy)]
+pub struct Brief<'a> {
+    /// The dig asked for.
+    pub dig: &'a DigSpec,
+    /// The planner's settings.
+    pub planner: &'a PlannerSpec,
+    /// The ground line.
+    pub ground: &'a Ground,
+}
+
+impl<'a> Brief<'a> {
+    /// Level 1's request for this dig: start, depth, target and the three
+    /// attitudes in radians.
+    pub fn level1_request(&self) -> Level1Request {
+        let d = self.dig;
+        Level1Request {
+            start_x_m: d.start_x_m,
+            depth_m: d.depth_m,
+            target_volume_m3: d.target_volume_m3,
+            attitude_rad: [
+                d.attitude_start_deg.to_radians(),
+                d.attitude_mid_deg.to_radians(),
+                d.attitude_end_deg.to_radians(),
+            ],
+        }
+    }
+
+    /// The step-search settings of this dig for `machine` with a bucket
+    /// `bucket_width_m` wide, avoiding the `known` envelopes.
+    pub fn step_search<'b>(
+        &self,
+        machine: &'b Backhoe,
+        bucket_width_m: f64,
+        known: &'b [Envelope],
+    ) -> StepSearch<'b>
+    where
+        'a: 'b,
+    {
+        let p = self.planner;
+        StepSearch {
+            machine,
+            ground: self.ground,
+            bucket_width_m,
+            step_m: self.dig.step_m,
+            trapezoids: p.trapezoids,
+            speed_fraction: p.speed_fraction,
+            min_segment_time_s: p.min_segment_time_s,
+            known,
+            refine: p.refine_volume,
+            max_overdig_m: p.max_overdig_m,
+        }
+    }
 }
 
 /// A whole scenario.
@@ -154,46 +262,34 @@ pub struct Scenario {
     /// Buried boulders, unknown to the planner until met.
     #[serde(default, rename = "obstacle")]
     pub obstacles: Vec<Envelope>,
+    /// The machine's sensors (torque noise).
+    #[serde(default)]
+    pub sensing: SensingSpec,
 }
 
 impl Scenario {
-    /// Level 1's request for this dig: start, depth, target and the three
-    /// attitudes in radians.
-    pub fn level1_request(&self) -> Level1Request {
-        let d = &self.dig;
-        Level1Request {
-            start_x_m: d.start_x_m,
-            depth_m: d.depth_m,
-            target_volume_m3: d.target_volume_m3,
-            attitude_rad: [
-                d.attitude_start_deg.to_radians(),
-                d.attitude_mid_deg.to_radians(),
-                d.attitude_end_deg.to_radians(),
-            ],
+    /// What the planner may know of this scenario: no boulders, no soil.
+    pub fn brief(&self) -> Brief<'_> {
+        Brief {
+            dig: &self.dig,
+            planner: &self.planner,
+            ground: &self.ground,
         }
     }
 
-    /// The step-search settings of this dig for `machine` with a bucket
-    /// `bucket_width_m` wide, avoiding the `known` boulders.
+    /// Level 1's request for this dig ([`Brief::level1_request`]).
+    pub fn level1_request(&self) -> Level1Request {
+        self.brief().level1_request()
+    }
+
+    /// The step-search settings of this dig ([`Brief::step_search`]).
     pub fn step_search<'a>(
         &'a self,
         machine: &'a Backhoe,
         bucket_width_m: f64,
         known: &'a [Envelope],
     ) -> StepSearch<'a> {
-        let p = &self.planner;
-        StepSearch {
-            machine,
-            ground: &self.ground,
-            bucket_width_m,
-            step_m: self.dig.step_m,
-            trapezoids: p.trapezoids,
-            speed_fraction: p.speed_fraction,
-            min_segment_time_s: p.min_segment_time_s,
-            known,
-            refine: p.refine_volume,
-            max_overdig_m: p.max_overdig_m,
-        }
+        self.brief().step_search(machine, bucket_width_m, known)
     }
 
     /// Names of the built-ins.
@@ -334,6 +430,36 @@ impl Scenario {
                 "max_contacts",
                 p.max_contacts.to_string(),
                 "between 1 and 100",
+            ));
+        }
+        if let Some(r) = p.boulder_radius_m {
+            if !(r.is_finite() && r > 0.0 && r <= 5.0) {
+                return Err(bad(
+                    "planner",
+                    0,
+                    "boulder_radius_m",
+                    r.to_string(),
+                    "a radius in (0, 5] m",
+                ));
+            }
+        }
+        if !(p.rock_friction_prior.is_finite() && (0.0..=2.0).contains(&p.rock_friction_prior)) {
+            return Err(bad(
+                "planner",
+                0,
+                "rock_friction_prior",
+                p.rock_friction_prior.to_string(),
+                "a friction coefficient in [0, 2]",
+            ));
+        }
+        let noise = self.sensing.torque_noise_nm;
+        if !(noise.is_finite() && noise >= 0.0) {
+            return Err(bad(
+                "sensing",
+                0,
+                "torque_noise_nm",
+                noise.to_string(),
+                "a standard deviation ≥ 0 N·m",
             ));
         }
         if let Some(why) = self.ground.problem() {

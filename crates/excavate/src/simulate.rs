@@ -1,7 +1,13 @@
 //! The digging simulator: soil with buried boulders the planner does not know.
 //!
+//! This is the truth's side of the code: the boulders, the soil and the
+//! sensor noise live here and in the scenario's `[soil]`, `[sensing]` and
+//! `[[obstacle]]`; the planner ([`crate::planner`]) sees none of them, only the
+//! joint torques [`TorqueSensor`] reports.
+//!
 //! [`SoilSim::advance`] moves the tooth along one planned segment in time steps
-//! of dt and reports the first contact with a boulder not yet met: between
+//! of dt and reports the first contact with any boulder, met before or not
+//! (the planner only estimates where the ones it met are): between
 //! two steps it tests the chord against every unknown envelope (so a fast
 //! step cannot jump over a rim), then bisects the time of entry to 1e-12 s and
 //! puts the contact on the outside of the rim. At the contact the boulder
@@ -9,10 +15,15 @@
 //! [`Soil::contact_force`] — the jump in the digging resistance of paper §2.2.
 
 use autoshovel_core::Vec2;
+use rand::SeedableRng;
+use rand_chacha::ChaCha8Rng;
+use rand_distr::{Distribution, Normal};
 
 use crate::ground::Ground;
 use crate::kinematics::Backhoe;
+use crate::kinematics::Joints;
 use crate::obstacle::Envelope;
+use crate::scenario::SensingSpec;
 use crate::segment::{MotionState, Segment};
 use crate::soil::Soil;
 
@@ -69,9 +80,9 @@ impl SoilSim<'_> {
             .resistance(self.ground, state.tip, state.direction, self.bucket_width_m)
     }
 
-    /// Advance along `segment` in steps of `dt_s`; `known[i]` marks boulders
-    /// already met (the planner avoids those; they are not contacts).
-    pub fn advance(&self, segment: &Segment, dt_s: f64, known: &[bool]) -> SegmentRun {
+    /// Advance along `segment` in steps of `dt_s`, up to its end or the first
+    /// contact with a boulder.
+    pub fn advance(&self, segment: &Segment, dt_s: f64) -> SegmentRun {
         let total = segment.duration_s();
         let steps = (total / dt_s - 1e-9).ceil().max(1.0) as usize;
         let mut states = Vec::with_capacity(steps);
@@ -80,7 +91,7 @@ impl SoilSim<'_> {
         for k in 1..=steps {
             let t = if k == steps { total } else { k as f64 * dt_s };
             let p = segment.tip(self.machine, t);
-            if let Some(contact) = self.first_contact(segment, t_prev, p_prev, t, p, known) {
+            if let Some(contact) = self.first_contact(segment, t_prev, p_prev, t, p) {
                 states.push((contact.t_local_s, contact.state));
                 return SegmentRun {
                     states,
@@ -106,11 +117,10 @@ impl SoilSim<'_> {
         pa: Vec2,
         tb: f64,
         pb: Vec2,
-        known: &[bool],
     ) -> Option<Contact> {
         let mut best: Option<(f64, usize)> = None;
         for (i, e) in self.obstacles.iter().enumerate() {
-            if known.get(i).copied().unwrap_or(false) || !e.meets_segment(pa, pb) {
+            if !e.meets_segment(pa, pb) {
                 continue;
             }
             // A time inside the envelope ([HE eq. 10]: the tip is in S): the
@@ -159,5 +169,32 @@ impl SoilSim<'_> {
             velocity,
             force,
         })
+    }
+}
+
+/// The machine's joint-torque readings: the torques of the dynamics plus
+/// independent Gaussian noise per joint, seeded.
+#[derive(Debug, Clone)]
+pub struct TorqueSensor {
+    noise: Option<Normal<f64>>,
+    rng: ChaCha8Rng,
+}
+
+impl TorqueSensor {
+    /// A sensor with the scenario's noise and seed.
+    pub fn new(spec: &SensingSpec) -> Self {
+        Self {
+            noise: (spec.torque_noise_nm > 0.0)
+                .then(|| Normal::new(0.0, spec.torque_noise_nm).expect("σ > 0 and finite")),
+            rng: ChaCha8Rng::seed_from_u64(spec.seed),
+        }
+    }
+
+    /// One reading of the torques `tau` [N·m].
+    pub fn measure(&mut self, tau: &Joints) -> Joints {
+        match &self.noise {
+            Some(n) => tau.map(|t| t + n.sample(&mut self.rng)),
+            None => *tau,
+        }
     }
 }

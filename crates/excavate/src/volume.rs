@@ -14,6 +14,7 @@
 use autoshovel_core::Vec2;
 
 use crate::ground::Ground;
+use crate::obstacle::Envelope;
 
 /// [HE eq. 2] as printed: equal intervals on [a, b] with depths y₀ … yₙ, times h_b [m³].
 pub fn trapezoid_volume(a: f64, b: f64, depths: &[f64], width_m: f64) -> f64 {
@@ -71,6 +72,71 @@ pub fn disc_area_below(ground: &Ground, center: Vec2, radius: f64) -> f64 {
         s += if i % 2 == 1 { 4.0 } else { 2.0 } * f(a + i as f64 * h);
     }
     s * h / 3.0
+}
+
+/// (soil, boulders) volume [m³] of a dig whose executed tip path `path` has
+/// the [HE eq. 2] area `area` [m²], with a bucket `width_m` wide: the soil is
+/// that area less the part of every boulder lying inside it, times the width;
+/// a boulder counts whole (π r²·b, a disc across the bucket) when it lies
+/// inside the dug area or `met[i]` says the bucket met it (the paper counts a
+/// boulder met as dug).
+pub fn counted_volume(
+    ground: &Ground,
+    boulders: &[Envelope],
+    met: &[bool],
+    path: &[Vec2],
+    area: f64,
+    width_m: f64,
+) -> (f64, f64) {
+    let mut soil_area = area;
+    let mut rock = 0.0;
+    for (i, e) in boulders.iter().enumerate() {
+        let c = e.center();
+        let probe = Vec2::new(c.x, c.y.min(ground.height(c.x) - 1e-6));
+        let inside = e.contains(probe) && inside_dug_region(ground, path, probe);
+        if inside {
+            soil_area -= disc_area_below(ground, c, e.radius_m);
+        }
+        if inside || met.get(i).copied().unwrap_or(false) {
+            rock += e.area_m2() * width_m;
+        }
+    }
+    (soil_area * width_m, rock) // [HE eq. 2]: area × h_b
+}
+
+/// True when `p` lies in the region between the ground and the tip path
+/// (closed by the vertical at the path's last point and the ground back to
+/// its first), by the crossing-number test.
+fn inside_dug_region(ground: &Ground, path: &[Vec2], p: Vec2) -> bool {
+    let (Some(first), Some(last)) = (path.first(), path.last()) else {
+        return false;
+    };
+    let mut poly: Vec<Vec2> = path.to_vec();
+    poly.push(Vec2::new(last.x, ground.height(last.x)));
+    let (lo, hi) = (last.x.min(first.x), last.x.max(first.x));
+    let mut between: Vec<Vec2> = ground
+        .points
+        .iter()
+        .filter(|v| v[0] > lo && v[0] < hi)
+        .map(|v| Vec2::new(v[0], v[1]))
+        .collect();
+    if last.x > first.x {
+        between.reverse();
+    }
+    poly.extend(between);
+    poly.push(Vec2::new(first.x, ground.height(first.x)));
+    let mut inside = false;
+    let n = poly.len();
+    for i in 0..n {
+        let (a, b) = (poly[i], poly[(i + 1) % n]);
+        if (a.y > p.y) != (b.y > p.y) {
+            let x = a.x + (p.y - a.y) * (b.x - a.x) / (b.y - a.y);
+            if x > p.x {
+                inside = !inside;
+            }
+        }
+    }
+    inside
 }
 
 #[cfg(test)]

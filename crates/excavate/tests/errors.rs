@@ -93,10 +93,12 @@ fn an_obstacle_enclosing_the_start_is_refused() {
 
 #[test]
 fn a_boulder_the_joint_limits_do_not_let_the_bucket_pass_is_named() {
-    // Met while descending on its lower part, near the far end of the reach:
-    // passing under needs the stick straighter than its limit.
+    // Met while descending on its lower part, near the far end of the reach,
+    // by a planner that assumes boulders of 0.45 m radius: passing under the
+    // envelope it assumes needs the stick straighter than its limit.
     let mut s = Scenario::paper_under();
-    s.obstacles[0].center_m = [6.55, -0.50];
+    s.obstacles[0].center_m = [6.6, -0.50];
+    s.planner.boulder_radius_m = Some(0.45);
     let e = plan(&s);
     match &e {
         ExcavateError::ObstacleImpassable {
