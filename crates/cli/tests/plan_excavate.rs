@@ -172,6 +172,8 @@ fn check_summary(s: &Value, scenario: &str, profile: &str) {
         );
         let (v, f) = (pair(&c["velocity_m_s"]), pair(&c["force_n"]));
         assert!((f[0].hypot(f[1]) - rated).abs() < 1e-6 * rated, "{c}");
+        // The planner reads γ from the force it measured, not the simulator's.
+        let f = pair(&c["measured_force_n"]);
         let g = f64_field(c, "gamma_deg");
         assert!(
             (g - gamma_deg(v, f)).abs() < 1e-9,
@@ -542,10 +544,16 @@ fn broken_or_impossible_scenarios_are_refused_by_name() {
         ),
         (
             "impassable.toml",
+            // A planner that assumes 0.45 m boulders cannot pass under one
+            // met low near the far end of the reach.
             replace_once(
-                &under,
-                "center_m = [6.10, -0.45]",
-                "center_m = [6.55, -0.50]",
+                &replace_once(
+                    &under,
+                    "center_m = [6.10, -0.45]",
+                    "center_m = [6.6, -0.50]",
+                ),
+                "max_overdig_m = 0.15",
+                "boulder_radius_m = 0.45\nmax_overdig_m = 0.15",
             ),
             &["cannot pass obstacle 0 under", "stick"],
             None,
