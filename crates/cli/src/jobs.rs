@@ -71,6 +71,45 @@ pub fn study(
     })
 }
 
+/// `study-boulders`: the seeded boulder study on `base`, cases in parallel
+/// (with a progress bar when `progress`).
+pub fn study_boulders(
+    base: &autoshovel_excavate::Scenario,
+    profile: &autoshovel_excavate::MachineProfile,
+    params: &autoshovel_excavate::study::BoulderStudyParams,
+    out: Option<&OutDir>,
+    progress: bool,
+) -> Result<Job<autoshovel_excavate::study::BoulderStudySummary>> {
+    use autoshovel_excavate::study::{boulder_free_path, run_case, summarize, CaseRow};
+    if params.cases == 0 || params.cases > 100_000 {
+        bail!("--cases {} must be between 1 and 100000", params.cases);
+    }
+    let [r0, r1] = params.radius_m;
+    if !(r0.is_finite() && r1.is_finite() && r0 > 0.0 && r0 <= r1 && r1 <= 2.0) {
+        bail!("--min-radius {r0} and --max-radius {r1} must satisfy 0 < min <= max <= 2 m");
+    }
+    let path = boulder_free_path(base, profile)
+        .with_context(|| format!("planning `{}` without boulders", base.name))?;
+    let bar = progress_bar(
+        progress,
+        "{msg} [{bar:40}] {pos}/{len} boulders, {eta} left",
+    );
+    bar.set_length(params.cases as u64);
+    bar.set_message("digging");
+    let rows: Vec<CaseRow> = (0..params.cases)
+        .into_par_iter()
+        .progress_with(bar.clone())
+        .map(|i| run_case(base, profile, &path, params, i))
+        .collect();
+    bar.finish_and_clear();
+    let summary = summarize(params, base, profile, &rows);
+    Job::finish(summary.clone(), out, |dir, written| {
+        Ok(figures::boulders::write_study(
+            dir, &summary, &rows, written,
+        )?)
+    })
+}
+
 /// `track`: drive `scenario` with `controller` (all three with `compare`).
 pub fn track(
     scenario: &TrackScenario,

@@ -24,6 +24,7 @@ mod plan_dig;
 mod plan_excavate;
 mod plan_path;
 mod study;
+mod study_boulders;
 mod track;
 
 use std::path::PathBuf;
@@ -55,6 +56,8 @@ enum Command {
     PlanExcavate(plan_excavate::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
+    /// Seeded boulder study of the excavator planner that knows only what it touches.
+    StudyBoulders(study_boulders::Args),
     /// Print a built-in scenario (of plan-path, track or plan-excavate) as TOML, to copy and edit.
     Scenario {
         /// Built-in scenario name (an unknown one lists them all, by job).
@@ -149,6 +152,7 @@ fn main() -> ExitCode {
     let result = match cli.command {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),
+        Command::StudyBoulders(args) => study_boulders::run(&args),
         Command::Track(args) => track::run(&args),
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),

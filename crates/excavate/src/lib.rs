@@ -53,6 +53,7 @@ pub mod setup;
 pub mod simulate;
 pub mod smooth;
 pub mod soil;
+pub mod study;
 pub mod summary;
 pub mod volume;
 

@@ -141,8 +141,9 @@ pub struct DetourReport {
     pub search: SearchPath,
     /// The smoothed detour, densely sampled [m].
     pub smoothed_m: Vec<[f64; 2]>,
-    /// Least distance of the smoothed detour from the boulder really met
-    /// (simulator), past its first tenth (it starts on the rim) [m].
+    /// Least distance of the executed detour from the boulder really met
+    /// (simulator), past its first tenth (it starts on the rim), the
+    /// contact that may cut it short excluded [m].
     pub clearance_m: f64,
     /// The same from the envelope the planner estimated [m].
     pub planned_clearance_m: f64,
@@ -668,15 +669,21 @@ impl<'a> Run<'a> {
                 min_dist = Some(min_dist.map_or(d, |m: f64| m.min(d)));
             }
         }
-        // Each detour's clearance from the boulder really met, past its first tenth.
-        for d in &mut self.detours {
+        // Each detour's clearance from the boulder really met: over the
+        // samples that executed it (a contact may have cut it short), past
+        // their first tenth (it starts on the rim).
+        let detour_segments: Vec<usize> = (0..self.segments.len())
+            .filter(|&i| self.segments[i].kind == SegmentKind::Detour)
+            .collect();
+        for (d, &seg) in self.detours.iter_mut().zip(&detour_segments) {
             let real = sc.obstacles[self.contacts[d.contact].obstacle];
-            let first_tenth = (d.smoothed_m.len() / 10).max(1);
-            d.clearance_m = d
-                .smoothed_m
+            let executed: Vec<&Sample> = self.samples.iter().filter(|s| s.segment == seg).collect();
+            let first_tenth = (executed.len() / 10).max(1);
+            d.clearance_m = executed
                 .iter()
                 .skip(first_tenth)
-                .map(|p| real.signed_distance(Vec2::new(p[0], p[1])))
+                .filter(|s| !s.contact)
+                .map(|s| real.signed_distance(Vec2::new(s.tip_m[0], s.tip_m[1])))
                 .fold(f64::INFINITY, f64::min);
         }
         let speed = self.world.machine.limits.speed_rad_s;

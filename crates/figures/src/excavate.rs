@@ -234,6 +234,20 @@ fn dig_layers(ex: &Excavation, x0: f64, x1: f64, detail: bool) -> Vec<Layer> {
             ));
         }
     }
+    for (i, b) in ex.estimates.iter().enumerate() {
+        let e = b.envelope;
+        let l = Layer::circle(
+            pt(e.center_m),
+            e.radius_m,
+            None,
+            Stroke::dashed(Rgb::RED, 2),
+        );
+        layers.push(if i == 0 {
+            label(l, "boulder as the planner estimated it (from the touches)")
+        } else {
+            l
+        });
+    }
     layers.push(label(
         Layer::line(
             ex.planned_path().iter().map(|p| pt(*p)),

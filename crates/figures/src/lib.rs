@@ -9,6 +9,7 @@
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]
 
+pub mod boulders;
 pub mod dig;
 pub mod excavate;
 pub mod map;

@@ -1,0 +1,67 @@
+//! `autoshovel study-boulders`: the hydraulic excavator's dig with one
+//! buried boulder of random size and place, planned by the planner that knows
+//! only what it touches, measured on the truth (`autoshovel_excavate::study`).
+
+use std::path::{Path, PathBuf};
+
+use anyhow::Result;
+use autoshovel_excavate::study::BoulderStudyParams;
+use autoshovel_excavate::Setup;
+use autoshovel_figures::boulders::markdown_table;
+
+/// Arguments of `study-boulders`.
+#[derive(Debug, clap::Args)]
+pub struct Args {
+    /// The dig to put the boulders in: paper-over, paper-under, or a scenario
+    /// TOML file (its own boulders are replaced).
+    #[arg(long, default_value = "paper-over")]
+    pub scenario: String,
+    /// Machine profile (TOML); default: the 15 t class backhoe.
+    #[arg(long)]
+    pub profile: Option<PathBuf>,
+    /// Number of boulders, one dig each.
+    #[arg(long, default_value_t = 200)]
+    pub cases: usize,
+    /// Seed of the boulders and of the sensor noise.
+    #[arg(long, default_value_t = 1)]
+    pub seed: u64,
+    /// Smallest boulder radius [m].
+    #[arg(long, default_value_t = 0.15)]
+    pub min_radius: f64,
+    /// Largest boulder radius [m].
+    #[arg(long, default_value_t = 0.5)]
+    pub max_radius: f64,
+    /// Write summary.json, cases.csv and plots here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
+    /// Print the summary JSON alone on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
+/// Runs the study as the command line asks.
+pub fn run(args: &Args) -> Result<()> {
+    let setup = Setup::load(&args.scenario, args.profile.as_deref())?;
+    let params = BoulderStudyParams {
+        cases: args.cases,
+        seed: args.seed,
+        radius_m: [args.min_radius, args.max_radius],
+    };
+    let out = crate::output::out_dir(
+        args.out.as_deref(),
+        &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
+        args.force,
+    )?;
+    let job = crate::jobs::study_boulders(
+        &setup.scenario,
+        &setup.profile,
+        &params,
+        out.as_ref(),
+        !args.json,
+    )?;
+    job.report(args.json, |s| crate::say!("{}", markdown_table(s)))
+}
