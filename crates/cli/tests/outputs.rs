@@ -32,10 +32,11 @@ fn no_staging_left(dir: &Path) {
 #[test]
 fn every_job_keeps_a_users_file_unless_forced_and_reruns_into_its_own_folder() {
     let tmp = TempDir::new("outputs-jobs");
-    let jobs: [&[&str]; 5] = [
+    let jobs: [&[&str]; 6] = [
         &["plan-path", "--scenario", "straight"],
         &["track", "--scenario", "straight"],
         &["study-paths", "--maps", "4"],
+        &["study-boulders", "--cases", "3"],
         &["plan-excavate", "--scenario", "paper-over"],
         &["plan-dig", "--surface", "typical"],
     ];

@@ -277,3 +277,60 @@ fn timeout_helper_kills_a_slow_run() {
         std::time::Duration::from_millis(200),
     );
 }
+
+#[test]
+fn the_boulder_study_is_repeatable_and_writes_its_cases() {
+    let dir = TempDir::new("boulders-out");
+    let go = |out: Option<&std::path::Path>| {
+        let mut a: Vec<&std::ffi::OsStr> =
+            ["study-boulders", "--cases", "8", "--seed", "5", "--json"]
+                .iter()
+                .map(|s| s.as_ref())
+                .collect();
+        if let Some(d) = out {
+            a.extend(["--out".as_ref(), d.as_os_str()]);
+        }
+        run(&a).ok().json()
+    };
+    let printed = go(Some(dir.path()));
+    let mut without_files = printed.clone();
+    without_files.as_object_mut().unwrap().remove("files");
+    assert_eq!(without_files, go(None), "same seed, same study");
+    assert_eq!(printed["job"], "study-boulders");
+    let planners: Vec<&str> = printed["planners"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|p| p["planner"].as_str().unwrap())
+        .collect();
+    assert_eq!(planners, ["class prior", "true size"]);
+    let csv = std::fs::read_to_string(dir.path().join("cases.csv")).expect("cases.csv");
+    assert!(csv.starts_with("case,center_x_m,center_y_m,radius_m,class_prior_completed,"));
+    assert_eq!(csv.lines().count(), 9, "a header and one row per boulder");
+    for f in [
+        "volume_error_by_radius.svg",
+        "volume_error_by_radius.png",
+        "summary.json",
+    ] {
+        assert!(dir.path().join(f).is_file(), "{f} missing");
+    }
+    let r = run(&["study-boulders", "--cases", "0"]).fails();
+    assert!(
+        r.error_message().contains("--cases 0"),
+        "{}",
+        r.error_message()
+    );
+    let r = run(&[
+        "study-boulders",
+        "--min-radius",
+        "0.6",
+        "--max-radius",
+        "0.5",
+    ])
+    .fails();
+    assert!(
+        r.error_message().contains("--min-radius 0.6"),
+        "{}",
+        r.error_message()
+    );
+}

@@ -128,7 +128,7 @@ pub fn sample_row(s: &Sample) -> Vec<String> {
 
 /// The columns of `contacts.csv`: every field of [`ContactReport`], vectors
 /// split, with |F_f| and the attitude angle at the contact.
-pub const CONTACT_COLUMNS: [&str; 13] = [
+pub const CONTACT_COLUMNS: [&str; 20] = [
     "contact",
     "obstacle",
     "t_s",
@@ -142,6 +142,13 @@ pub const CONTACT_COLUMNS: [&str; 13] = [
     "gamma_deg",
     "decision",
     "attitude_deg",
+    "measured_force_x_n",
+    "measured_force_y_n",
+    "estimated_normal_x",
+    "estimated_normal_y",
+    "estimate_center_x_m",
+    "estimate_center_y_m",
+    "estimate_radius_m",
 ];
 
 /// Row of contact `i` (0-based) of `contacts.csv` ([`CONTACT_COLUMNS`]).
@@ -163,6 +170,13 @@ pub fn contact_row(i: usize, c: &ContactReport, ex: &Excavation) -> Vec<String> 
         format_f64(c.gamma_deg),
         c.decision.to_string(),
         format_f64(attitude),
+        format_f64(c.measured_force_n[0]),
+        format_f64(c.measured_force_n[1]),
+        format_f64(c.estimated_normal[0]),
+        format_f64(c.estimated_normal[1]),
+        format_f64(c.estimated_envelope.center_m[0]),
+        format_f64(c.estimated_envelope.center_m[1]),
+        format_f64(c.estimated_envelope.radius_m),
     ]
 }
 
