@@ -19,6 +19,8 @@ pub enum ControllerArg {
     Pid,
     /// Pure pursuit (geometric), forward and reverse.
     PurePursuit,
+    /// Stanley (heading and cross-track error, with curvature feed-forward).
+    Stanley,
 }
 
 impl From<ControllerArg> for ControllerKind {
@@ -27,6 +29,7 @@ impl From<ControllerArg> for ControllerKind {
             ControllerArg::Fuzzy => ControllerKind::Fuzzy,
             ControllerArg::Pid => ControllerKind::Pid,
             ControllerArg::PurePursuit => ControllerKind::PurePursuit,
+            ControllerArg::Stanley => ControllerKind::Stanley,
         }
     }
 }

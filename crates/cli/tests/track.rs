@@ -53,13 +53,14 @@ fn compare_runs_every_controller_on_the_same_seed_and_writes_the_table() {
         .iter()
         .map(|r| r["controller"].as_str().unwrap())
         .collect();
-    assert_eq!(names, ["fuzzy", "pid", "pure-pursuit"]);
+    assert_eq!(names, ["fuzzy", "pid", "pure-pursuit", "stanley"]);
     for f in [
         "summary.json",
         "compare.csv",
         "track_fuzzy.csv",
         "track_pid.csv",
         "track_pure-pursuit.csv",
+        "track_stanley.csv",
         "track_path.svg",
         "track_path.png",
         "track_deviation_heading.svg",
@@ -69,7 +70,7 @@ fn compare_runs_every_controller_on_the_same_seed_and_writes_the_table() {
         assert!(out.join(f).exists(), "{f} missing");
     }
     let csv = std::fs::read_to_string(out.join("compare.csv")).unwrap();
-    assert_eq!(csv.lines().count(), 4, "{csv}");
+    assert_eq!(csv.lines().count(), 5, "{csv}");
     // Same seed, same fuzzy numbers as a run on its own.
     let alone = run(&["track", "--scenario", "straight", "--json"])
         .ok()
@@ -185,7 +186,7 @@ fn scenario_gains_change_the_run_and_the_summary_reports_them() {
     assert_eq!(base["params"]["pid"]["kp"], 800.0);
     let tuned = format!(
         "{GOOD}[controller.fuzzy]\nk1 = 1.2\n[controller.pid]\nkp = 400.0\n\
-         [controller.pure_pursuit]\nlookahead_m = 3.0\n"
+         [controller.pure_pursuit]\nlookahead_m = 3.0\n[controller.stanley]\nk_per_s = 2.5\n"
     );
     let (_d2, p) = track_file(&tuned);
     let s = run(&args(&p)).ok().json();
@@ -201,6 +202,7 @@ fn scenario_gains_change_the_run_and_the_summary_reports_them() {
     assert_eq!(rows[1]["gains"]["kp"], 400.0);
     assert_eq!(rows[1]["gains"]["ki"], 100.0);
     assert_eq!(rows[2]["gains"]["lookahead_m"], 3.0);
+    assert_eq!(rows[3]["gains"]["k_per_s"], 2.5);
     // ... and every controller's run changes with its gains.
     let before = base["compare"].as_array().expect("compare rows");
     for (i, (a, b)) in before.iter().zip(rows).enumerate() {

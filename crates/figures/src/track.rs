@@ -24,6 +24,7 @@ pub fn color(kind: ControllerKind) -> Rgb {
         ControllerKind::Fuzzy => Rgb::RED,
         ControllerKind::Pid => Rgb::BLUE,
         ControllerKind::PurePursuit => Rgb::GREEN,
+        ControllerKind::Stanley => Rgb::PURPLE,
     }
 }
 

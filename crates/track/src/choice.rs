@@ -3,7 +3,7 @@
 
 use serde::{Deserialize, Serialize};
 
-use crate::controller::{Controller, ControllerParams, Pid, PurePursuit};
+use crate::controller::{Controller, ControllerParams, Pid, PurePursuit, Stanley};
 use crate::fuzzy_tracker::FuzzyTracker;
 
 /// Which controller tracks the path.
@@ -16,14 +16,17 @@ pub enum ControllerKind {
     Pid,
     /// Pure pursuit (geometric), forward and reverse.
     PurePursuit,
+    /// Stanley (geometric, heading and cross-track error).
+    Stanley,
 }
 
 impl ControllerKind {
     /// Every controller, in report order.
-    pub const ALL: [ControllerKind; 3] = [
+    pub const ALL: [ControllerKind; 4] = [
         ControllerKind::Fuzzy,
         ControllerKind::Pid,
         ControllerKind::PurePursuit,
+        ControllerKind::Stanley,
     ];
 
     /// A fresh controller of this kind with its gains from `params`.
@@ -33,6 +36,9 @@ impl ControllerKind {
             ControllerKind::Pid => Box::new(Pid::new(params.pid)),
             ControllerKind::PurePursuit => Box::new(PurePursuit {
                 params: params.pure_pursuit,
+            }),
+            ControllerKind::Stanley => Box::new(Stanley {
+                params: params.stanley,
             }),
         }
     }

@@ -1,8 +1,9 @@
 //! The tracker seam: a controller turns the deviations of [W eq. 21]–[W eq. 22]
 //! into the speed difference between the right and left track motors; the
 //! gains of every controller ([`ControllerParams`], the `[controller.*]`
-//! tables of a tracking scenario), the PID and pure pursuit. The fuzzy
-//! tracker is in `fuzzy_tracker.rs`, the choice among them in `choice.rs`.
+//! tables of a tracking scenario), the PID, pure pursuit and Stanley. The
+//! fuzzy tracker is in `fuzzy_tracker.rs`, the choice among them in
+//! `choice.rs`.
 //!
 //! Sign convention (SPEC §3): deviations are positive left of the path, and
 //! every controller returns `steer_rpm` = n_right − n_left, positive turning
@@ -58,6 +59,8 @@ pub enum Gains {
     Pid(PidParams),
     /// Pure pursuit's.
     PurePursuit(PurePursuitParams),
+    /// Stanley's.
+    Stanley(StanleyParams),
 }
 
 /// The gains of every controller: the `[controller.fuzzy]`,
@@ -72,6 +75,8 @@ pub struct ControllerParams {
     pub pid: PidParams,
     /// Pure pursuit.
     pub pure_pursuit: PurePursuitParams,
+    /// Stanley.
+    pub stanley: StanleyParams,
 }
 
 /// Parameters of the fuzzy tracker.
@@ -89,6 +94,38 @@ pub struct FuzzyParams {
     /// Time constant of the first-order low-pass on ec [s] (0 = none): the
     /// rate of a centimetre-noisy RTK error at 10 Hz is mostly noise.
     pub ec_filter_s: f64,
+    /// Growth of α with the path's curvature [m]: α(κ) = alpha +
+    /// alpha_curvature_m·|κ| [W eq. 23] ("its value is related to the
+    /// curvature of the trajectory"). 0 keeps α constant.
+    pub alpha_curvature_m: f64,
+    /// Fixed scaling factors, or contraction–expansion factors that vary
+    /// with the inputs ([`Universe`], [W eq. 24]).
+    pub universe: Universe,
+    /// τ of the variable universe's factor α(x) = (|x|/E)^τ + ε, in (0, 1].
+    pub vu_tau: f64,
+    /// ε of the variable universe's factor, in (0, 1]: the narrowest a
+    /// universe contracts to, as a share of its full width.
+    pub vu_epsilon: f64,
+}
+
+/// How the fuzzy tracker's universes scale [W eq. 24].
+///
+/// `Fixed` is eq. 24 as printed: σ_i = n_i·k_i with constant k_i.
+/// `Variable` is the variable-universe method of Li Hongxing ("Adaptive
+/// fuzzy controllers based on variable universe", Science in China E 42(1),
+/// 1999, 10–20): each input's universe [−E, E] contracts and expands with the
+/// input itself by the factor α(x) = (|x|/E)^τ + ε (capped at 1), so the rule
+/// base sees x/α(x) — fine resolution near zero error, the whole table far
+/// from it — and the output universe scales with the error's factor, β =
+/// α(e) (Li's simplest output factor).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum Universe {
+    /// Constant k1, k2, k3 (the default).
+    #[default]
+    Fixed,
+    /// Input-dependent contraction–expansion factors.
+    Variable,
 }
 
 impl Default for FuzzyParams {
@@ -102,6 +139,10 @@ impl Default for FuzzyParams {
             k2: 32.1,
             k3: 1.11,
             ec_filter_s: 0.34,
+            alpha_curvature_m: 0.0,
+            universe: Universe::Fixed,
+            vu_tau: 0.5,
+            vu_epsilon: 0.1,
         }
     }
 }
@@ -123,6 +164,20 @@ pub struct PidParams {
     pub alpha: f64,
     /// Output limit [rpm].
     pub max_steer_rpm: f64,
+    /// The error it acts on ([`PidError`]).
+    pub error: PidError,
+}
+
+/// The error a PID acts on.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default, Serialize, Deserialize)]
+#[serde(rename_all = "kebab-case")]
+pub enum PidError {
+    /// e = d + α·d0, the fuzzy tracker's input [W eq. 23] (the default).
+    #[default]
+    Preview,
+    /// The centroid's position error d0 alone, as a PID on the position
+    /// error (§5.4's baseline) acts.
+    Position,
 }
 
 impl Default for PidParams {
@@ -133,6 +188,17 @@ impl Default for PidParams {
             kd: 300.0,
             alpha: 0.5,
             max_steer_rpm: 2700.0,
+            error: PidError::Preview,
+        }
+    }
+}
+
+impl PidParams {
+    /// The paper's §5.4 baseline: kp 800, ki 100, kd 300 on the position error.
+    pub fn paper() -> Self {
+        Self {
+            error: PidError::Position,
+            ..Self::default()
         }
     }
 }
@@ -173,8 +239,11 @@ impl Controller for Pid {
 
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
-        // e = d + α·d0 [W eq. 23]
-        let e = input.dev.d_m + p.alpha * input.dev.d0_m;
+        let e = match p.error {
+            // e = d + α·d0 [W eq. 23]
+            PidError::Preview => input.dev.d_m + p.alpha * input.dev.d0_m,
+            PidError::Position => input.dev.d0_m,
+        };
         let de = match self.prev_e {
             Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
             _ => 0.0,
@@ -259,3 +328,69 @@ impl Controller for PurePursuit {
         (dv / input.crawler.mps_per_rpm()).clamp(-p.max_steer_rpm, p.max_steer_rpm)
     }
 }
+
+/// Stanley's steering law (Hoffmann, Tomlin, Montemerlo & Thrun, "Autonomous
+/// automobile trajectory tracking for off-road driving", ACC 2007), for a
+/// skid-steered crawler: the heading correction
+/// δ = θ_e + atan(k·e / (v_s + |v|)), with θ_e the path's heading minus the
+/// heading of motion and e the centroid's cross-track error (right of the
+/// path positive, so −d0), becomes a yaw rate ω = |v|·κ + δ/τ (the path's
+/// curvature as feed-forward, δ closed in τ), and the speed difference
+/// n_r − n_l = ω·B / (m/s per rpm).
+#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct StanleyParams {
+    /// k, the cross-track gain [1/s].
+    pub k_per_s: f64,
+    /// v_s, the softening speed that keeps the law finite at rest [m/s].
+    pub softening_mps: f64,
+    /// τ, the time in which the heading correction is closed [s].
+    pub heading_time_s: f64,
+    /// Output limit [rpm].
+    pub max_steer_rpm: f64,
+}
+
+impl Default for StanleyParams {
+    fn default() -> Self {
+        Self {
+            k_per_s: 1.0,
+            softening_mps: 0.3,
+            heading_time_s: 0.8,
+            max_steer_rpm: 2700.0,
+        }
+    }
+}
+
+/// The Stanley tracker.
+#[derive(Debug, Clone)]
+pub struct Stanley {
+    /// Parameters.
+    pub params: StanleyParams,
+}
+
+impl Controller for Stanley {
+    fn name(&self) -> &'static str {
+        "stanley"
+    }
+
+    fn reset(&mut self) {}
+
+    fn gains(&self) -> Gains {
+        Gains::Stanley(self.params)
+    }
+
+    fn step(&mut self, input: &ControlInput) -> f64 {
+        let p = self.params;
+        let v = input.speed_mps.abs();
+        let theta_e = -input.dev.heading_error_rad;
+        let delta = theta_e + (-p.k_per_s * input.dev.d0_m).atan2(p.softening_mps + v);
+        let kappa = input.leg.curvature_at(input.dev.s_a_m, CURVATURE_WINDOW_M);
+        let omega = v * kappa + delta / p.heading_time_s;
+        (omega * input.crawler.gauge_m / input.crawler.mps_per_rpm())
+            .clamp(-p.max_steer_rpm, p.max_steer_rpm)
+    }
+}
+
+/// Half the arc over which a controller measures the path's curvature [m]:
+/// wider than the planner's point spacing, narrower than the tightest turn.
+pub const CURVATURE_WINDOW_M: f64 = 0.5;

@@ -15,7 +15,11 @@
 use autoshovel_fuzzy::{FuzzyError, MamdaniSystem, Scratch};
 
 pub use crate::controller::FuzzyParams;
-use crate::controller::{ControlInput, Controller, Gains};
+use crate::controller::{ControlInput, Controller, Gains, Universe, CURVATURE_WINDOW_M};
+
+/// The edge of the rule base's e and ec universes (Table 1's terms).
+const E_EDGE: f64 = 0.45;
+const EC_EDGE: f64 = 30.0;
 
 pub use autoshovel_fuzzy::presets::shovel_table1::{TABLE1, TERMS};
 
@@ -77,8 +81,15 @@ impl Controller for FuzzyTracker {
     /// and Table 1's Mamdani inference.
     fn step(&mut self, input: &ControlInput) -> f64 {
         let p = self.params;
+        // α related to the path's curvature [W eq. 23]
+        let alpha = if p.alpha_curvature_m > 0.0 {
+            let kappa = input.leg.curvature_at(input.dev.s_a_m, CURVATURE_WINDOW_M);
+            p.alpha + p.alpha_curvature_m * kappa.abs()
+        } else {
+            p.alpha
+        };
         // e = d + α·d0 [W eq. 23]
-        let e = input.dev.d_m + p.alpha * input.dev.d0_m;
+        let e = input.dev.d_m + alpha * input.dev.d0_m;
         let raw = match self.prev_e {
             Some(prev) if input.dt_s > 0.0 => (e - prev) / input.dt_s,
             _ => 0.0,
@@ -91,16 +102,25 @@ impl Controller for FuzzyTracker {
         };
         self.ec_filtered += a * (raw - self.ec_filtered);
         let ec = self.ec_filtered;
-        // e_f = k1·e, ec_f = k2·ec [W eq. 24]
-        let x = [p.k1 * e, p.k2 * ec];
+        // e_f = k1·e, ec_f = k2·ec [W eq. 24]; with a variable universe the
+        // physical universes E = edge/k contract by α(x) = (|x|/E)^τ + ε.
+        let (ae, aec) = match p.universe {
+            Universe::Fixed => (1.0, 1.0),
+            Universe::Variable => {
+                let factor =
+                    |x: f64, edge: f64| ((x.abs() / edge).powf(p.vu_tau) + p.vu_epsilon).min(1.0);
+                (factor(p.k1 * e, E_EDGE), factor(p.k2 * ec, EC_EDGE))
+            }
+        };
+        let x = [p.k1 * e / ae, p.k2 * ec / aec];
         let u_f = if x.iter().all(|v| v.is_finite()) {
             self.system.infer_with(&x, &mut self.scratch).unwrap_or(0.0)
         } else {
             0.0
         };
         self.last = (x[0], x[1], u_f);
-        // u = k3·u_f [W eq. 24]; n_r − n_l = −u
-        -(p.k3 * u_f)
+        // u = β·k3·u_f [W eq. 24] (β = α(e), 1 for fixed universes); n_r − n_l = −u
+        -(ae * p.k3 * u_f)
     }
 }
 

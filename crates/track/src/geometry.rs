@@ -120,6 +120,21 @@ impl RefLeg {
         best
     }
 
+    /// Signed curvature κ of the leg at arc length `s`, positive turning
+    /// left in travel order [1/m]: the change of the tangent's heading over
+    /// `window_m` either side, divided by the arc between (0 on a straight
+    /// leg, 1/R on an arc of radius R sampled finer than the window).
+    pub fn curvature_at(&self, s: f64, window_m: f64) -> f64 {
+        let (lo, hi) = ((s - window_m).max(0.0), (s + window_m).min(self.length_m()));
+        if hi - lo <= 1e-9 {
+            return 0.0;
+        }
+        let (_, t0) = self.point_at(lo);
+        let (_, t1) = self.point_at(hi);
+        let turn = (t0.x * t1.y - t0.y * t1.x).atan2(t0.dot(&t1));
+        turn / (hi - lo)
+    }
+
     /// The point at arc length `s` (clamped to the leg).
     pub fn point_at(&self, s: f64) -> (Vec2, Vec2) {
         let s = s.clamp(0.0, self.length_m());

@@ -25,8 +25,8 @@ pub mod workstation;
 pub use autoshovel_core::config::TomlFile;
 pub use choice::ControllerKind;
 pub use controller::{
-    ControlInput, Controller, ControllerParams, FuzzyParams, Gains, Pid, PidParams, PurePursuit,
-    PurePursuitParams,
+    ControlInput, Controller, ControllerParams, FuzzyParams, Gains, Pid, PidError, PidParams,
+    PurePursuit, PurePursuitParams, Stanley, StanleyParams, Universe,
 };
 pub use error::TrackError;
 pub use fuzzy_tracker::FuzzyTracker;

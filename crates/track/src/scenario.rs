@@ -29,15 +29,25 @@
 //! k2 = 32.1                     # ec_f = k2·ec [W eq. 24] [s/m], > 0
 //! k3 = 1.11                     # u = k3·u_f [W eq. 24], > 0
 //! ec_filter_s = 0.34            # low-pass time constant on ec [s], >= 0 (0 = none)
+//! alpha_curvature_m = 0.0       # α(κ) = alpha + alpha_curvature_m·|κ| [W eq. 23] [m], >= 0
+//! universe = "fixed"            # or "variable": contraction–expansion factors [W eq. 24]
+//! vu_tau = 0.5                  # variable universe: α(x) = (|x|/E)^τ + ε, τ in (0, 1]
+//! vu_epsilon = 0.1              # ε in (0, 1]
 //! [controller.pid]              # PidParams: the PID baseline (§5.4)
 //! kp = 800.0                    # [rpm/m], >= 0
 //! ki = 100.0                    # [rpm/(m·s)], >= 0
 //! kd = 300.0                    # [rpm·s/m], >= 0
 //! alpha = 0.5                   # weight of d0 in e [W eq. 23], >= 0
 //! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! error = "preview"             # e = d + α·d0; "position": the centroid's d0 alone
 //! [controller.pure_pursuit]     # PurePursuitParams
 //! lookahead_m = 1.5             # look-ahead at standstill [m], > 0
 //! lookahead_gain_s = 1.0        # growth of the look-ahead with speed [s], >= 0
+//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! [controller.stanley]          # StanleyParams
+//! k_per_s = 1.0                 # cross-track gain k [1/s], >= 0
+//! softening_mps = 0.3           # softening speed [m/s], > 0
+//! heading_time_s = 0.8          # time to close the heading correction [s], > 0
 //! max_steer_rpm = 2700.0        # output limit [rpm], > 0
 //! ```
 //!
@@ -371,14 +381,16 @@ impl ScenarioFile {
     }
 
     fn check_controllers(&self, text: &str, file: &str) -> Result<(), TrackError> {
-        let (f, p, pp) = (
+        let (f, p, pp, st) = (
             &self.controller.fuzzy,
             &self.controller.pid,
             &self.controller.pure_pursuit,
+            &self.controller.stanley,
         );
         const FUZZY: &str = "controller.fuzzy";
         const PID: &str = "controller.pid";
         const PP: &str = "controller.pure_pursuit";
+        const ST: &str = "controller.stanley";
         let positive = [
             (FUZZY, "k1", f.k1),
             (FUZZY, "k2", f.k2),
@@ -386,6 +398,9 @@ impl ScenarioFile {
             (PID, "max_steer_rpm", p.max_steer_rpm),
             (PP, "lookahead_m", pp.lookahead_m),
             (PP, "max_steer_rpm", pp.max_steer_rpm),
+            (ST, "softening_mps", st.softening_mps),
+            (ST, "heading_time_s", st.heading_time_s),
+            (ST, "max_steer_rpm", st.max_steer_rpm),
         ];
         config::check_each(text, file, &positive, config::POSITIVE)?;
         let non_negative = [
@@ -396,8 +411,23 @@ impl ScenarioFile {
             (PID, "kd", p.kd),
             (PID, "alpha", p.alpha),
             (PP, "lookahead_gain_s", pp.lookahead_gain_s),
+            (ST, "k_per_s", st.k_per_s),
+            (FUZZY, "alpha_curvature_m", f.alpha_curvature_m),
         ];
         config::check_each(text, file, &non_negative, config::NON_NEGATIVE)?;
+        for (key, v) in [("vu_tau", f.vu_tau), ("vu_epsilon", f.vu_epsilon)] {
+            if !(v.is_finite() && v > 0.0 && v <= 1.0) {
+                return Err(config::invalid(
+                    text,
+                    file,
+                    (FUZZY, 0),
+                    key,
+                    v.to_string(),
+                    "a value in (0, 1]",
+                )
+                .into());
+            }
+        }
         Ok(())
     }
 
