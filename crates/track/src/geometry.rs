@@ -121,27 +121,34 @@ impl RefLeg {
     }
 
     /// Signed curvature κ of the leg at arc length `s`, positive turning
-    /// left in travel order [1/m]: the change of the tangent's heading over
-    /// `window_m` either side, divided by the arc between (0 on a straight
-    /// leg, 1/R on an arc of radius R sampled finer than the window).
+    /// left in travel order [1/m]: the turn between the segments at
+    /// `s − window_m` and `s + window_m`, over the arc between their
+    /// midpoints (0 on a straight leg, 1/R on an arc of radius R sampled
+    /// finer than the window).
     pub fn curvature_at(&self, s: f64, window_m: f64) -> f64 {
-        let (lo, hi) = ((s - window_m).max(0.0), (s + window_m).min(self.length_m()));
-        if hi - lo <= 1e-9 {
+        let (i, j) = (self.segment_at(s - window_m), self.segment_at(s + window_m));
+        if i == j {
             return 0.0;
         }
-        let (_, t0) = self.point_at(lo);
-        let (_, t1) = self.point_at(hi);
-        let turn = (t0.x * t1.y - t0.y * t1.x).atan2(t0.dot(&t1));
-        turn / (hi - lo)
+        let dir = |k: usize| (self.points[k + 1] - self.points[k]).normalize();
+        let (t0, t1) = (dir(i), dir(j));
+        let mid = |k: usize| 0.5 * (self.s[k] + self.s[k + 1]);
+        (t0.x * t1.y - t0.y * t1.x).atan2(t0.dot(&t1)) / (mid(j) - mid(i))
+    }
+
+    /// Index of the segment holding arc length `s` (clamped to the leg).
+    fn segment_at(&self, s: f64) -> usize {
+        let s = s.clamp(0.0, self.length_m());
+        match self.s.binary_search_by(|v| v.total_cmp(&s)) {
+            Ok(i) => i.min(self.points.len() - 2),
+            Err(i) => i.saturating_sub(1).min(self.points.len() - 2),
+        }
     }
 
     /// The point at arc length `s` (clamped to the leg).
     pub fn point_at(&self, s: f64) -> (Vec2, Vec2) {
         let s = s.clamp(0.0, self.length_m());
-        let i = match self.s.binary_search_by(|v| v.total_cmp(&s)) {
-            Ok(i) => i.min(self.points.len() - 2),
-            Err(i) => i.saturating_sub(1).min(self.points.len() - 2),
-        };
+        let i = self.segment_at(s);
         let (a, b) = (self.points[i], self.points[i + 1]);
         let t = ((s - self.s[i]) / (self.s[i + 1] - self.s[i])).clamp(0.0, 1.0);
         (a + (b - a) * t, (b - a).normalize())
