@@ -110,6 +110,38 @@ pub fn study_boulders(
     })
 }
 
+/// `tune-trackers`: every tracker tuned with `budget` evaluations (seeded),
+/// trackers in parallel, then scored on every set.
+pub fn tune_trackers(
+    budget: usize,
+    seed: u64,
+    out: Option<&OutDir>,
+    progress: bool,
+) -> Result<Job<autoshovel_track::tune::TuneSummary>> {
+    use autoshovel_track::tune::{summarize, tune, CaseSets, Tunable, Tuned};
+    if !(1..=100_000).contains(&budget) {
+        bail!("--budget {budget} must be between 1 and 100000");
+    }
+    let sets = CaseSets::standard().context("building the tuning runs")?;
+    let bar = progress_bar(
+        progress,
+        "{msg} [{bar:40}] {pos}/{len} trackers, {eta} left",
+    );
+    bar.set_length(Tunable::ALL.len() as u64);
+    bar.set_message("tuning");
+    let tuned: Vec<Tuned> = Tunable::ALL
+        .into_par_iter()
+        .enumerate()
+        .progress_with(bar.clone())
+        .map(|(i, t)| tune(t, &sets.training, budget, seed.wrapping_add(i as u64)))
+        .collect();
+    bar.finish_and_clear();
+    let summary = summarize(&sets, &tuned, budget, seed);
+    Job::finish(summary.clone(), out, |dir, written| {
+        Ok(figures::tune::write(dir, &summary, &tuned, written)?)
+    })
+}
+
 /// `track`: drive `scenario` with `controller` (all three with `compare`).
 pub fn track(
     scenario: &TrackScenario,

@@ -26,6 +26,7 @@ mod plan_path;
 mod study;
 mod study_boulders;
 mod track;
+mod tune_trackers;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -58,6 +59,8 @@ enum Command {
     StudyPaths(study::Args),
     /// Seeded boulder study of the excavator planner that knows only what it touches.
     StudyBoulders(study_boulders::Args),
+    /// Tune every tracker with the same budget, then score them on runs none was tuned on.
+    TuneTrackers(tune_trackers::Args),
     /// Print a built-in scenario (of plan-path, track or plan-excavate) as TOML, to copy and edit.
     Scenario {
         /// Built-in scenario name (an unknown one lists them all, by job).
@@ -153,6 +156,7 @@ fn main() -> ExitCode {
         Command::PlanPath(args) => plan_path::run(&args),
         Command::StudyPaths(args) => study::run(&args),
         Command::StudyBoulders(args) => study_boulders::run(&args),
+        Command::TuneTrackers(args) => tune_trackers::run(&args),
         Command::Track(args) => track::run(&args),
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),

@@ -17,6 +17,7 @@ pub mod perceive;
 pub mod shovel;
 pub mod study;
 pub mod track;
+pub mod tune;
 
 /// What can go wrong while writing a job's files.
 #[derive(Debug, thiserror::Error)]

@@ -20,6 +20,7 @@ pub mod plant;
 pub mod scenario;
 pub mod sensor;
 pub mod sim;
+pub mod tune;
 pub mod workstation;
 
 pub use autoshovel_core::config::TomlFile;

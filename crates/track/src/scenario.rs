@@ -76,6 +76,8 @@ pub const BUILTINS: &[&str] = &[
     "curve",
     "curve-reverse",
     "v-shape",
+    "tight-curve",
+    "long-v-slip",
 ];
 
 /// Whether a run has sensor noise and slip.
@@ -121,6 +123,8 @@ pub const MAX_START_OFFSET_M: f64 = 20.0;
 pub const BUILTIN_TOML: &[(&str, &str)] = &[
     ("fig9a", include_str!("../scenarios/fig9a.toml")),
     ("fig9b", include_str!("../scenarios/fig9b.toml")),
+    ("tight-curve", include_str!("../scenarios/tight-curve.toml")),
+    ("long-v-slip", include_str!("../scenarios/long-v-slip.toml")),
 ];
 
 /// The TOML text of a built-in (with its comments), to print and edit:
@@ -150,7 +154,7 @@ pub fn resolve(
         setup
     };
     match name_or_path {
-        "fig9a" | "fig9b" => {
+        name if BUILTIN_TOML.iter().any(|(n, _)| *n == name) => {
             let text = builtin_text(name_or_path).expect("a built-in");
             from_toml(text, &format!("<builtin {name_or_path}>"), noise, seed)
         }
