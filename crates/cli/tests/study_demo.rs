@@ -227,7 +227,7 @@ fn demo_writes_index_and_summary() {
         jobs["track curve --compare"]["compare"]
             .as_array()
             .map(|a| a.len()),
-        Some(3)
+        Some(4)
     );
     assert_eq!(jobs["plan-path curve improved-apf"]["success"], true);
     assert_eq!(jobs["plan-path curve apf"]["success"], false);

@@ -7,17 +7,9 @@ use std::path::Path;
 
 use autoshovel_excavate::study::{BoulderStudySummary, CaseRow, VARIANTS};
 use autoshovel_report::{
-    write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke, Written,
+    finite_cell as cell, write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke,
+    Written,
 };
-
-/// A finite number as Rust prints it, else an empty cell.
-fn cell(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v}")
-    } else {
-        String::new()
-    }
-}
 
 /// Writes `cases.csv` and the `volume_error_by_radius` plot into `dir`.
 pub fn write_study(

@@ -6,7 +6,8 @@ use std::path::Path;
 
 use autoshovel_propel::study::{success_by_obstacles, MapRow, StudyParams, StudySummary, FIELDS};
 use autoshovel_report::{
-    write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke, Written,
+    finite_cell as cell, write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke,
+    Written,
 };
 
 /// The per-planner columns of `maps.csv`, each prefixed with the planner
@@ -20,15 +21,6 @@ const OUTCOME_COLUMNS: [&str; 7] = [
     "escapes",
     "error",
 ];
-
-/// A finite number as Rust prints it, else an empty cell.
-fn cell(v: f64) -> String {
-    if v.is_finite() {
-        format!("{v}")
-    } else {
-        String::new()
-    }
-}
 
 /// Writes `maps.csv` and the `success_by_obstacles` plot into `dir`.
 pub fn write_study(

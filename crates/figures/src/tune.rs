@@ -7,7 +7,7 @@
 use std::path::Path;
 
 use autoshovel_report::{
-    write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke, Written,
+    format_f64, write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke, Written,
 };
 use autoshovel_track::tune::{TuneSummary, Tuned};
 
@@ -72,7 +72,7 @@ pub fn write(
             t.progress
                 .iter()
                 .enumerate()
-                .map(|(k, c)| vec![t.name.to_string(), (k + 1).to_string(), format!("{c}")])
+                .map(|(k, c)| vec![t.name.to_string(), (k + 1).to_string(), format_f64(*c)])
         })
         .collect();
     write_csv_cells(

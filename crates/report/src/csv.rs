@@ -67,6 +67,16 @@ pub fn format_f64(v: f64) -> String {
     }
 }
 
+/// A number for a CSV cell: [`format_f64`] when finite, an empty cell
+/// otherwise (NaN and ±inf mean "none" in the tables that use it).
+pub fn finite_cell(v: f64) -> String {
+    if v.is_finite() {
+        format_f64(v)
+    } else {
+        String::new()
+    }
+}
+
 /// `cell`, quoted if it has to be.
 fn quote(cell: &str) -> std::borrow::Cow<'_, str> {
     if cell.contains([',', '"', '\n', '\r']) {

@@ -44,7 +44,7 @@ mod staging;
 mod style;
 mod written;
 
-pub use crate::csv::{format_f64, write_csv, write_csv_cells};
+pub use crate::csv::{finite_cell, format_f64, write_csv, write_csv_cells};
 pub use crate::error::ReportError;
 pub use crate::figure::{Figure, Layer, DEFAULT_HEIGHT_PX, DEFAULT_WIDTH_PX};
 pub use crate::heatmap::{write_heatmap, Heatmap, MAX_HEATMAP_CELLS};
