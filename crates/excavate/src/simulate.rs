@@ -2,7 +2,7 @@
 //!
 //! This is the truth's side of the code: the boulders, the soil and the
 //! sensor noise live here and in the scenario's `[soil]`, `[sensing]` and
-//! `[[obstacle]]`; the planner ([`crate::planner`]) sees none of them, only the
+//! `[[obstacle]]`; the planner (`planner.rs`) sees none of them, only the
 //! joint torques [`TorqueSensor`] reports.
 //!
 //! [`SoilSim::advance`] moves the tooth along one planned segment in time steps

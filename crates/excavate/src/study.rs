@@ -1,6 +1,6 @@
 //! The seeded boulder study (`autoshovel study-boulders`): the paper's dig
 //! with one buried boulder of random size and place on the planned path, run
-//! by the planner that knows only what it touches ([`crate::planner`]), and
+//! by the planner that knows only what it touches (`planner.rs`), and
 //! measured on the truth: completed digs, volume error, extra contacts and
 //! clearance.
 //!
