@@ -45,7 +45,7 @@ struct Cli {
 enum Command {
     /// Plan the crawler's walk to the next face with a potential field (SPEC §2).
     PlanPath(plan_path::Args),
-    /// Drive the crawler along a path: fuzzy, PID or pure-pursuit tracking in the simulator (SPEC §3).
+    /// Drive the crawler along a path: fuzzy, PID, pure-pursuit or Stanley tracking in the simulator (SPEC §3).
     Track(track::Args),
     /// Write a synthetic LiDAR scan of a muck pile (Fig. 7 shapes) to a point-cloud file.
     GeneratePile(pile::Args),

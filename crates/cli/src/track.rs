@@ -1,5 +1,5 @@
 //! `autoshovel track`: closed-loop tracking of a path by the crawler with the
-//! fuzzy tracker, PID or pure pursuit (SPEC §3, §6), and `--compare` to run
+//! fuzzy tracker, PID, pure pursuit or Stanley (SPEC §3, §6), and `--compare` to run
 //! every controller on the same scenario and seed.
 
 use std::path::{Path, PathBuf};
