@@ -11,6 +11,22 @@ use anyhow::{bail, Result};
 pub use autoshovel_report::{OutDir, Staging, Written};
 use serde::Serialize;
 
+/// `--out`, `--force` and `--json`, the same for every job (flattened into
+/// each subcommand's arguments).
+#[derive(Debug, clap::Args)]
+pub struct OutputArgs {
+    /// Write summary.json, the job's CSV data and its plots (SVG and PNG) here.
+    #[arg(long)]
+    pub out: Option<PathBuf>,
+    /// Replace existing files in the output that autoshovel did not write
+    /// (never the job's own inputs).
+    #[arg(long)]
+    pub force: bool,
+    /// Print the summary JSON alone on stdout.
+    #[arg(long)]
+    pub json: bool,
+}
+
 /// The output folder of `--out DIR`, protecting the job's `inputs` (never
 /// written over) and, without `--force`, every existing file autoshovel did
 /// not write. A `DIR` that is a file is refused before any work.

@@ -21,16 +21,8 @@ pub struct Args {
     /// Print the pipeline settings (the defaults, or --config's) as TOML and exit.
     #[arg(long)]
     pub print_config: bool,
-    /// Write summary.json, the cleaned cloud, the surface and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// The settings of `--config`, or the defaults.
@@ -50,12 +42,12 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let input = args.input.as_deref().context("--input is required")?;
     let out = out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[Some(input), args.config.as_deref()],
-        args.force,
+        args.output.force,
     )?;
-    let job = crate::jobs::perceive(input, &params, out.as_ref(), !args.json)?;
-    job.report(args.json, |s| {
+    let job = crate::jobs::perceive(input, &params, out.as_ref(), !args.output.json)?;
+    job.report(args.output.json, |s| {
         crate::say!("perceive {}", s.input);
         for st in &s.stages {
             crate::say!(

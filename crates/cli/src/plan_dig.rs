@@ -95,16 +95,8 @@ pub struct Args {
     /// next dig cycle would: those wolves replace the first of the new pack.
     #[arg(long, conflicts_with = "all_surfaces")]
     pub warm_start: Option<PathBuf>,
-    /// Write summary.json, CSV and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs `plan-dig` as the command line asks.
@@ -132,24 +124,24 @@ pub fn run(args: &Args) -> Result<()> {
         None => PerceptionParams::default(),
     };
     let out = out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[
             args.cloud.as_deref(),
             args.config.as_deref(),
             args.profile.as_deref(),
             args.warm_start.as_deref(),
         ],
-        args.force,
+        args.output.force,
     )?;
     if args.all_surfaces {
-        return run_all_surfaces(&setup, out.as_ref(), args.json);
+        return run_all_surfaces(&setup, out.as_ref(), args.output.json);
     }
     let pile = match &args.cloud {
-        Some(path) => crate::jobs::scan_pile(path, &pipeline, &setup.profile, !args.json)?,
+        Some(path) => crate::jobs::scan_pile(path, &pipeline, &setup.profile, !args.output.json)?,
         None => Pile::shape(args.surface.unwrap_or_default(), &setup.profile),
     };
     let job = crate::jobs::plan_dig(&pile, &setup, out.as_ref())?;
-    job.report(args.json, print_human)?;
+    job.report(args.output.json, print_human)?;
     match &job.summary.error {
         Some(e) => bail!("{e}"),
         None => Ok(()),

@@ -26,16 +26,8 @@ pub struct Args {
     /// Print the machine profile as TOML and exit (the built-in one, commented, or the checked --profile).
     #[arg(long)]
     pub print_profile: bool,
-    /// Write summary.json, CSV and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs `plan-excavate` as the command line asks.
@@ -51,11 +43,11 @@ pub fn run(args: &Args) -> Result<()> {
     let setup = Setup::load(&args.scenario, args.profile.as_deref())?;
     // Refuse a bad --out before planning; it is created only for a plan.
     let out = crate::output::out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
-        args.force,
+        args.output.force,
     )?;
-    crate::jobs::plan_excavate(&setup, out.as_ref())?.report(args.json, print_human)
+    crate::jobs::plan_excavate(&setup, out.as_ref())?.report(args.output.json, print_human)
 }
 
 fn print_raw(text: &str) {

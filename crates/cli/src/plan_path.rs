@@ -1,7 +1,7 @@
 //! `autoshovel plan-path`: travel planning with the classic or improved
 //! potential field on a built-in or user scenario (SPEC §2, §6).
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Result;
 use autoshovel_propel::{PlanPathSummary, Scenario};
@@ -18,16 +18,8 @@ pub struct Args {
     /// Potential field to descend.
     #[arg(long, value_enum, default_value = "improved-apf")]
     pub planner: PlannerArg,
-    /// Write summary.json, CSV and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
     /// Success needs every leg to end within this of its required heading [deg].
     #[arg(long, default_value_t = autoshovel_propel::DEFAULT_HEADING_TOLERANCE_DEG)]
     pub heading_tolerance_deg: f64,
@@ -37,9 +29,9 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<()> {
     let scenario = Scenario::resolve(&args.scenario)?;
     let out = out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[Some(Path::new(&args.scenario))],
-        args.force,
+        args.output.force,
     )?;
     if !(args.heading_tolerance_deg.is_finite() && args.heading_tolerance_deg >= 0.0) {
         anyhow::bail!(
@@ -53,7 +45,7 @@ pub fn run(args: &Args) -> Result<()> {
         args.heading_tolerance_deg,
         out.as_ref(),
     )?;
-    job.report(args.json, print_human)?;
+    job.report(args.output.json, print_human)?;
     match &job.summary.error {
         Some(e) => Err(anyhow::anyhow!(
             "{} could not plan scenario '{}': {e}",

@@ -1,8 +1,6 @@
 //! `autoshovel study-paths`: the seeded random haul-road study comparing the
 //! classic field, the improved field and the Theta* reference.
 
-use std::path::PathBuf;
-
 use anyhow::Result;
 use autoshovel_figures::study::markdown_table;
 use autoshovel_propel::study::StudyParams;
@@ -24,16 +22,8 @@ pub struct Args {
     /// Most obstacles per map.
     #[arg(long, default_value_t = 12)]
     pub max_obstacles: usize,
-    /// Write summary.json, maps.csv and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs the study as the command line asks.
@@ -45,7 +35,7 @@ pub fn run(args: &Args) -> Result<()> {
         max_obstacles: args.max_obstacles,
         ..Default::default()
     };
-    let out = out_dir(args.out.as_deref(), &[], args.force)?;
-    let job = crate::jobs::study(&params, out.as_ref(), !args.json)?;
-    job.report(args.json, |s| crate::say!("{}", markdown_table(s)))
+    let out = out_dir(args.output.out.as_deref(), &[], args.output.force)?;
+    let job = crate::jobs::study(&params, out.as_ref(), !args.output.json)?;
+    job.report(args.output.json, |s| crate::say!("{}", markdown_table(s)))
 }

@@ -31,16 +31,8 @@ pub struct Args {
     /// Largest boulder radius [m].
     #[arg(long, default_value_t = 0.5)]
     pub max_radius: f64,
-    /// Write summary.json, cases.csv and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs the study as the command line asks.
@@ -52,16 +44,16 @@ pub fn run(args: &Args) -> Result<()> {
         radius_m: [args.min_radius, args.max_radius],
     };
     let out = crate::output::out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
-        args.force,
+        args.output.force,
     )?;
     let job = crate::jobs::study_boulders(
         &setup.scenario,
         &setup.profile,
         &params,
         out.as_ref(),
-        !args.json,
+        !args.output.json,
     )?;
-    job.report(args.json, |s| crate::say!("{}", markdown_table(s)))
+    job.report(args.output.json, |s| crate::say!("{}", markdown_table(s)))
 }

@@ -2,7 +2,7 @@
 //! fuzzy tracker, PID, pure pursuit or Stanley (SPEC §3, §6), and `--compare` to run
 //! every controller on the same scenario and seed.
 
-use std::path::{Path, PathBuf};
+use std::path::Path;
 
 use anyhow::Result;
 use autoshovel_track::scenario::{resolve, Noise};
@@ -61,16 +61,8 @@ pub struct Args {
     /// Run every controller on the same scenario and seed; one table, one overlay plot.
     #[arg(long)]
     pub compare: bool,
-    /// Write summary.json, CSV and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write
-    /// (never the job's own inputs).
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs `track` as the command line asks.
@@ -81,9 +73,9 @@ pub fn run(args: &Args) -> Result<()> {
     });
     let scenario = resolve(&args.scenario, noise, args.seed)?;
     let out = out_dir(
-        args.out.as_deref(),
+        args.output.out.as_deref(),
         &[Some(Path::new(&args.scenario))],
-        args.force,
+        args.output.force,
     )?;
     let job = crate::jobs::track(
         &scenario,
@@ -95,7 +87,7 @@ pub fn run(args: &Args) -> Result<()> {
     for e in job.summary.events.iter().filter(|e| e.is_safety()) {
         eprintln!("safety: t = {:.2} s: {} ({})", e.t_s, e.message, e.kind);
     }
-    job.report(args.json, print_human)?;
+    job.report(args.output.json, print_human)?;
     match job.summary.failure() {
         Some(e) => Err(e.into()),
         None => Ok(()),
