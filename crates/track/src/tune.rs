@@ -220,61 +220,42 @@ impl Tunable {
     pub fn params(self, x: &[f64]) -> ControllerParams {
         let mut p = self.defaults();
         for ((name, ..), &v) in self.ranges().iter().zip(x) {
-            match (self.kind(), *name) {
-                (ControllerKind::Fuzzy, "alpha") => p.fuzzy.alpha = v,
-                (ControllerKind::Fuzzy, "k1") => p.fuzzy.k1 = v,
-                (ControllerKind::Fuzzy, "k2") => p.fuzzy.k2 = v,
-                (ControllerKind::Fuzzy, "k3") => p.fuzzy.k3 = v,
-                (ControllerKind::Fuzzy, "ec_filter_s") => p.fuzzy.ec_filter_s = v,
-                (ControllerKind::Fuzzy, "alpha_curvature_m") => p.fuzzy.alpha_curvature_m = v,
-                (ControllerKind::Fuzzy, "vu_tau") => p.fuzzy.vu_tau = v,
-                (ControllerKind::Fuzzy, "vu_epsilon") => p.fuzzy.vu_epsilon = v,
-                (ControllerKind::Pid, "kp") => p.pid.kp = v,
-                (ControllerKind::Pid, "ki") => p.pid.ki = v,
-                (ControllerKind::Pid, "kd") => p.pid.kd = v,
-                (ControllerKind::Pid, "alpha") => p.pid.alpha = v,
-                (ControllerKind::PurePursuit, "lookahead_m") => p.pure_pursuit.lookahead_m = v,
-                (ControllerKind::PurePursuit, "lookahead_gain_s") => {
-                    p.pure_pursuit.lookahead_gain_s = v
-                }
-                (ControllerKind::Stanley, "k_per_s") => p.stanley.k_per_s = v,
-                (ControllerKind::Stanley, "softening_mps") => p.stanley.softening_mps = v,
-                (ControllerKind::Stanley, "heading_time_s") => p.stanley.heading_time_s = v,
-                (kind, name) => unreachable!("{kind:?} has no gain {name}"),
-            }
+            *gain(self.kind(), &mut p, name) = v;
         }
         p
     }
 
     /// The default gains as a point of the box (clamped into it).
     fn default_point(self) -> Vec<f64> {
-        let p = self.defaults();
+        let mut p = self.defaults();
         self.ranges()
             .iter()
-            .map(|&(name, lo, hi, _)| {
-                let v = match name {
-                    "alpha" if self.kind() == ControllerKind::Pid => p.pid.alpha,
-                    "alpha" => p.fuzzy.alpha,
-                    "k1" => p.fuzzy.k1,
-                    "k2" => p.fuzzy.k2,
-                    "k3" => p.fuzzy.k3,
-                    "ec_filter_s" => p.fuzzy.ec_filter_s,
-                    "alpha_curvature_m" => p.fuzzy.alpha_curvature_m,
-                    "vu_tau" => p.fuzzy.vu_tau,
-                    "vu_epsilon" => p.fuzzy.vu_epsilon,
-                    "kp" => p.pid.kp,
-                    "ki" => p.pid.ki,
-                    "kd" => p.pid.kd,
-                    "lookahead_m" => p.pure_pursuit.lookahead_m,
-                    "lookahead_gain_s" => p.pure_pursuit.lookahead_gain_s,
-                    "k_per_s" => p.stanley.k_per_s,
-                    "softening_mps" => p.stanley.softening_mps,
-                    "heading_time_s" => p.stanley.heading_time_s,
-                    _ => unreachable!(),
-                };
-                v.clamp(lo, hi)
-            })
+            .map(|&(name, lo, hi, _)| gain(self.kind(), &mut p, name).clamp(lo, hi))
             .collect()
+    }
+}
+
+/// The gain `name` of a `kind` tracker in `p` (the names of [`Tunable::ranges`]).
+fn gain<'a>(kind: ControllerKind, p: &'a mut ControllerParams, name: &str) -> &'a mut f64 {
+    match (kind, name) {
+        (ControllerKind::Fuzzy, "alpha") => &mut p.fuzzy.alpha,
+        (ControllerKind::Fuzzy, "k1") => &mut p.fuzzy.k1,
+        (ControllerKind::Fuzzy, "k2") => &mut p.fuzzy.k2,
+        (ControllerKind::Fuzzy, "k3") => &mut p.fuzzy.k3,
+        (ControllerKind::Fuzzy, "ec_filter_s") => &mut p.fuzzy.ec_filter_s,
+        (ControllerKind::Fuzzy, "alpha_curvature_m") => &mut p.fuzzy.alpha_curvature_m,
+        (ControllerKind::Fuzzy, "vu_tau") => &mut p.fuzzy.vu_tau,
+        (ControllerKind::Fuzzy, "vu_epsilon") => &mut p.fuzzy.vu_epsilon,
+        (ControllerKind::Pid, "kp") => &mut p.pid.kp,
+        (ControllerKind::Pid, "ki") => &mut p.pid.ki,
+        (ControllerKind::Pid, "kd") => &mut p.pid.kd,
+        (ControllerKind::Pid, "alpha") => &mut p.pid.alpha,
+        (ControllerKind::PurePursuit, "lookahead_m") => &mut p.pure_pursuit.lookahead_m,
+        (ControllerKind::PurePursuit, "lookahead_gain_s") => &mut p.pure_pursuit.lookahead_gain_s,
+        (ControllerKind::Stanley, "k_per_s") => &mut p.stanley.k_per_s,
+        (ControllerKind::Stanley, "softening_mps") => &mut p.stanley.softening_mps,
+        (ControllerKind::Stanley, "heading_time_s") => &mut p.stanley.heading_time_s,
+        (kind, name) => unreachable!("{kind:?} has no gain {name}"),
     }
 }
 
