@@ -200,13 +200,18 @@ impl Estimates {
             }
             None => {
                 self.boulders.push(BoulderEstimate {
-                    envelope: Envelope::new(point - normal * prior.radius_m, prior.radius_m),
+                    envelope: behind(point, normal, prior.radius_m),
                     touches: vec![touch],
                 });
                 self.boulders.len() - 1
             }
         }
     }
+}
+
+/// The circle of radius `r` whose rim passes `point` with outward normal `normal`.
+fn behind(point: Vec2, normal: Vec2, r: f64) -> Envelope {
+    Envelope::new(point - normal * r, r)
 }
 
 /// Least squares over (c, r) of p_i = c + r·n_i, with a weak pull of r
@@ -234,10 +239,7 @@ pub fn fit_envelope(
     b[2] += lambda * prior.radius_m;
     let Some(x) = a.lu().solve(&b) else {
         let (p, n) = touches[0];
-        return Envelope::new(
-            Vec2::new(p[0], p[1]) - Vec2::new(n[0], n[1]) * prior.radius_m,
-            prior.radius_m,
-        );
+        return behind(Vec2::new(p[0], p[1]), Vec2::new(n[0], n[1]), prior.radius_m);
     };
     let r = x[2].clamp(prior.radius_m, max_radius_m.max(prior.radius_m));
     if r == x[2] {
