@@ -5,7 +5,7 @@ use std::path::PathBuf;
 
 use anyhow::Result;
 use autoshovel_cloud::io::{write, Encoding};
-use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape};
+use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern};
 
 use crate::output::print_json;
 
@@ -40,6 +40,16 @@ pub struct Args {
     /// Scale of the pile: 1 = a 10 m face; 0.0333 = the paper's 1:30 model.
     #[arg(long, default_value_t = 1.0)]
     pub scale: f64,
+    /// How the points are spread: area (even over the ground) or rosette (a
+    /// Livox-like non-repetitive pattern cast from the sensor).
+    #[arg(long, default_value = "area")]
+    pub pattern: ScanPattern,
+    /// Sensor height above the floor [m at scale 1].
+    #[arg(long, default_value_t = 12.0)]
+    pub sensor_height: f64,
+    /// Full field of view of the rosette pattern [deg].
+    #[arg(long, default_value_t = 70.4)]
+    pub fov: f64,
     /// Seed of the noise and sampling.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
@@ -72,6 +82,9 @@ pub fn run(args: &Args) -> Result<()> {
         roll_rad: args.roll.to_radians(),
         pitch_rad: args.pitch.to_radians(),
         seed: args.seed,
+        pattern: args.pattern,
+        sensor_height_m: args.sensor_height,
+        fov_rad: args.fov.to_radians(),
         ..PileParams::default()
     };
     let t0 = std::time::Instant::now();
@@ -87,10 +100,12 @@ pub fn run(args: &Args) -> Result<()> {
                 "PileParams.points" => "--points",
                 "PileParams.roll_rad" => "--roll",
                 "PileParams.pitch_rad" => "--pitch",
+                "PileParams.sensor_height_m" => "--sensor-height",
+                "PileParams.fov_rad" => "--fov",
                 other => other,
             };
             let (value, expected) = match flag {
-                "--roll" | "--pitch" => (value.to_degrees(), expected.replace(" [rad]", "")),
+                "--roll" | "--pitch" | "--fov" => (value.to_degrees(), expected.replace(" [rad]", "")),
                 _ => (value, expected.to_string()),
             };
             anyhow::anyhow!(

@@ -40,19 +40,19 @@ pub enum SurfaceError {
         /// What to change (may be empty; starts with "; " otherwise).
         hint: &'static str,
     },
-    /// RANSAC found no plane within the allowed tilt that holds enough of the
-    /// lowest points to be the floor.
+    /// No plane within the allowed tilt with almost nothing below it holds
+    /// enough of the points to be the floor.
     #[error(
-        "no floor: the best plane within {max_tilt_deg:.1} deg of horizontal holds {inliers} of \
-         {candidates} low points (at least {required} needed); if the scan has a floor, raise the \
-         share searched for it (`[level] floor_fraction` in perceive's settings, \
-         TiltParams.floor_fraction in the library), or give roll and pitch \
-         (`[level] mode = \"given\"`)"
+        "no floor: the best plane within {max_tilt_deg:.1} deg of horizontal with almost no points \
+         below it holds {inliers} of {candidates} points (at least {required} needed); the scan \
+         shows no floor to level by: give roll and pitch (`[level] mode = \"given\"` in \
+         perceive's settings), or, if the floor is a smaller share of the scan, lower \
+         `[level] min_floor_share` (TiltParams.min_floor_share in the library)"
     )]
     NoFloor {
         /// Inliers of the best plane found.
         inliers: usize,
-        /// Low points searched.
+        /// Points searched.
         candidates: usize,
         /// Inliers required.
         required: usize,

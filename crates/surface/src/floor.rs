@@ -2,42 +2,96 @@
 //! from the floor, since a user rarely knows them"), for the horizontal
 //! calibration of [RS eq. 11]–12.
 //!
-//! 1. Candidates: the lowest [`TiltParams::floor_fraction`] of the points by
-//!    z (the floor in front of a pile is the lowest part of a scan as long as
-//!    the sensor is tilted by much less than the pile face is steep).
-//! 2. The floor plane `n · p = d` among them by RANSAC with least-squares
-//!    refinement ([`crate::ransac_plane`]).
-//! 3. The angles that level it: `T(α, β) · n = e_z`, i.e. `α = −asin n_y`,
+//! The floor is found without assuming how much of the scan it is or where it
+//! lies: it is **the plane with the most points that has (almost) nothing
+//! below it** — the ground the machine and the pile stand on. A pile's flat
+//! top holds many points too, but the floor and the face are below it; a
+//! plane along a gentle part of the face has fewer points on it than the
+//! floor as long as the floor is a few per cent of the scan.
+//!
+//! 1. Work on a seeded random subset of at most
+//!    [`RansacParams::max_scored_points`] points.
+//! 2. Hypotheses (RANSAC, Fischler & Bolles 1981, with *local* sampling as in
+//!    NAPSAC, Myatt et al. 2002): a seed point and two more from its
+//!    neighbourhood on an x–y grid (about 32 points a cell). A floor that is
+//!    a share w of the points is then hit by about w of the draws, where three
+//!    independent draws would need w³: 5 % of floor needs a few hundred
+//!    hypotheses, not 55 000.
+//! 3. Each hypothesis within [`RansacParams::max_tilt_rad`] of horizontal is
+//!    grown: its inliers (within [`RansacParams::inlier_threshold_m`]) are
+//!    refitted by orthogonal least squares and gathered again until they stop
+//!    growing (a local plane from a patch extends to the whole floor).
+//! 4. A grown plane is a floor candidate only if at most
+//!    [`TiltParams::max_below_share`] of the points lie more than
+//!    [`TiltParams::below_margin`] thresholds below it (multipath returns, a
+//!    puddle); the candidate with the most inliers wins. Draws stop when the
+//!    confidence [`RansacParams::confidence`] is reached for the best
+//!    candidate's share (or at [`RansacParams::max_iterations`]).
+//! 5. The winner is refined on *all* points ([`RansacParams::refine_rounds`]
+//!    least-squares rounds) and must hold [`TiltParams::min_floor_share`] of
+//!    them, or the scan has no floor to find ([`SurfaceError::NoFloor`]).
+//! 6. The angles that level it: `T(α, β) · n = e_z`, i.e. `α = −asin n_y`,
 //!    `β = atan2(n_x, n_z)` ([`crate::angles_from_normal`]). After
 //!    [`crate::level`] with them the floor is the horizontal plane `z = d`.
 
+use std::collections::HashMap;
+
 use autoshovel_cloud::PointCloud;
+use rand::seq::index::sample;
+use rand::{Rng, SeedableRng};
+use rand_chacha::ChaCha8Rng;
 
 use crate::calibrate::angles_from_normal;
 use crate::error::{Result, SurfaceError};
-use crate::ransac::{ransac_plane, RansacParams};
+use crate::ransac::{least_squares_plane, Plane, RansacParams};
+
+/// Largest tilt of the floor in the sensor's frame by default [deg]: a
+/// sensor is mounted within a few degrees of level, and a muck pile's face
+/// stands at 35–45° (its gentlest parts, a concave toe, near 20°), so a
+/// plane along the face is not taken for the floor.
+pub const MAX_FLOOR_TILT_DEG: f64 = 15.0;
+/// Mean points per cell of the grid the local triples are drawn from.
+const POINTS_PER_CELL: f64 = 32.0;
+/// Cell of the grid on which the ground's rises are found, in inlier
+/// thresholds (0.4 m at a mine face's 5 cm).
+const RISE_CELL: f64 = 8.0;
+/// How far above the plane a point still counts as the foot of a rise, in
+/// inlier thresholds.
+const RISE_BAND: f64 = 4.0;
+/// Fewest hypotheses drawn, whatever the confidence says.
+const MIN_HYPOTHESES: usize = 16;
+/// Most growing rounds of one hypothesis.
+const GROW_ROUNDS: usize = 6;
 
 /// Parameters of [`estimate_tilt`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct TiltParams {
-    /// Share of the points, lowest z first, searched for the floor, in
-    /// (0, 1]. Default 0.3: the synthetic scans of [`crate::generate_pile`]
-    /// have about a third of their points on the floor.
-    pub floor_fraction: f64,
-    /// Share of the candidates the floor plane must hold, in (0, 1].
-    /// Default 0.2.
-    pub min_inlier_fraction: f64,
-    /// The RANSAC plane fit (threshold, confidence, seed, largest tilt).
+    /// Smallest share of all points the floor must hold, in (0, 1]. Default
+    /// 0.03: a floor of 5 % of the scan is found; less is reported as no floor.
+    pub min_floor_share: f64,
+    /// Largest share of the points that may lie below the floor, in [0, 1).
+    /// Default 0.02 (multipath returns, puddles, a rut).
+    pub max_below_share: f64,
+    /// How far below a plane a point must be to count as below it, in inlier
+    /// thresholds (> 0). Default 3.
+    pub below_margin: f64,
+    /// The plane search (threshold, confidence, hypothesis cap, subset size,
+    /// largest tilt — default [`MAX_FLOOR_TILT_DEG`] here —, refinement
+    /// rounds, seed).
     pub ransac: RansacParams,
 }
 
 impl Default for TiltParams {
     fn default() -> Self {
         Self {
-            floor_fraction: 0.3,
-            min_inlier_fraction: 0.2,
-            ransac: RansacParams::default(),
+            min_floor_share: 0.03,
+            max_below_share: 0.02,
+            below_margin: 3.0,
+            ransac: RansacParams {
+                max_tilt_rad: MAX_FLOOR_TILT_DEG.to_radians(),
+                ..RansacParams::default()
+            },
         }
     }
 }
@@ -53,19 +107,33 @@ impl TiltParams {
 
     /// Check the ranges once, at the edge.
     pub fn validate(&self) -> Result<()> {
-        if !(self.floor_fraction > 0.0 && self.floor_fraction <= 1.0) {
-            return Err(SurfaceError::BadParameter {
-                name: "TiltParams.floor_fraction",
-                value: self.floor_fraction,
-                expected: "a share in (0, 1]",
-            });
+        let bad = |name, value: f64, expected| {
+            Err(SurfaceError::BadParameter {
+                name,
+                value,
+                expected,
+            })
+        };
+        if !(self.min_floor_share > 0.0 && self.min_floor_share <= 1.0) {
+            return bad(
+                "TiltParams.min_floor_share",
+                self.min_floor_share,
+                "a share in (0, 1]",
+            );
         }
-        if !(self.min_inlier_fraction > 0.0 && self.min_inlier_fraction <= 1.0) {
-            return Err(SurfaceError::BadParameter {
-                name: "TiltParams.min_inlier_fraction",
-                value: self.min_inlier_fraction,
-                expected: "a share in (0, 1]",
-            });
+        if !(self.max_below_share >= 0.0 && self.max_below_share < 1.0) {
+            return bad(
+                "TiltParams.max_below_share",
+                self.max_below_share,
+                "a share in [0, 1)",
+            );
+        }
+        if !(self.below_margin.is_finite() && self.below_margin > 0.0) {
+            return bad(
+                "TiltParams.below_margin",
+                self.below_margin,
+                "a number of inlier thresholds > 0",
+            );
         }
         self.ransac.validate()
     }
@@ -85,11 +153,13 @@ pub struct TiltEstimate {
     pub normal: [f64; 3],
     /// Points on the floor plane (within the inlier threshold).
     pub inliers: usize,
-    /// Low points searched.
+    /// Points searched (the whole cloud).
     pub candidates: usize,
+    /// Points more than the below margin under the floor.
+    pub below: usize,
     /// Root-mean-square distance of the floor inliers from the plane [m].
     pub rms_m: f64,
-    /// RANSAC hypotheses drawn.
+    /// Hypotheses drawn.
     pub iterations: usize,
 }
 
@@ -100,8 +170,8 @@ pub struct TiltEstimate {
 /// use autoshovel_surface::{estimate_tilt, generate_pile, level, PileParams, TiltParams};
 /// let scan = generate_pile(&PileParams { points: 20_000, ..PileParams::default() }).unwrap();
 /// let est = estimate_tilt(&scan, &TiltParams::default()).unwrap();
-/// assert!((est.roll_rad.to_degrees() - 3.0).abs() < 0.2);
-/// assert!((est.pitch_rad.to_degrees() + 2.0).abs() < 0.2);
+/// assert!((est.roll_rad.to_degrees() - 3.0).abs() < 0.02);
+/// assert!((est.pitch_rad.to_degrees() + 2.0).abs() < 0.02);
 /// let levelled = level(&scan, est.roll_rad, est.pitch_rad);
 /// # assert_eq!(levelled.len(), scan.len());
 /// ```
@@ -116,40 +186,241 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
             hint: "",
         });
     }
-    let take = ((params.floor_fraction * n as f64).ceil() as usize).clamp(3, n);
-    let mut zs: Vec<f32> = cloud.points.iter().map(|p| p[2]).collect();
-    let (_, z_cut, _) = zs.select_nth_unstable_by(take - 1, f32::total_cmp);
-    let z_cut = *z_cut;
-    drop(zs);
-    let candidates: Vec<[f64; 3]> = cloud
-        .points
-        .iter()
-        .filter(|p| p[2] <= z_cut)
-        .map(|p| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])])
-        .collect();
+    let r = &params.ransac;
+    let mut rng = ChaCha8Rng::seed_from_u64(r.seed);
+    let to_f64 = |p: &[f32; 3]| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])];
+    let mut subset: Vec<usize> = if n > r.max_scored_points {
+        sample(&mut rng, n, r.max_scored_points).into_vec()
+    } else {
+        (0..n).collect()
+    };
+    subset.sort_unstable();
+    let scored: Vec<[f64; 3]> = subset.iter().map(|&i| to_f64(&cloud.points[i])).collect();
+    let grid = Grid::new(&scored);
+    let min_nz = r.max_tilt_rad.cos() - 1e-12;
+    let threshold = r.inlier_threshold_m;
+    let below_m = params.below_margin * threshold;
+    let max_below = (params.max_below_share * scored.len() as f64).floor() as usize;
+    let log_fail = (1.0 - r.confidence).ln();
 
-    let fit = ransac_plane(&candidates, &params.ransac)?;
-    let required = ((params.min_inlier_fraction * candidates.len() as f64).ceil() as usize).max(3);
-    if fit.inliers.len() < required {
-        return Err(SurfaceError::NoFloor {
-            inliers: fit.inliers.len(),
-            candidates: candidates.len(),
-            required,
-            max_tilt_deg: params.ransac.max_tilt_rad.to_degrees(),
-        });
+    let mut best: Option<(Plane, usize)> = None;
+    let mut needed = r.max_iterations;
+    let mut iterations = 0;
+    while iterations < needed.max(MIN_HYPOTHESES.min(r.max_iterations)) {
+        iterations += 1;
+        let Some(plane) = grid.local_plane(&scored, &mut rng) else {
+            continue;
+        };
+        if plane.normal[2] < min_nz {
+            continue;
+        }
+        let Some((plane, count)) = grow(&scored, plane, threshold, min_nz) else {
+            continue;
+        };
+        if matches!(best, Some((_, c)) if c >= count) {
+            continue;
+        }
+        let below = scored
+            .iter()
+            .filter(|p| plane.signed_distance(**p) < -below_m)
+            .count();
+        if below > max_below {
+            continue;
+        }
+        best = Some((plane, count));
+        // A draw lands on the floor with probability ≈ w (its share), and
+        // about half of those grow to it.
+        let w = 0.5 * count as f64 / scored.len() as f64;
+        let k = (log_fail / (1.0 - w).ln()).ceil();
+        if k.is_finite() && k >= 1.0 {
+            needed = needed.min(k as usize);
+        }
     }
+    let required = ((params.min_floor_share * n as f64).ceil() as usize).max(3);
+    let no_floor = |inliers| SurfaceError::NoFloor {
+        inliers,
+        candidates: n,
+        required,
+        max_tilt_deg: r.max_tilt_rad.to_degrees(),
+    };
+    let Some((mut plane, _)) = best else {
+        return Err(no_floor(0));
+    };
+
+    // Refine on every point, away from where the ground rises.
+    let all: Vec<[f64; 3]> = cloud.points.iter().map(to_f64).collect();
+    let all_grid = Grid::with_cell(&all, RISE_CELL * threshold);
+    let mut inliers = inliers_of(&all, &plane, threshold);
+    for _ in 0..r.refine_rounds {
+        let flat = all_grid.away_from_rises(&all, &plane, threshold, &inliers);
+        let used = if flat.len() >= 3 { &flat } else { &inliers };
+        match least_squares_plane(&all, used) {
+            Some(refined) if refined.normal[2] >= min_nz => plane = refined,
+            _ => break,
+        }
+        inliers = inliers_of(&all, &plane, threshold);
+    }
+    if inliers.len() < required {
+        return Err(no_floor(inliers.len()));
+    }
+    let below = all
+        .iter()
+        .filter(|p| plane.signed_distance(**p) < -below_m)
+        .count();
+    let rms_m = (inliers
+        .iter()
+        .map(|&i| plane.signed_distance(all[i]).powi(2))
+        .sum::<f64>()
+        / inliers.len() as f64)
+        .sqrt();
     let (roll_rad, pitch_rad) =
-        angles_from_normal(fit.plane.normal).expect("a RANSAC plane has a unit normal");
+        angles_from_normal(plane.normal).expect("a fitted plane has a unit normal");
     Ok(TiltEstimate {
         roll_rad,
         pitch_rad,
-        floor_height_m: fit.plane.offset_m,
-        normal: fit.plane.normal,
-        inliers: fit.inliers.len(),
-        candidates: candidates.len(),
-        rms_m: fit.rms_m,
-        iterations: fit.iterations,
+        floor_height_m: plane.offset_m,
+        normal: plane.normal,
+        inliers: inliers.len(),
+        candidates: n,
+        below,
+        rms_m,
+        iterations,
     })
+}
+
+/// Grow a plane hypothesis: refit its inliers and gather them again until they
+/// stop growing. `None` if it tilts past the limit or holds fewer than 3.
+fn grow(points: &[[f64; 3]], mut plane: Plane, threshold: f64, min_nz: f64) -> Option<(Plane, usize)> {
+    let mut inliers = inliers_of(points, &plane, threshold);
+    for _ in 0..GROW_ROUNDS {
+        let refined = least_squares_plane(points, &inliers)?;
+        if refined.normal[2] < min_nz {
+            return None;
+        }
+        let next = inliers_of(points, &refined, threshold);
+        if next.len() <= inliers.len() {
+            break;
+        }
+        plane = refined;
+        inliers = next;
+    }
+    (inliers.len() >= 3).then_some((plane, inliers.len()))
+}
+
+fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> Vec<usize> {
+    points
+        .iter()
+        .enumerate()
+        .filter(|(_, p)| plane.signed_distance(**p).abs() <= threshold)
+        .map(|(i, _)| i)
+        .collect()
+}
+
+/// The points bucketed on an x–y grid, for drawing triples from one
+/// neighbourhood (a hash map of cells: a scan's footprint is sparse).
+struct Grid {
+    cell_m: f64,
+    cells: HashMap<(i64, i64), Vec<usize>>,
+}
+
+impl Grid {
+    fn new(points: &[[f64; 3]]) -> Self {
+        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+        for p in points {
+            for a in 0..2 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
+        let cell_m = (area * POINTS_PER_CELL / points.len() as f64).sqrt();
+        let cell_m = if cell_m.is_finite() && cell_m > 0.0 { cell_m } else { 1.0 };
+        Self::with_cell(points, cell_m)
+    }
+
+    fn with_cell(points: &[[f64; 3]], cell_m: f64) -> Self {
+        let mut cells: HashMap<(i64, i64), Vec<usize>> = HashMap::new();
+        for (i, p) in points.iter().enumerate() {
+            cells.entry(Self::key(cell_m, p)).or_default().push(i);
+        }
+        Self { cell_m, cells }
+    }
+
+    /// The inliers of `plane` none of whose 3 × 3 cells rises off it: a cell
+    /// rises when at least 3 of its points, and more than a tenth of them,
+    /// lie just above the inlier band (up to [`RISE_BAND`] thresholds above
+    /// the plane: the foot of a face; dust and spray higher up are not a
+    /// rise). This leaves out the floor at the toe of a
+    /// pile, where the bottom of the face lies inside the band and would tilt
+    /// the plane towards the pile (a bias that grows as the floor's share
+    /// of the scan falls).
+    fn away_from_rises(
+        &self,
+        points: &[[f64; 3]],
+        plane: &Plane,
+        threshold: f64,
+        inliers: &[usize],
+    ) -> Vec<usize> {
+        let rises: std::collections::HashSet<(i64, i64)> = self
+            .cells
+            .iter()
+            .filter(|(_, idx)| {
+                let above = idx
+                    .iter()
+                    .filter(|&&i| {
+                        let d = plane.signed_distance(points[i]);
+                        d > threshold && d <= RISE_BAND * threshold
+                    })
+                    .count();
+                above >= 3 && 10 * above > idx.len()
+            })
+            .map(|(k, _)| *k)
+            .collect();
+        inliers
+            .iter()
+            .copied()
+            .filter(|&i| {
+                let (cx, cy) = Self::key(self.cell_m, &points[i]);
+                !(-1..=1).any(|dx| (-1..=1).any(|dy| rises.contains(&(cx + dx, cy + dy))))
+            })
+            .collect()
+    }
+
+    fn key(cell_m: f64, p: &[f64; 3]) -> (i64, i64) {
+        ((p[0] / cell_m).floor() as i64, (p[1] / cell_m).floor() as i64)
+    }
+
+    /// The plane through a random point and two random points of its 3 × 3
+    /// cells; `None` if they are too few or collinear.
+    fn local_plane(&self, points: &[[f64; 3]], rng: &mut ChaCha8Rng) -> Option<Plane> {
+        let i = rng.gen_range(0..points.len());
+        let (cx, cy) = Self::key(self.cell_m, &points[i]);
+        let near: Vec<usize> = (-1..=1)
+            .flat_map(|dx| (-1..=1).map(move |dy| (cx + dx, cy + dy)))
+            .filter_map(|k| self.cells.get(&k))
+            .flatten()
+            .copied()
+            .filter(|&j| j != i)
+            .collect();
+        if near.len() < 2 {
+            return None;
+        }
+        let a = rng.gen_range(0..near.len());
+        let mut b = rng.gen_range(0..near.len() - 1);
+        if b >= a {
+            b += 1;
+        }
+        let (p, q, r) = (
+            nalgebra::Vector3::from(points[i]),
+            nalgebra::Vector3::from(points[near[a]]),
+            nalgebra::Vector3::from(points[near[b]]),
+        );
+        let cross = (q - p).cross(&(r - p));
+        if !(cross.norm() > 1e-9 * (q - p).norm() * (r - p).norm()) {
+            return None;
+        }
+        Plane::from_point_normal(p.into(), cross.into())
+    }
 }
 
 #[cfg(test)]
@@ -182,11 +453,7 @@ mod tests {
     fn exact_floor_gives_exact_angles() {
         let (a, b) = (4f64.to_radians(), (-6f64).to_radians());
         let scan = tilt(&floor_and_wall(), a, b);
-        let all = TiltParams {
-            floor_fraction: 1.0,
-            ..TiltParams::default()
-        };
-        let est = estimate_tilt(&scan, &all).unwrap();
+        let est = estimate_tilt(&scan, &TiltParams::default()).unwrap();
         assert_relative_eq!(est.roll_rad, a, epsilon = 1e-6);
         assert_relative_eq!(est.pitch_rad, b, epsilon = 1e-6);
         assert_relative_eq!(est.floor_height_m, -2.0, epsilon = 1e-5);
@@ -203,12 +470,12 @@ mod tests {
         let err = estimate_tilt(&PointCloud::default(), &TiltParams::default()).unwrap_err();
         assert!(matches!(err, SurfaceError::TooFewPoints { points: 0, .. }));
         let p = TiltParams {
-            floor_fraction: 0.0,
+            min_floor_share: 0.0,
             ..TiltParams::default()
         };
         let err = estimate_tilt(&floor_and_wall(), &p).unwrap_err();
         assert!(
-            err.to_string().contains("TiltParams.floor_fraction"),
+            err.to_string().contains("TiltParams.min_floor_share"),
             "{err}"
         );
     }

@@ -40,7 +40,9 @@ mod volume;
 pub use calibrate::{angles_from_normal, level, level_from_sensor, sensor_from_level, tilt};
 pub use error::{Result, SurfaceError};
 pub use fit::{fit_samples, fit_surface, DegreeScore, FitParams, HeightMap, SurfaceFit, Term};
-pub use floor::{estimate_tilt, TiltEstimate, TiltParams};
-pub use pile::{generate_pile, GeneratePileSummary, PileParams, PileShape, MAX_SCALE, MIN_SCALE};
+pub use floor::{estimate_tilt, TiltEstimate, TiltParams, MAX_FLOOR_TILT_DEG};
+pub use pile::{
+    generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern, MAX_SCALE, MIN_SCALE,
+};
 pub use ransac::{least_squares_plane, ransac_plane, Plane, PlaneFit, RansacParams};
 pub use sample::{sample_grid, Extent, GridSample, SampleParams, Samples};

@@ -148,8 +148,10 @@ pub struct LevelStage {
     pub roll_deg: f64,
     /// Pitch β [deg] when given.
     pub pitch_deg: f64,
-    /// Share of the lowest points searched for the floor.
-    pub floor_fraction: f64,
+    /// Smallest share of the points the floor must hold (the floor is the
+    /// plane with the most points and almost nothing below it; see
+    /// `autoshovel_surface::estimate_tilt`).
+    pub min_floor_share: f64,
 }
 
 /// Floor removal settings.
@@ -259,7 +261,7 @@ impl Default for LevelStage {
             mode: LevelMode::Estimate,
             roll_deg: 0.0,
             pitch_deg: 0.0,
-            floor_fraction: TiltParams::default().floor_fraction,
+            min_floor_share: TiltParams::default().min_floor_share,
         }
     }
 }
@@ -366,9 +368,9 @@ impl TomlFile for PerceptionParams {
         let checks: [(&str, &str, f64, bool, &str); 4] = [
             (
                 "level",
-                "floor_fraction",
-                self.level.floor_fraction,
-                self.level.floor_fraction > 0.0 && self.level.floor_fraction <= 1.0,
+                "min_floor_share",
+                self.level.min_floor_share,
+                self.level.min_floor_share > 0.0 && self.level.min_floor_share <= 1.0,
                 "a share in (0, 1]",
             ),
             (
@@ -739,7 +741,7 @@ pub fn perceive_with(
     on_stage("level");
     let t = Instant::now();
     let mut tilt_params = TiltParams::for_scale(scale);
-    tilt_params.floor_fraction = p.level.floor_fraction;
+    tilt_params.min_floor_share = p.level.min_floor_share;
     let (cloud, roll, pitch) = match p.level.mode {
         LevelMode::Estimate => {
             let est = estimate_tilt(cloud, &tilt_params)
@@ -1061,8 +1063,8 @@ mod tests {
         for (text, key, line) in [
             ("scale = -2\n", "scale", 1),
             (
-                "\n[level]\nfloor_fraction = 1.5\n",
-                "[level] floor_fraction",
+                "\n[level]\nmin_floor_share = 1.5\n",
+                "[level] min_floor_share",
                 3,
             ),
             ("[fit]\nr2_threshold = nan\n", "[fit] r2_threshold", 2),

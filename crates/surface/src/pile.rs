@@ -209,6 +209,51 @@ impl FromStr for PileShape {
     }
 }
 
+/// How the scan's surface points are spread (see the module docs).
+#[derive(
+    Debug, Clone, Copy, PartialEq, Eq, Hash, Default, serde::Serialize, serde::Deserialize,
+)]
+#[serde(rename_all = "kebab-case")]
+pub enum ScanPattern {
+    /// Uniform by area over the visible window (an idealised, evenly spread
+    /// survey). The default.
+    #[default]
+    Area,
+    /// Rays from the sensor in a non-repetitive rosette over a circular field
+    /// of view (`fov_rad`), as a Livox-type Risley-prism LiDAR scans, cast
+    /// onto the terrain: dense near the sensor and on the pattern's petals,
+    /// sparse far away, with the floor's share set by the geometry.
+    Rosette,
+}
+
+impl ScanPattern {
+    /// The name used on the command line and in files.
+    pub fn name(self) -> &'static str {
+        match self {
+            ScanPattern::Area => "area",
+            ScanPattern::Rosette => "rosette",
+        }
+    }
+}
+
+impl std::fmt::Display for ScanPattern {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+impl FromStr for ScanPattern {
+    type Err = String;
+
+    fn from_str(s: &str) -> std::result::Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "area" => Ok(ScanPattern::Area),
+            "rosette" => Ok(ScanPattern::Rosette),
+            _ => Err(format!("unknown scan pattern '{s}' (use area or rosette)")),
+        }
+    }
+}
+
 /// Smallest length scale [`generate_pile`] accepts (a 1 mm face).
 pub const MIN_SCALE: f64 = 1e-4;
 /// Largest length scale [`generate_pile`] accepts (a 10 km face): f32
@@ -254,6 +299,12 @@ pub struct PileParams {
     pub roll_rad: f64,
     /// Sensor pitch β of [RS eq. 11] [rad]. Default −2°.
     pub pitch_rad: f64,
+    /// How the surface points are spread. Default [`ScanPattern::Area`].
+    pub pattern: ScanPattern,
+    /// Full angle of the circular field of view of [`ScanPattern::Rosette`],
+    /// centred on the middle of the scan window [rad]. Default 70.4° (a
+    /// Livox Avia's circular pattern).
+    pub fov_rad: f64,
     /// Seed of the ChaCha8 generator. Default 1.
     pub seed: u64,
 }
@@ -277,6 +328,8 @@ impl Default for PileParams {
             isolated_share: 0.2,
             roll_rad: 3f64.to_radians(),
             pitch_rad: (-2f64).to_radians(),
+            pattern: ScanPattern::Area,
+            fov_rad: 70.4f64.to_radians(),
             seed: 1,
         }
     }
@@ -365,6 +418,13 @@ impl PileParams {
                 "a share in [0, 1]",
             );
         }
+        if !(self.fov_rad > 0.0 && self.fov_rad < 170f64.to_radians()) {
+            return bad(
+                "PileParams.fov_rad",
+                self.fov_rad,
+                "a field of view in (0°, 170°) [rad]",
+            );
+        }
         for (name, v) in [
             ("PileParams.roll_rad", self.roll_rad),
             ("PileParams.pitch_rad", self.pitch_rad),
@@ -445,40 +505,13 @@ pub fn generate_pile(params: &PileParams) -> Result<PointCloud> {
         * (1.0 + (params.toe_bow_m * PI / params.width_m).powi(2)).sqrt();
     let area_bound = (1.0 + slope_bound * slope_bound).sqrt() * 1.000_001;
     let noise = Normal::new(0.0, params.scale * params.range_noise_m).expect("σ >= 0, finite");
-    let nearest_toe = params.toe_x_m(0.0) - params.shape.overhang() * l;
-    // Along a ray from the sensor the terrain height never falls (s grows with
-    // the ray parameter while x > A·π/W·|y|, which holds for x ≥ near > A·π/2),
-    // so a sensor at or above the top sees every point: no marching needed.
-    let sees_all = params.sensor_height_m >= params.face_height_m
-        && params.near_distance_m > params.toe_bow_m * FRAC_PI_2;
 
     let mut scene: Vec<Vector3<f64>> = Vec::with_capacity(params.points);
-    let max_attempts = 1000 * n_surface + 1_000_000;
-    let mut attempts = 0;
-    while scene.len() < n_surface {
-        attempts += 1;
-        if attempts > max_attempts {
-            return Err(SurfaceError::TooFewPoints {
-                stage: "pile generator (visible surface)",
-                points: scene.len(),
-                required: n_surface,
-                hint: "; raise PileParams.sensor_height_m: the sensor sees almost none of the scan window",
-            });
+    match params.pattern {
+        ScanPattern::Area => {
+            area_surface(params, &mut rng, &noise, n_surface, area_bound, &mut scene)?;
         }
-        let x = rng.gen_range(x0..=x1);
-        let y = rng.gen_range(y0..=y1);
-        let (gx, gy) = params.gradient(x, y);
-        let keep = (1.0 + gx * gx + gy * gy).sqrt() / area_bound;
-        if rng.gen::<f64>() >= keep {
-            continue;
-        }
-        let p = Vector3::new(x, y, params.height_at(x, y));
-        if !sees_all && x >= nearest_toe && !visible(params, &p) {
-            continue;
-        }
-        let r = p.norm();
-        let eps = noise.sample(&mut rng);
-        scene.push(if r > 0.0 { p * (1.0 + eps / r) } else { p });
+        ScanPattern::Rosette => rosette_surface(params, &mut rng, &noise, n_surface, &mut scene)?,
     }
     let z_hi = top + 0.1 * params.scale * params.face_height_m;
     while scene.len() < n_surface + n_air {
@@ -509,6 +542,136 @@ pub fn generate_pile(params: &PileParams) -> Result<PointCloud> {
         })
         .collect();
     Ok(PointCloud { points })
+}
+
+/// The surface points of [`ScanPattern::Area`]: (x, y) uniform over the window,
+/// kept ∝ the area element, then only where the sensor sees them.
+fn area_surface(
+    params: &PileParams,
+    rng: &mut ChaCha8Rng,
+    noise: &Normal<f64>,
+    n_surface: usize,
+    area_bound: f64,
+    scene: &mut Vec<Vector3<f64>>,
+) -> Result<()> {
+    let ([x0, x1], [y0, y1]) = params.window_m();
+    let nearest_toe = params.toe_x_m(0.0) - params.shape.overhang() * params.face_run_m();
+    // Along a ray from the sensor the terrain height never falls (s grows with
+    // the ray parameter while x > A·π/W·|y|, which holds for x ≥ near > A·π/2),
+    // so a sensor at or above the top sees every point: no marching needed.
+    let sees_all = params.sensor_height_m >= params.face_height_m
+        && params.near_distance_m > params.toe_bow_m * FRAC_PI_2;
+    let max_attempts = 1000 * n_surface + 1_000_000;
+    let mut attempts = 0;
+    while scene.len() < n_surface {
+        attempts += 1;
+        if attempts > max_attempts {
+            return Err(SurfaceError::TooFewPoints {
+                stage: "pile generator (visible surface)",
+                points: scene.len(),
+                required: n_surface,
+                hint: "; raise PileParams.sensor_height_m: the sensor sees almost none of the scan window",
+            });
+        }
+        let x = rng.gen_range(x0..=x1);
+        let y = rng.gen_range(y0..=y1);
+        let (gx, gy) = params.gradient(x, y);
+        let keep = (1.0 + gx * gx + gy * gy).sqrt() / area_bound;
+        if rng.gen::<f64>() >= keep {
+            continue;
+        }
+        let p = Vector3::new(x, y, params.height_at(x, y));
+        if !sees_all && x >= nearest_toe && !visible(params, &p) {
+            continue;
+        }
+        let r = p.norm();
+        let eps = noise.sample(rng);
+        scene.push(if r > 0.0 { p * (1.0 + eps / r) } else { p });
+    }
+    Ok(())
+}
+
+/// The surface points of [`ScanPattern::Rosette`]: rays from the sensor in a
+/// non-repetitive rosette about the boresight (the sensor to the middle of the
+/// window), each cast onto the terrain; a ray that lands outside the window
+/// or never lands is a miss (no return). The angular offsets from the
+/// boresight are `u = ½R (cos t + cos ωt)`, `v = ½R (sin t − sin ωt)` with
+/// R half the field of view and ω = 5φ (φ the golden ratio, so the curve
+/// never closes), t advancing a fixed step per ray from a seeded phase.
+fn rosette_surface(
+    params: &PileParams,
+    rng: &mut ChaCha8Rng,
+    noise: &Normal<f64>,
+    n_surface: usize,
+    scene: &mut Vec<Vector3<f64>>,
+) -> Result<()> {
+    let ([x0, x1], [y0, y1]) = params.window_m();
+    let xc = 0.5 * (x0 + x1);
+    let boresight = Vector3::new(xc, 0.0, params.height_at(xc, 0.0)).normalize();
+    let e1 = boresight.cross(&Vector3::z()).normalize();
+    let e2 = e1.cross(&boresight);
+    let half_fov = 0.5 * params.fov_rad;
+    let omega = 2.5 * (1.0 + 5f64.sqrt());
+    // About 400 turns of the slow rotation over the scan.
+    let dt = 400.0 * 2.0 * PI / (2.0 * n_surface.max(1) as f64);
+    let mut t = rng.gen_range(0.0..2.0 * PI);
+    // March a ray in steps of 1/40 of the face run (the terrain's shortest
+    // feature is the typical fillet, 1/10 of it), then bisect to the hit.
+    let step = params.face_run_m() / 40.0;
+    let floor = -params.scale * params.sensor_height_m;
+    let reach = 2.0 * (x1.hypot(y1) + params.scale * params.sensor_height_m);
+    let max_rays = 50 * n_surface + 10_000;
+    let mut rays = 0;
+    while scene.len() < n_surface {
+        rays += 1;
+        if rays > max_rays {
+            return Err(SurfaceError::TooFewPoints {
+                stage: "pile generator (rosette pattern)",
+                points: scene.len(),
+                required: n_surface,
+                hint: "; widen PileParams.fov_rad or move the sensor: the pattern misses the scan window",
+            });
+        }
+        t += dt;
+        let u = 0.5 * half_fov * (t.cos() + (omega * t).cos());
+        let v = 0.5 * half_fov * (t.sin() - (omega * t).sin());
+        let d = (boresight + u.tan() * e1 + v.tan() * e2).normalize();
+        let above = |s: f64| {
+            let q = d * s;
+            q.z - params.height_at(q.x, q.y)
+        };
+        let t_end = if d.z < 0.0 { (floor / d.z).min(reach) } else { reach };
+        let (mut lo, mut hi) = (0.0, f64::NAN);
+        let mut s = step;
+        while s < t_end + step {
+            let s_clamped = s.min(t_end);
+            if above(s_clamped) <= 0.0 {
+                hi = s_clamped;
+                break;
+            }
+            lo = s_clamped;
+            s += step;
+        }
+        if hi.is_nan() {
+            continue; // into the sky
+        }
+        for _ in 0..40 {
+            let mid = 0.5 * (lo + hi);
+            if above(mid) > 0.0 {
+                lo = mid;
+            } else {
+                hi = mid;
+            }
+        }
+        let r = hi;
+        let p = d * r;
+        if !(x0..=x1).contains(&p.x) || !(y0..=y1).contains(&p.y) {
+            continue;
+        }
+        let p = Vector3::new(p.x, p.y, params.height_at(p.x, p.y));
+        scene.push(p * (1.0 + noise.sample(rng) / p.norm()));
+    }
+    Ok(())
 }
 
 /// Whether the straight ray from the sensor (origin) to a surface point stays
@@ -762,6 +925,10 @@ pub struct GeneratePileSummary {
     pub shape: &'static str,
     /// Points written.
     pub points: usize,
+    /// How the points are spread (`area` or `rosette`).
+    pub pattern: &'static str,
+    /// Sensor height above the floor [m].
+    pub sensor_height_m: f64,
     /// Sensor roll α [deg].
     pub roll_deg: f64,
     /// Sensor pitch β [deg].
@@ -795,6 +962,8 @@ impl GeneratePileSummary {
             job: "generate-pile",
             shape: p.shape.name(),
             points,
+            pattern: p.pattern.name(),
+            sensor_height_m: p.scale * p.sensor_height_m,
             roll_deg: p.roll_rad.to_degrees(),
             pitch_deg: p.pitch_rad.to_degrees(),
             scale: p.scale,
