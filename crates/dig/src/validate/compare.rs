@@ -24,7 +24,7 @@ use serde::Serialize;
 
 use crate::error::Result;
 use crate::validate::align::{align, interpolate, AlignParams, Alignment};
-use crate::validate::record::{MeasuredRecord, PlannedRecord};
+use crate::validate::record::{ForceRecord, MeasuredRecord, PlannedRecord};
 
 /// One quantity planned and measured (a row entry of [RS Table 6]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
@@ -212,6 +212,9 @@ pub struct Validation {
     pub summary: ValidateSummary,
     /// The compared samples.
     pub aligned: AlignedSeries,
+    /// The whole measured record with its times moved onto the plan's
+    /// clock, (t − τ)/s (for plots like [RS Fig. 20]).
+    pub measured_on_plan_clock: ForceRecord,
 }
 
 /// Compares `measured` with `planned` ([RS §5]): aligns the two in time
@@ -280,7 +283,15 @@ pub fn validate(
         handle_extension: travel(&aligned.handle_extension_m),
         alignment,
     };
-    Ok(Validation { summary, aligned })
+    let mut measured_on_plan_clock = m.clone();
+    for t in &mut measured_on_plan_clock.t_s {
+        *t = (*t - alignment.offset_s) / alignment.time_scale;
+    }
+    Ok(Validation {
+        summary,
+        aligned,
+        measured_on_plan_clock,
+    })
 }
 
 #[cfg(test)]
