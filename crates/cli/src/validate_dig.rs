@@ -55,28 +55,28 @@ pub struct Args {
     #[arg(long, default_value_t = 10.0)]
     pub max_stretch_pct: f64,
     /// --simulate: time from the logger's start to the dig's start [s].
-    #[arg(long, default_value_t = 0.37, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().delay_s, allow_negative_numbers = true)]
     pub sim_delay_s: f64,
     /// --simulate: gain of the hoist force sensor.
-    #[arg(long, default_value_t = 1.06)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().gain_hoist)]
     pub sim_gain_hoist: f64,
     /// --simulate: gain of the crowd force sensor.
-    #[arg(long, default_value_t = 0.95)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().gain_crowd)]
     pub sim_gain_crowd: f64,
     /// --simulate: standard deviation of the force noise [N].
-    #[arg(long, default_value_t = 2.0)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().noise_n)]
     pub sim_noise_n: f64,
     /// --simulate: measured dig time per planned dig time.
-    #[arg(long, default_value_t = 0.997)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().time_scale)]
     pub sim_time_scale: f64,
     /// --simulate: weighed minus planned mass [kg].
-    #[arg(long, default_value_t = 0.033, allow_negative_numbers = true)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().mass_offset_kg, allow_negative_numbers = true)]
     pub sim_mass_offset_kg: f64,
     /// --simulate: logger sample period [s].
-    #[arg(long, default_value_t = 0.01)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().sample_period_s)]
     pub sim_period_s: f64,
     /// --simulate: seed of the noise.
-    #[arg(long, default_value_t = 1)]
+    #[arg(long, default_value_t = MeasurementModel::testbed().seed)]
     pub sim_seed: u64,
     #[command(flatten)]
     pub output: crate::output::OutputArgs,
@@ -93,7 +93,8 @@ impl Args {
             gain_crowd: self.sim_gain_crowd,
             mass_offset_kg: self.sim_mass_offset_kg,
             sample_period_s: self.sim_period_s,
-            ..MeasurementModel::default()
+            seed: self.sim_seed,
+            ..MeasurementModel::testbed()
         };
         let ok = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
         for (name, v, lo, hi) in [
