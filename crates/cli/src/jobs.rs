@@ -336,6 +336,19 @@ pub fn plan_dig_all_surfaces(
     })
 }
 
+/// `validate-dig`: `measured` against `planned`, aligned with `params`.
+pub fn validate_dig(
+    planned: &autoshovel_dig::validate::PlannedRecord,
+    measured: &autoshovel_dig::validate::MeasuredRecord,
+    params: &autoshovel_dig::validate::AlignParams,
+    out: Option<&OutDir>,
+) -> Result<Job<autoshovel_dig::validate::ValidateSummary>> {
+    let v = autoshovel_dig::validate::validate(planned, measured, params)?;
+    Job::finish(v.summary.clone(), out, |dir, written| {
+        Ok(figures::validate::write(dir, &v, written)?)
+    })
+}
+
 /// `plan-excavate`: plan and execute the dig of `setup`; an impossible dig
 /// is an error naming the scenario; `out` is made only for a plan.
 pub fn plan_excavate(setup: &Setup, out: Option<&OutDir>) -> Result<Job<ExcavateSummary>> {

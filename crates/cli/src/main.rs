@@ -27,6 +27,7 @@ mod study;
 mod study_boulders;
 mod track;
 mod tune_trackers;
+mod validate_dig;
 
 use std::path::PathBuf;
 use std::process::ExitCode;
@@ -53,6 +54,8 @@ enum Command {
     Perceive(perceive::Args),
     /// Plan the dig: a 6th-order tooth path by the Grey Wolf Optimizer (rope-shovel paper §4, SPEC §4.2–4.3).
     PlanDig(plan_dig::Args),
+    /// Planned against measured: compare a plan-dig plan with a testbed record (rope-shovel paper §5, Table 6, Fig. 20).
+    ValidateDig(validate_dig::Args),
     /// Plan a hydraulic excavator's dig round buried boulders: two-level planning (SPEC §5).
     PlanExcavate(plan_excavate::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
@@ -161,6 +164,7 @@ fn main() -> ExitCode {
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),
         Command::PlanDig(args) => plan_dig::run(&args),
+        Command::ValidateDig(args) => validate_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
         Command::Scenario { name } => print_scenario(&name),
         Command::PlcSim(args) => link::plc_sim(&args),

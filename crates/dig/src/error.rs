@@ -93,9 +93,162 @@ pub enum DigError {
         /// Why a plan on this pile may fail (e.g. a full-size scan for a scale model).
         hint: Option<String>,
     },
+    /// A record file of `validate-dig` (a measured CSV, a plan's
+    /// `samples.csv`) could not be read.
+    #[error("cannot read {}", .path.display())]
+    RecordRead {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A record file could not be written (a simulated measurement).
+    #[error("cannot write {}", .path.display())]
+    RecordWrite {
+        /// The file.
+        path: PathBuf,
+        /// Why.
+        source: std::io::Error,
+    },
+    /// A record file is not a usable table (names the file, the line and
+    /// the column at fault).
+    #[error("{}: {problem}", location(.path, *.line))]
+    Record {
+        /// The file.
+        path: PathBuf,
+        /// The 1-based line at fault, if one is.
+        line: Option<usize>,
+        /// What is wrong there.
+        problem: RecordProblem,
+    },
+    /// A `--plan` folder is not the output of one `plan-dig` plan.
+    #[error("{}: {problem}", .dir.display())]
+    PlanDir {
+        /// The folder.
+        dir: PathBuf,
+        /// What is wrong with it.
+        problem: PlanDirProblem,
+    },
+    /// The measured record cannot be aligned with the plan: at no offset
+    /// within the lag window does it cover enough of the dig.
+    #[error(
+        "{}: the record ({record_start_s} s to {record_end_s} s) covers less than {min_overlap_pct} % of the {td_s} s dig at every offset within ±{max_lag_s} s of its start; record the whole dig, or widen the window (--max-lag-s)",
+        .path.display()
+    )]
+    NoOverlap {
+        /// The measured file.
+        path: PathBuf,
+        /// Its first time [s].
+        record_start_s: f64,
+        /// Its last time [s].
+        record_end_s: f64,
+        /// The planned dig time [s].
+        td_s: f64,
+        /// The lag window searched, either side of the record's start [s].
+        max_lag_s: f64,
+        /// The least share of the dig a record must cover [%].
+        min_overlap_pct: f64,
+    },
 }
 
-/// What is wrong in a warm-start pack file.
+/// What is wrong in a record file of `validate-dig`.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum RecordProblem {
+    /// No header line.
+    #[error("empty file; expected a header line naming the columns ({expected})")]
+    Empty {
+        /// The columns a record needs.
+        expected: String,
+    },
+    /// A required column is not in the header.
+    #[error("no column '{column}' in the header '{header}' (required: {required})")]
+    MissingColumn {
+        /// The column missing.
+        column: &'static str,
+        /// The header found.
+        header: String,
+        /// Every required column.
+        required: String,
+    },
+    /// A column named twice.
+    #[error("column '{column}' appears twice in the header")]
+    DuplicateColumn {
+        /// The column.
+        column: String,
+    },
+    /// A row with the wrong number of cells.
+    #[error("{found} cells, the header has {expected}")]
+    Width {
+        /// Cells found.
+        found: usize,
+        /// Cells the header names.
+        expected: usize,
+    },
+    /// A cell that is not a finite number.
+    #[error("column {column}: '{cell}' is not a finite number")]
+    NotANumber {
+        /// Its column.
+        column: String,
+        /// Its text.
+        cell: String,
+    },
+    /// Time not strictly increasing.
+    #[error("t_s = {t_s} does not increase (the line before has {previous_t_s})")]
+    TimeNotIncreasing {
+        /// The time of this line [s].
+        t_s: f64,
+        /// The time of the line before [s].
+        previous_t_s: f64,
+    },
+    /// Too few rows to compare.
+    #[error("{found} samples; at least {min} are needed")]
+    TooFewSamples {
+        /// Rows found.
+        found: usize,
+        /// Rows needed.
+        min: usize,
+    },
+    /// A `mass_kg` column with no value in it.
+    #[error(
+        "column mass_kg has no value; give the dug mass in at least one row, or drop the column"
+    )]
+    NoMass,
+}
+
+/// What is wrong with a `--plan` folder.
+#[derive(Debug, Clone, PartialEq, thiserror::Error)]
+#[non_exhaustive]
+pub enum PlanDirProblem {
+    /// `summary.json` is not JSON.
+    #[error("summary.json is not valid JSON: {message}")]
+    Json {
+        /// The parser's message.
+        message: String,
+    },
+    /// `summary.json` of another job.
+    #[error("summary.json is of job '{job}', not plan-dig; pass the --out folder of `autoshovel plan-dig`")]
+    NotPlanDig {
+        /// The job named there.
+        job: String,
+    },
+    /// The folder of `plan-dig --all-surfaces`.
+    #[error("this is an --all-surfaces folder; pass one pile's folder in it, e.g. its typical/")]
+    AllSurfaces,
+    /// A summary without a plan.
+    #[error("the plan-dig run found no feasible plan: {error}")]
+    NoPlan {
+        /// Its error.
+        error: String,
+    },
+    /// A field missing from `summary.json`.
+    #[error("summary.json has no '{field}'")]
+    MissingField {
+        /// The field.
+        field: &'static str,
+    },
+}
+
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum PackProblem {

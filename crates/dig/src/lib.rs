@@ -12,6 +12,9 @@
 //! paper's Tables 4–5, [`all_surfaces`]), [`paper`] (those tables as data),
 //! [`pack`] (the warm-start `pack.csv`) and [`scan`] (the dig profile cut
 //! from a perceived scan).
+//!
+//! The `validate-dig` job, planned against measured ([RS §5], Table 6,
+//! Fig. 20), is [`validate`].
 
 // Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
 #![allow(rustdoc::broken_intra_doc_links)]
@@ -29,13 +32,14 @@ pub mod profile;
 pub mod scan;
 pub mod terrain;
 pub mod trajectory;
+pub mod validate;
 
 pub use autoshovel_core::config::TomlFile;
 pub use compare::{
     all_surfaces, table_summary, AllSurfaces, AllSurfacesSummary, ComparedPile, PaperPlanCheck,
     SurfaceComparison, TableColumn, TableRow, TableSummary, TABLE_COLUMNS,
 };
-pub use error::{DigError, PackProblem, Result};
+pub use error::{DigError, PackProblem, PlanDirProblem, RecordProblem, Result};
 pub use job::{
     plan_pile, ConstraintReport, DigHeader, DigSetup, DigSummary, Pile, PlanFields, PlannedPile,
     WarmStart, WarmStartSummary, BUILTIN_PROFILE_NAME,
@@ -45,7 +49,7 @@ pub use pack::{read_pack, write_pack, PACK_COLUMNS};
 pub use paper::{paper_row, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
 pub use plan::{
     gwo_preset, plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample,
-    SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS,
+    SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS, SAMPLE_COLUMNS,
 };
 pub use profile::{Geometry, MachineProfile};
 pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};

@@ -125,6 +125,53 @@ pub struct DigSample {
     pub back_angle_rad: f64,
 }
 
+/// Columns of a plan's `samples.csv`, one per value of [`DigSample::csv_row`]
+/// (`plan-dig` writes it, `validate-dig` reads it back).
+pub const SAMPLE_COLUMNS: [&str; 17] = [
+    "t_s",
+    "tip_x_m",
+    "tip_y_m",
+    "theta1_rad",
+    "d2_m",
+    "hoist_force_n",
+    "crowd_force_n",
+    "hoist_speed_m_s",
+    "crowd_speed_m_s",
+    "hoist_power_w",
+    "crowd_power_w",
+    "rope_handle_angle_rad",
+    "resistance_tangential_n",
+    "resistance_normal_n",
+    "cut_thickness_m",
+    "load_kg",
+    "back_angle_rad",
+];
+
+impl DigSample {
+    /// The sample as one row of `samples.csv` ([`SAMPLE_COLUMNS`]).
+    pub fn csv_row(&self) -> [f64; 17] {
+        [
+            self.t_s,
+            self.tip_m[0],
+            self.tip_m[1],
+            self.joints.theta1,
+            self.joints.d2,
+            self.drive.hoist_force_n,
+            self.drive.crowd_force_n,
+            self.drive.hoist_speed_m_s,
+            self.drive.crowd_speed_m_s,
+            self.drive.hoist_power_w(),
+            self.drive.crowd_power_w(),
+            self.drive.rope_handle_angle_rad,
+            self.drive.resistance_tangential_n,
+            self.drive.resistance_normal_n,
+            self.cut_thickness_m,
+            self.load_kg,
+            self.back_angle_rad,
+        ]
+    }
+}
+
 /// Everything one evaluation measures.
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct DigOutcome {

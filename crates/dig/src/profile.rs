@@ -461,7 +461,7 @@ impl MachineProfile {
 
 /// Quantities derived from Table 1 in the dig frame {Oo} (x from the toe into
 /// the pile, y up; metres, radians).
-#[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
+#[derive(Debug, Clone, Copy, PartialEq, Deserialize, serde::Serialize)]
 pub struct Geometry {
     /// l₁: x of the saddle centre O (negative: O is on the machine's side of the toe).
     pub l1: f64,

@@ -11,7 +11,7 @@ use std::path::Path;
 
 use autoshovel_dig::{
     write_pack, AllSurfaces, AllSurfacesSummary, ComparedPile, Decision, DigModel, DigPlan,
-    DigSample, PlannedPile, TableRow, TABLE_COLUMNS,
+    DigSample, PlannedPile, TableRow, SAMPLE_COLUMNS, TABLE_COLUMNS,
 };
 use autoshovel_report::{
     markdown_table as md_table, rating_line, write_csv, write_csv_cells, write_figure,
@@ -144,50 +144,13 @@ pub fn drive_figures(name: &str, model: &DigModel, plan: &DigPlan) -> [Figure; 3
     [speeds, forces, powers]
 }
 
-/// Writes every sample of the planned dig to `path`.
+/// Writes every sample of the planned dig to `path` (the columns of
+/// [`SAMPLE_COLUMNS`]).
 pub fn write_samples_csv(path: &Path, samples: &[DigSample]) -> Result<(), Error> {
     write_csv(
         path,
-        &[
-            "t_s",
-            "tip_x_m",
-            "tip_y_m",
-            "theta1_rad",
-            "d2_m",
-            "hoist_force_n",
-            "crowd_force_n",
-            "hoist_speed_m_s",
-            "crowd_speed_m_s",
-            "hoist_power_w",
-            "crowd_power_w",
-            "rope_handle_angle_rad",
-            "resistance_tangential_n",
-            "resistance_normal_n",
-            "cut_thickness_m",
-            "load_kg",
-            "back_angle_rad",
-        ],
-        samples.iter().map(|s| {
-            vec![
-                s.t_s,
-                s.tip_m[0],
-                s.tip_m[1],
-                s.joints.theta1,
-                s.joints.d2,
-                s.drive.hoist_force_n,
-                s.drive.crowd_force_n,
-                s.drive.hoist_speed_m_s,
-                s.drive.crowd_speed_m_s,
-                s.drive.hoist_power_w(),
-                s.drive.crowd_power_w(),
-                s.drive.rope_handle_angle_rad,
-                s.drive.resistance_tangential_n,
-                s.drive.resistance_normal_n,
-                s.cut_thickness_m,
-                s.load_kg,
-                s.back_angle_rad,
-            ]
-        }),
+        &SAMPLE_COLUMNS,
+        samples.iter().map(|s| s.csv_row().to_vec()),
     )?;
     Ok(())
 }

@@ -18,6 +18,7 @@ pub mod shovel;
 pub mod study;
 pub mod track;
 pub mod tune;
+pub mod validate;
 
 /// What can go wrong while writing a job's files.
 #[derive(Debug, thiserror::Error)]
