@@ -91,6 +91,11 @@ pub struct Args {
     /// Placement of the optimiser's first pack.
     #[arg(long, value_enum, default_value = "good-point-set")]
     pub init: InitArg,
+    /// After the Grey Wolf Optimizer, polish its best plan by CMA-ES with this
+    /// many more evaluations (0: none). A long polish (e.g. 20000, about
+    /// 0.3 s) brings a plan closer to the best the model allows (docs/dig.md).
+    #[arg(long, default_value_t = 0)]
+    pub polish: usize,
     /// Start from the final pack of an earlier plan (its `pack.csv`), as the
     /// next dig cycle would: those wolves replace the first of the new pack.
     #[arg(long, conflicts_with = "all_surfaces")]
@@ -114,6 +119,7 @@ pub fn run(args: &Args) -> Result<()> {
         Some(p) => DigSetup::new(MachineProfile::load(p)?, p.display().to_string(), args.seed),
         None => DigSetup::scale_model(args.seed),
     };
+    setup.polish_evaluations = args.polish;
     setup.gwo.init = args.init.into();
     setup.search = args.search.into();
     if let Some(path) = &args.warm_start {

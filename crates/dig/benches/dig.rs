@@ -25,16 +25,31 @@ fn evaluation(c: &mut Criterion) {
 
 fn whole_plan(c: &mut Criterion) {
     let m = model();
-    let mut g = c.benchmark_group("dig/plan typical 50x100");
+    let mut g = c.benchmark_group("dig/plan typical 5050 evaluations");
     g.sample_size(20);
     for parallel in [false, true] {
-        let params = GwoParams {
+        let gwo_only: autoshovel_dig::DigSearch = GwoParams {
             seed: 1,
             parallel,
             ..autoshovel_dig::gwo_preset()
+        }
+        .into();
+        let preset = autoshovel_dig::search_preset();
+        let polished = autoshovel_dig::DigSearch {
+            gwo: GwoParams {
+                seed: 1,
+                parallel,
+                ..preset.gwo
+            },
+            ..preset
         };
-        let name = if parallel { "parallel" } else { "serial" };
-        g.bench_function(name, |b| b.iter(|| plan_dig(&m, &params, &[]).unwrap()));
+        let threads = if parallel { "parallel" } else { "serial" };
+        g.bench_function(format!("gwo 50x100 {threads}"), |b| {
+            b.iter(|| plan_dig(&m, &gwo_only, &[]).unwrap())
+        });
+        g.bench_function(format!("gwo 150x25 + cma 1150 {threads}"), |b| {
+            b.iter(|| plan_dig(&m, &polished, &[]).unwrap())
+        });
     }
     g.finish();
 }

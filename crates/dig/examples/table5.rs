@@ -5,7 +5,7 @@
 //! `cargo run --release -p autoshovel-dig --example table5`
 
 use autoshovel_dig::{
-    gwo_preset, plan_dig, DigModel, DigSurface, MachineProfile, PAPER_TABLES_4_5,
+    plan_dig, search_preset, DigModel, DigSearch, DigSurface, MachineProfile, PAPER_TABLES_4_5,
 };
 use autoshovel_optim::GwoParams;
 
@@ -23,9 +23,13 @@ fn main() {
         );
         let surface = DigSurface::from_shape(shape, profile.dipper.width_m);
         let model = DigModel::new(&profile, surface).expect("the scale model reaches the pile");
-        let gwo = GwoParams {
-            seed: 1,
-            ..gwo_preset()
+        let preset = search_preset();
+        let gwo = DigSearch {
+            gwo: GwoParams {
+                seed: 1,
+                ..preset.gwo
+            },
+            ..preset
         };
         let plan = plan_dig(&model, &gwo, &[]).expect("a feasible plan");
         let o = &plan.outcome;

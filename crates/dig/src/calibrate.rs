@@ -14,10 +14,8 @@
 //! 0.056 per unit of ε), backing off when the limits leave no feasible plan. The result is calibrated on one pile and then used
 //! unchanged to *predict* the others.
 
-use autoshovel_optim::GwoParams;
-
 use crate::error::{DigError, Result};
-use crate::plan::{plan_dig, DigModel};
+use crate::plan::{plan_dig, DigModel, DigSearch};
 use crate::profile::MachineProfile;
 use crate::terrain::DigSurface;
 
@@ -70,7 +68,7 @@ pub fn calibrate(
     profile: &MachineProfile,
     surface: &DigSurface,
     target: CalibrationTarget,
-    gwo: &GwoParams,
+    search: &DigSearch,
 ) -> Result<Calibration> {
     let mut p = profile.clone();
     let mut plans = 0;
@@ -78,7 +76,7 @@ pub fn calibrate(
     while plans < 24 {
         plans += 1;
         let model = DigModel::new(&p, surface.clone())?;
-        match plan_dig(&model, gwo, &[]) {
+        match plan_dig(&model, search, &[]) {
             Ok(plan) => (f1, fill) = (plan.outcome.f1_j_per_kg, plan.outcome.fill_factor),
             Err(DigError::Infeasible { .. }) => {
                 // Too much resistance to fill the dipper within the limits.

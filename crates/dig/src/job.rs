@@ -16,7 +16,9 @@ use serde::Serialize;
 
 use crate::error::{DigError, Result};
 use crate::pack::read_pack;
-use crate::plan::{gwo_preset, plan_dig, Bound, DigModel, DigOutcome, DigPlan, SearchSpace};
+use crate::plan::{
+    plan_dig, search_preset, Bound, DigModel, DigOutcome, DigPlan, DigSearch, SearchSpace,
+};
 use crate::profile::{Geometry, MachineProfile};
 use crate::scan::{cut_scan, PerceptionSummary, ScanSource};
 use crate::terrain::DigSurface;
@@ -29,8 +31,11 @@ pub struct DigSetup {
     pub profile: MachineProfile,
     /// Where it came from: a path or "builtin scale-model".
     pub profile_name: String,
-    /// Optimiser settings ([`gwo_preset`]: the paper's 50 wolves, 100 iterations).
+    /// Optimiser settings ([`search_preset`]: the paper's 50 wolves, 100
+    /// iterations).
     pub gwo: GwoParams,
+    /// Evaluations of the CMA-ES polish after GWO (default 0: none).
+    pub polish_evaluations: usize,
     /// Search coordinates.
     pub search: SearchSpace,
     /// Wolves to start from (an earlier plan's final pack).
@@ -60,24 +65,34 @@ impl WarmStart {
 pub const BUILTIN_PROFILE_NAME: &str = "builtin scale-model";
 
 impl DigSetup {
-    /// The built-in 1:30 scale model with the dig planner's optimiser preset
-    /// ([`gwo_preset`]) at `seed`, in the bends coordinates.
+    /// The built-in 1:30 scale model with the dig planner's search preset
+    /// ([`search_preset`]) at `seed`, in the bends coordinates.
     pub fn scale_model(seed: u64) -> Self {
         Self::new(MachineProfile::scale_model(), BUILTIN_PROFILE_NAME, seed)
     }
 
-    /// `profile` (named `profile_name` in summaries) with [`gwo_preset`] at
-    /// `seed`, in the bends coordinates and without a warm start.
+    /// `profile` (named `profile_name` in summaries) with [`search_preset`]
+    /// at `seed`, in the bends coordinates and without a warm start.
     pub fn new(profile: MachineProfile, profile_name: impl Into<String>, seed: u64) -> Self {
+        let preset = search_preset();
         Self {
             profile,
             profile_name: profile_name.into(),
-            gwo: GwoParams {
-                seed,
-                ..gwo_preset()
-            },
+            gwo: GwoParams { seed, ..preset.gwo },
+            polish_evaluations: preset.polish_evaluations,
             search: SearchSpace::default(),
             warm_start: None,
+        }
+    }
+}
+
+impl DigSetup {
+    /// The optimiser settings as one [`DigSearch`].
+    pub fn search_settings(&self) -> DigSearch {
+        DigSearch {
+            gwo: self.gwo,
+            polish_evaluations: self.polish_evaluations,
+            ..search_preset()
         }
     }
 }
@@ -147,6 +162,8 @@ pub struct DigHeader {
     pub population: usize,
     /// Iterations.
     pub iterations: usize,
+    /// Evaluations of the CMA-ES polish after GWO.
+    pub polish_evaluations: usize,
     /// Constraint handling ([`autoshovel_optim::Constraints::name`]).
     pub constraint_handling: &'static str,
     /// The profile's path or "builtin scale-model".
@@ -191,6 +208,7 @@ impl DigHeader {
             init: setup.gwo.init.name(),
             population: setup.gwo.population,
             iterations: setup.gwo.iterations,
+            polish_evaluations: setup.polish_evaluations,
             constraint_handling: setup.gwo.constraints.name(),
             profile: setup.profile_name.clone(),
             warm_start: setup.warm_start.as_ref().map(|w| WarmStartSummary {
@@ -319,7 +337,7 @@ impl PlanFields {
             hoist_energy_j: o.hoist_energy_j,
             crowd_energy_j: o.crowd_energy_j,
             constraints: constraint_reports(model, o),
-            evaluations: plan.search.evaluations,
+            evaluations: plan.evaluations(),
             first_feasible_iteration: plan
                 .search
                 .history
@@ -395,7 +413,7 @@ pub fn plan_pile(pile: &Pile, setup: &DigSetup) -> Result<PlannedPile> {
         .flat_map(|w| w.wolves.iter().take(setup.gwo.population))
         .map(|d| model.vector(d))
         .collect();
-    let result = plan_dig(&model, &setup.gwo, &warm);
+    let result = plan_dig(&model, &setup.search_settings(), &warm);
     let plan_time_ms = t0.elapsed().as_secs_f64() * 1e3;
     let header = DigHeader::new(pile, setup);
     let (summary, plan) = match result {

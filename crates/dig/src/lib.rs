@@ -48,8 +48,8 @@ pub use kinematics::{Joints, RopeShovel};
 pub use pack::{read_pack, write_pack, PACK_COLUMNS};
 pub use paper::{paper_row, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
 pub use plan::{
-    gwo_preset, plan_dig, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan, DigSample,
-    SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS, SAMPLE_COLUMNS,
+    gwo_preset, plan_dig, search_preset, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan,
+    DigSample, DigSearch, SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS, SAMPLE_COLUMNS,
 };
 pub use profile::{Geometry, MachineProfile};
 pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};

@@ -73,15 +73,27 @@ impl DigSurface {
             shape,
             ..PileParams::paper_model()
         };
+        Self::from_pile(&p, 0.0, width_m)
+    }
+
+    /// The noiseless pile `p` of [`autoshovel_surface::generate_pile`] with
+    /// its toe (on the centre line) at `toe_x_m` in the dig frame: a positive
+    /// value puts the toe that far beyond where the dig starts.
+    pub fn from_pile(p: &PileParams, toe_x_m: f64, width_m: f64) -> Self {
         let toe = p.toe_x_m(0.0);
         let floor = -p.scale * p.sensor_height_m;
         let (xs, _) = p.window_m();
         Self::from_fn(
-            |x, y| p.height_at(x + toe, y) - floor,
+            |x, y| p.height_at(x - toe_x_m + toe, y) - floor,
             width_m,
             -0.1,
-            xs[1] - toe,
-            &format!("{} pile (1:30 model)", shape.name()),
+            xs[1] - toe + toe_x_m.max(0.0),
+            &format!(
+                "{} pile (1:30 model, face {:.3} m, toe at {:+.3} m)",
+                p.shape.name(),
+                p.scale * p.face_height_m,
+                toe_x_m
+            ),
         )
     }
 

@@ -2,8 +2,8 @@
 //! refusals.
 
 use autoshovel_dig::{
-    gwo_preset, plan_dig, DigError, DigModel, DigSurface, MachineProfile, SearchSpace,
-    PAPER_TABLES_4_5,
+    plan_dig, search_preset, DigError, DigModel, DigSearch, DigSurface, MachineProfile,
+    SearchSpace, PAPER_TABLES_4_5,
 };
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
@@ -13,10 +13,12 @@ fn model(shape: PileShape) -> DigModel {
     DigModel::new(&p, DigSurface::from_shape(shape, p.dipper.width_m)).unwrap()
 }
 
-fn gwo(seed: u64) -> GwoParams {
-    GwoParams {
-        seed,
-        ..gwo_preset()
+/// The planner's default search at `seed`.
+fn gwo(seed: u64) -> DigSearch {
+    let preset = search_preset();
+    DigSearch {
+        gwo: GwoParams { seed, ..preset.gwo },
+        ..preset
     }
 }
 
@@ -62,8 +64,11 @@ fn the_same_seed_gives_the_same_plan_and_another_seed_another_search() {
     let a = plan_dig(&m, &gwo(7), &[]).unwrap();
     let b = plan_dig(
         &m,
-        &GwoParams {
-            parallel: false,
+        &DigSearch {
+            gwo: GwoParams {
+                parallel: false,
+                ..gwo(7).gwo
+            },
             ..gwo(7)
         },
         &[],
@@ -136,10 +141,11 @@ fn a_warm_start_from_the_last_cycle_converges_in_fewer_iterations() {
         .iter()
         .map(|(x, _)| x.clone())
         .collect();
-    let short = GwoParams {
+    let short: DigSearch = GwoParams {
         iterations: 20,
-        ..gwo(2)
-    };
+        ..gwo(2).gwo
+    }
+    .into();
     let warm = plan_dig(&m, &short, &wolves[..10]).unwrap();
     assert!(warm.outcome.f <= cold.outcome.f + 1e-12);
     // A cold start with the same short budget does worse (or no better).

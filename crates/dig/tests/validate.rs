@@ -10,11 +10,11 @@ use autoshovel_dig::validate::{
     simulate_measurement, validate, AlignParams, MeasuredRecord, MeasurementModel, PlannedRecord,
     Validation,
 };
-use autoshovel_dig::{gwo_preset, plan_dig, DigModel, DigSurface, MachineProfile};
+use autoshovel_dig::{gwo_preset, plan_dig, DigModel, DigSearch, DigSurface, MachineProfile};
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
 
-/// The plan of the typical pile (seed 1, the planner's preset), made once.
+/// The plan of the typical pile (seed 1, the paper's GWO setting), made once.
 fn planned() -> &'static PlannedRecord {
     static PLAN: OnceLock<PlannedRecord> = OnceLock::new();
     PLAN.get_or_init(|| {
@@ -24,10 +24,11 @@ fn planned() -> &'static PlannedRecord {
             DigSurface::from_shape(PileShape::Typical, p.dipper.width_m),
         )
         .unwrap();
-        let gwo = GwoParams {
+        let gwo: DigSearch = GwoParams {
             seed: 1,
             ..gwo_preset()
-        };
+        }
+        .into();
         let plan = plan_dig(&model, &gwo, &[]).unwrap();
         PlannedRecord::from_plan("typical plan", "typical", &model, &plan)
     })

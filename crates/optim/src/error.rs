@@ -35,6 +35,14 @@ pub enum OptimError {
         /// The requested population.
         population: usize,
     },
+    /// A CMA-ES step share out of range.
+    #[error("CMA-ES {name} = {value}: expected a share of the box width in (0, 1]")]
+    BadStep {
+        /// `initial_step` or `min_step`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+    },
     /// No iterations requested.
     #[error("iterations is 0: ask for at least one position update")]
     ZeroIterations,

@@ -25,6 +25,9 @@
 //!   initial pack; warm-start wolves replace its first members.
 //! - [`Constraints::FeasibilityRules`] (default, Deb 2000) or
 //!   [`Constraints::Penalty`] ranks the wolves.
+//! - [`cma_es`]: CMA-ES with IPOP restarts under the same ranking rule, on
+//!   the box, within an evaluation budget: it learns a narrow valley's shape
+//!   where GWO and coordinate polls creep.
 //! - [`benchmarks`] holds sphere, Rosenbrock, Rastrigin and Ackley with the
 //!   paper's bounds and published results.
 
@@ -32,12 +35,14 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 pub mod benchmarks;
+mod cma_es;
 mod constraints;
 mod error;
 mod good_point_set;
 mod gwo;
 mod problem;
 
+pub use cma_es::{cma_es, CmaParams, CmaResult};
 pub use constraints::Constraints;
 pub use error::OptimError;
 pub use good_point_set::{good_point_set, smallest_prime_at_least, unit_good_point_set};
