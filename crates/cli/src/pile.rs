@@ -105,7 +105,9 @@ pub fn run(args: &Args) -> Result<()> {
                 other => other,
             };
             let (value, expected) = match flag {
-                "--roll" | "--pitch" | "--fov" => (value.to_degrees(), expected.replace(" [rad]", "")),
+                "--roll" | "--pitch" | "--fov" => {
+                    (value.to_degrees(), expected.replace(" [rad]", ""))
+                }
                 _ => (value, expected.to_string()),
             };
             anyhow::anyhow!(

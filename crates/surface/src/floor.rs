@@ -290,7 +290,12 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
 
 /// Grow a plane hypothesis: refit its inliers and gather them again until they
 /// stop growing. `None` if it tilts past the limit or holds fewer than 3.
-fn grow(points: &[[f64; 3]], mut plane: Plane, threshold: f64, min_nz: f64) -> Option<(Plane, usize)> {
+fn grow(
+    points: &[[f64; 3]],
+    mut plane: Plane,
+    threshold: f64,
+    min_nz: f64,
+) -> Option<(Plane, usize)> {
     let mut inliers = inliers_of(points, &plane, threshold);
     for _ in 0..GROW_ROUNDS {
         let refined = least_squares_plane(points, &inliers)?;
@@ -334,7 +339,11 @@ impl Grid {
         }
         let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
         let cell_m = (area * POINTS_PER_CELL / points.len() as f64).sqrt();
-        let cell_m = if cell_m.is_finite() && cell_m > 0.0 { cell_m } else { 1.0 };
+        let cell_m = if cell_m.is_finite() && cell_m > 0.0 {
+            cell_m
+        } else {
+            1.0
+        };
         Self::with_cell(points, cell_m)
     }
 
@@ -387,7 +396,10 @@ impl Grid {
     }
 
     fn key(cell_m: f64, p: &[f64; 3]) -> (i64, i64) {
-        ((p[0] / cell_m).floor() as i64, (p[1] / cell_m).floor() as i64)
+        (
+            (p[0] / cell_m).floor() as i64,
+            (p[1] / cell_m).floor() as i64,
+        )
     }
 
     /// The plane through a random point and two random points of its 3 × 3

@@ -640,7 +640,11 @@ fn rosette_surface(
             let q = d * s;
             q.z - params.height_at(q.x, q.y)
         };
-        let t_end = if d.z < 0.0 { (floor / d.z).min(reach) } else { reach };
+        let t_end = if d.z < 0.0 {
+            (floor / d.z).min(reach)
+        } else {
+            reach
+        };
         let (mut lo, mut hi) = (0.0, f64::NAN);
         let mut s = step;
         while s < t_end + step {

@@ -74,7 +74,13 @@ fn tilt_within_0_02_deg_for_any_floor_share_from_5_percent() {
         (ScanPattern::Area, 12.0, PileShape::Typical, 3.0, -2.0),
         (ScanPattern::Rosette, 11.0, PileShape::Typical, -1.5, 4.0),
         (ScanPattern::Rosette, 6.0, PileShape::Concave, 2.0, 1.0),
-        (ScanPattern::Area, 15.0, PileShape::ConvexConcave, -4.0, -3.0),
+        (
+            ScanPattern::Area,
+            15.0,
+            PileShape::ConvexConcave,
+            -4.0,
+            -3.0,
+        ),
         (ScanPattern::Rosette, 15.0, PileShape::Convex, 0.5, -6.0),
         (ScanPattern::Area, 4.0, PileShape::Concave, 5.0, 2.5),
     ];
@@ -92,9 +98,8 @@ fn tilt_within_0_02_deg_for_any_floor_share_from_5_percent() {
         let scan = generate_pile(&p).unwrap();
         for share in [0.05, 0.1, 0.25, 0.6] {
             let (thin, got) = with_floor_share(&scan, &p, share, k as u64);
-            let (dr, dp) = error_deg(&thin, &p).unwrap_or_else(|e| {
-                panic!("{pattern} h {height} {shape} floor {got:.3}: {e}")
-            });
+            let (dr, dp) = error_deg(&thin, &p)
+                .unwrap_or_else(|e| panic!("{pattern} h {height} {shape} floor {got:.3}: {e}"));
             rows.push(format!(
                 "{pattern:8} h {height:4} {shape:15} floor {got:.3} ({} pts): roll {dr:+.4}° pitch {dp:+.4}°",
                 thin.len()
@@ -103,7 +108,11 @@ fn tilt_within_0_02_deg_for_any_floor_share_from_5_percent() {
         }
     }
     eprintln!("{}", rows.join("\n"));
-    assert!(worst < TOLERANCE_DEG, "worst {worst:.4}°:\n{}", rows.join("\n"));
+    assert!(
+        worst < TOLERANCE_DEG,
+        "worst {worst:.4}°:\n{}",
+        rows.join("\n")
+    );
 }
 
 /// Sixteen seeds of the hardest case above (a rosette from 15 m, 5 % floor):
@@ -129,11 +138,7 @@ fn seed_spread_at_5_percent_floor() {
         let (thin, got) = with_floor_share(&scan, &p, 0.05, seed);
         let (dr, dp) = error_deg(&thin, &p).unwrap();
         let mask = floor_mask(&thin, &p);
-        let pts: Vec<[f64; 3]> = thin
-            .points
-            .iter()
-            .map(|q| q.map(f64::from))
-            .collect();
+        let pts: Vec<[f64; 3]> = thin.points.iter().map(|q| q.map(f64::from)).collect();
         let idx: Vec<usize> = (0..pts.len()).filter(|&i| mask[i]).collect();
         let truth = autoshovel_surface::least_squares_plane(&pts, &idx).unwrap();
         let (r0, p0) = autoshovel_surface::angles_from_normal(truth.normal).unwrap();
@@ -183,7 +188,10 @@ fn a_scan_without_floor_is_a_clear_error() {
             "{pattern} {shape}: {err}"
         );
         let msg = err.to_string();
-        assert!(msg.contains("mode = \"given\"") && msg.contains("min_floor_share"), "{msg}");
+        assert!(
+            msg.contains("mode = \"given\"") && msg.contains("min_floor_share"),
+            "{msg}"
+        );
     }
 }
 
