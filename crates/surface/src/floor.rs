@@ -428,7 +428,8 @@ impl Grid {
             nalgebra::Vector3::from(points[near[b]]),
         );
         let cross = (q - p).cross(&(r - p));
-        if !(cross.norm() > 1e-9 * (q - p).norm() * (r - p).norm()) {
+        let area = cross.norm();
+        if area.is_nan() || area <= 1e-9 * (q - p).norm() * (r - p).norm() {
             return None;
         }
         Plane::from_point_normal(p.into(), cross.into())
