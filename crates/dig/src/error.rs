@@ -220,6 +220,9 @@ pub enum RecordProblem {
 #[derive(Debug, Clone, PartialEq, thiserror::Error)]
 #[non_exhaustive]
 pub enum PlanDirProblem {
+    /// No `summary.json` in the folder.
+    #[error("no summary.json here; pass the --out folder of `autoshovel plan-dig`")]
+    NoSummary,
     /// `summary.json` is not JSON.
     #[error("summary.json is not valid JSON: {message}")]
     Json {

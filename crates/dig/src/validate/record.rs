@@ -198,6 +198,9 @@ impl PlannedRecord {
             problem,
         };
         let path = dir.join("summary.json");
+        if !path.is_file() {
+            return Err(bad(PlanDirProblem::NoSummary));
+        }
         let text = std::fs::read_to_string(&path).map_err(|source| DigError::RecordRead {
             path: path.clone(),
             source,
@@ -577,5 +580,30 @@ mod tests {
         let _ = std::fs::remove_dir_all(&dir);
         assert_eq!(back.forces, m.forces);
         assert_eq!(back.mass_kg, m.mass_kg);
+    }
+
+    #[test]
+    fn a_folder_that_is_not_one_plan_says_what_to_pass() {
+        let dir = std::env::temp_dir().join(format!("validate-plandir-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let e = PlannedRecord::load(&dir).unwrap_err().to_string();
+        assert!(
+            e.ends_with("no summary.json here; pass the --out folder of `autoshovel plan-dig`"),
+            "{e}"
+        );
+        std::fs::write(dir.join("summary.json"), r#"{"job": "perceive"}"#).unwrap();
+        let e = PlannedRecord::load(&dir).unwrap_err().to_string();
+        assert!(
+            e.contains("summary.json is of job 'perceive', not plan-dig"),
+            "{e}"
+        );
+        std::fs::write(
+            dir.join("summary.json"),
+            r#"{"job": "plan-dig", "surfaces": []}"#,
+        )
+        .unwrap();
+        let e = PlannedRecord::load(&dir).unwrap_err().to_string();
+        assert!(e.contains("--all-surfaces folder"), "{e}");
+        let _ = std::fs::remove_dir_all(&dir);
     }
 }
