@@ -58,9 +58,12 @@ pub fn run(args: &Args) -> Result<()> {
             );
         }
         crate::say!(
-            "  roll {:.3} deg, pitch {:.3} deg, fit degree {}, R² {:.4} (all points {:.4})",
+            "  roll {:.3} deg, pitch {:.3} deg from a floor of {} points ({:.1} % of the scan, RMS {:.1} mm), fit degree {}, R² {:.4} (all points {:.4})",
             s.roll_deg,
             s.pitch_deg,
+            s.floor_points,
+            100.0 * s.floor_share,
+            1e3 * s.floor_rms_m,
             s.fit.degree,
             s.r2,
             s.fit.r2_all_points

@@ -46,7 +46,7 @@ use serde::{Deserialize, Serialize};
 use crate::calibrate::level;
 use crate::error::{Result, SurfaceError};
 use crate::fit::{fit_surface, FitParams, SurfaceFit, Term};
-use crate::floor::{estimate_tilt, TiltParams};
+use crate::floor::{estimate_tilt, TiltEstimate, TiltParams};
 
 /// How the scan is levelled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
@@ -569,6 +569,9 @@ pub struct Perceived {
     pub fit: SurfaceFit,
     /// Floor height in the levelled frame [m].
     pub floor_height_m: f64,
+    /// The floor found in the levelled scan (the plane the pass-through cut
+    /// stands on): its points, those below it, its RMS.
+    pub floor: TiltEstimate,
     /// Roll α used to level [rad].
     pub roll_rad: f64,
     /// Pitch β used to level [rad].
@@ -877,6 +880,7 @@ pub fn perceive_with(
         cloud,
         fit,
         floor_height_m: floor.floor_height_m,
+        floor,
         roll_rad: roll,
         pitch_rad: pitch,
         scale,
@@ -991,6 +995,14 @@ pub struct PerceiveSummary {
     pub pitch_deg: f64,
     /// Floor height, levelled frame [m].
     pub floor_height_m: f64,
+    /// Points on the floor plane (within its inlier band).
+    pub floor_points: usize,
+    /// Their share of the points read.
+    pub floor_share: f64,
+    /// Points more than the below margin under the floor (multipath, ruts).
+    pub points_below_floor: usize,
+    /// RMS distance of the floor points from the plane [m].
+    pub floor_rms_m: f64,
     /// Length scale used.
     pub scale: f64,
     /// Point spacing used [m].
@@ -1025,6 +1037,10 @@ impl PerceiveSummary {
             roll_deg: got.roll_rad.to_degrees(),
             pitch_deg: got.pitch_rad.to_degrees(),
             floor_height_m: got.floor_height_m,
+            floor_points: got.floor.inliers,
+            floor_share: got.floor.inliers as f64 / got.floor.candidates.max(1) as f64,
+            points_below_floor: got.floor.below,
+            floor_rms_m: got.floor.rms_m,
             scale: got.scale,
             spacing_m: got.spacing_m,
             r2: fit.r2,

@@ -212,3 +212,35 @@ fn the_paper_model_levels_too() {
     let (dr, dp) = error_deg(&thin, &p).unwrap();
     assert!(dr.abs().max(dp.abs()) < TOLERANCE_DEG, "{dr} {dp}");
 }
+
+/// `perceive` reports the floor it levelled by: its share of a scan whose
+/// floor share is known.
+#[test]
+fn perceive_reports_the_floor_share() {
+    use autoshovel_surface::perceive::{perceive, PerceiveSummary, PerceptionParams};
+    let p = PileParams {
+        points: 60_000,
+        seed: 50,
+        ..PileParams::default()
+    };
+    let scan = generate_pile(&p).unwrap();
+    let (thin, share) = with_floor_share(&scan, &p, 0.12, 50);
+    let got = perceive(&thin, &PerceptionParams::default()).unwrap();
+    let s = PerceiveSummary::new(
+        std::path::Path::new("thin.pcd"),
+        &PerceptionParams::default(),
+        &got,
+    );
+    // The inlier band (5 cm) also holds the toe fillet's foot and a few
+    // hovering outliers: a little more than the floor itself.
+    assert!(
+        s.floor_share >= share && s.floor_share < share + 0.02,
+        "{} vs {share}",
+        s.floor_share
+    );
+    assert!(
+        s.floor_rms_m > 0.0 && s.floor_rms_m < 0.03,
+        "{}",
+        s.floor_rms_m
+    );
+}
