@@ -299,6 +299,33 @@ mod tests {
     use std::f64::consts::PI;
 
     #[test]
+    fn a_pile_moved_back_is_the_same_profile_shifted() {
+        let p = PileParams {
+            shape: PileShape::Convex,
+            face_height_m: 8.0,
+            ..PileParams::paper_model()
+        };
+        let at_start = DigSurface::from_pile(&p, 0.0, 0.12);
+        let moved = DigSurface::from_pile(&p, 0.03, 0.12);
+        for k in 0..60 {
+            let x = 0.01 * k as f64;
+            assert_relative_eq!(moved.height(x + 0.03), at_start.height(x), epsilon = 1e-9);
+        }
+        // Floor before the toe, the 8 m face (at 1:30) on top.
+        assert_relative_eq!(moved.height(0.02), 0.0, epsilon = 1e-12);
+        assert_relative_eq!(moved.top(), 8.0 / 30.0, epsilon = 1e-9);
+        // The built-in pile is the Fig. 7 model with its toe at the start.
+        let fig7 = PileParams {
+            shape: PileShape::Convex,
+            ..PileParams::paper_model()
+        };
+        assert_eq!(
+            DigSurface::from_shape(PileShape::Convex, 0.12).height(0.2),
+            DigSurface::from_pile(&fig7, 0.0, 0.12).height(0.2)
+        );
+    }
+
+    #[test]
     fn width_average_of_a_plane_is_its_centre_line() {
         let s = DigSurface::from_fn(|x, y| 0.8 * x + 0.3 * y, 0.12, 0.0, 0.5, "plane");
         assert_relative_eq!(s.height(0.2), 0.16, epsilon = 1e-12);
