@@ -491,15 +491,8 @@ pub struct ReplayArgs {
     /// For a CSV: the planned path, as `track` takes a scenario (built-in or TOML).
     #[arg(long)]
     pub path: Option<String>,
-    /// Write summary.json, CSV and plots here.
-    #[arg(long)]
-    pub out: Option<PathBuf>,
-    /// Replace existing files in the output that autoshovel did not write.
-    #[arg(long)]
-    pub force: bool,
-    /// Print the summary JSON alone on stdout.
-    #[arg(long)]
-    pub json: bool,
+    #[command(flatten)]
+    pub output: crate::output::OutputArgs,
 }
 
 /// Runs `replay`.
@@ -532,7 +525,11 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         }
         (replay_mcap(&args.log)?, None)
     };
-    let out = out_dir(args.out.as_deref(), &[Some(args.log.as_path())], args.force)?;
+    let out = out_dir(
+        args.output.out.as_deref(),
+        &[Some(args.log.as_path())],
+        args.output.force,
+    )?;
     let scenario = scenario.unwrap_or_else(|| {
         let mut sc = resolve("straight", Some(autoshovel_track::Noise::Off), 1)
             .expect("a built-in scenario");
@@ -563,7 +560,7 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         autoshovel_figures::track::write(dir, &scenario, &tracking, written)
             .context("writing the replay figures")
     })?;
-    job.report(args.json, |s: &autoshovel_link::replay::ReplaySummary| {
+    job.report(args.output.json, |s: &autoshovel_link::replay::ReplaySummary| {
         let m = &s.metrics;
         crate::say!(
             "replay {} (on {}): max dev {:.3} m, mean dev {:.3} m, final pos err {:.3} m, final heading err {:.2} deg, completed {}",

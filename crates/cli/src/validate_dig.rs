@@ -16,6 +16,7 @@ use autoshovel_dig::validate::{
     simulate_measurement, AlignParams, MeasuredRecord, MeasurementModel, PlannedRecord,
     ValidateSummary,
 };
+use autoshovel_dig::DigError;
 use autoshovel_figures::validate as figures;
 
 /// Arguments of `validate-dig`.
@@ -83,9 +84,9 @@ pub struct Args {
 }
 
 impl Args {
-    /// The measurement model of the `--sim-*` options, checked.
-    fn model(&self) -> Result<MeasurementModel> {
-        let m = MeasurementModel {
+    /// The measurement model of the `--sim-*` options.
+    fn model(&self) -> MeasurementModel {
+        MeasurementModel {
             noise_n: self.sim_noise_n,
             delay_s: self.sim_delay_s,
             time_scale: self.sim_time_scale,
@@ -95,46 +96,53 @@ impl Args {
             sample_period_s: self.sim_period_s,
             seed: self.sim_seed,
             ..MeasurementModel::testbed()
-        };
-        let ok = |v: f64, lo: f64, hi: f64| v.is_finite() && v >= lo && v <= hi;
-        for (name, v, lo, hi) in [
-            ("--sim-noise-n", m.noise_n, 0.0, 1e6),
-            ("--sim-delay-s", m.delay_s, -60.0, 60.0),
-            ("--sim-time-scale", m.time_scale, 0.5, 2.0),
-            ("--sim-gain-hoist", m.gain_hoist, 0.01, 100.0),
-            ("--sim-gain-crowd", m.gain_crowd, 0.01, 100.0),
-            ("--sim-mass-offset-kg", m.mass_offset_kg, -1e6, 1e6),
-            ("--sim-period-s", m.sample_period_s, 1e-4, 1.0),
-        ] {
-            if !ok(v, lo, hi) {
-                bail!("{name} {v} must be between {lo} and {hi}");
-            }
         }
-        Ok(m)
     }
 
-    /// The alignment search of `--max-lag-s` and `--max-stretch-pct`, checked.
-    fn align(&self) -> Result<AlignParams> {
-        if let Some(l) = self.max_lag_s {
-            if !(l.is_finite() && (0.0..=3600.0).contains(&l)) {
-                bail!("--max-lag-s {l} must be between 0 and 3600 s");
-            }
-        }
-        let p = self.max_stretch_pct;
-        if !(p.is_finite() && (0.0..=50.0).contains(&p)) {
-            bail!("--max-stretch-pct {p} must be between 0 and 50");
-        }
-        Ok(AlignParams {
+    /// The alignment search of `--max-lag-s` and `--max-stretch-pct`.
+    fn align(&self) -> AlignParams {
+        AlignParams {
             max_lag_s: self.max_lag_s,
-            max_stretch: p / 100.0,
+            max_stretch: self.max_stretch_pct / 100.0,
             ..AlignParams::default()
-        })
+        }
     }
+}
+
+/// The library names its fields; the user wrote flags.
+fn flag_error(e: DigError) -> anyhow::Error {
+    let DigError::BadParameter {
+        name,
+        value,
+        expected,
+    } = e
+    else {
+        return e.into();
+    };
+    let flag = match name {
+        "MeasurementModel.noise_n" => "--sim-noise-n",
+        "MeasurementModel.delay_s" => "--sim-delay-s",
+        "MeasurementModel.time_scale" => "--sim-time-scale",
+        "MeasurementModel.gain_hoist" => "--sim-gain-hoist",
+        "MeasurementModel.gain_crowd" => "--sim-gain-crowd",
+        "MeasurementModel.mass_offset_kg" => "--sim-mass-offset-kg",
+        "MeasurementModel.sample_period_s" => "--sim-period-s",
+        "AlignParams.max_lag_s" => "--max-lag-s",
+        "AlignParams.max_stretch" => {
+            return anyhow::anyhow!(
+                "--max-stretch-pct {}: expected a percentage in [0, 50]",
+                100.0 * value
+            )
+        }
+        other => other,
+    };
+    anyhow::anyhow!("{flag} {value}: expected {expected}")
 }
 
 /// Runs `validate-dig` as the command line asks.
 pub fn run(args: &Args) -> Result<()> {
-    let params = args.align()?;
+    let params = args.align();
+    params.validate().map_err(flag_error)?;
     let planned = PlannedRecord::load(&args.plan)?;
     let out = crate::output::out_dir(
         args.output.out.as_deref(),
@@ -148,7 +156,7 @@ pub fn run(args: &Args) -> Result<()> {
     )?;
     let measured = match (&args.measured, &args.simulate) {
         (Some(path), _) => MeasuredRecord::load(path)?,
-        (None, Some(path)) => simulate(&planned, &args.model()?, path, args.output.force)?,
+        (None, Some(path)) => simulate(&planned, &args.model(), path, args.output.force)?,
         (None, None) => bail!("give --measured FILE.csv, or --simulate FILE.csv"),
     };
     let job = crate::jobs::validate_dig(&planned, &measured, &params, out.as_ref())?;
@@ -169,7 +177,7 @@ fn simulate(
             path.display()
         );
     }
-    let m = simulate_measurement(planned, model, path);
+    let m = simulate_measurement(planned, model, path).map_err(flag_error)?;
     m.write(path)?;
     Ok(m)
 }

@@ -93,6 +93,16 @@ pub enum DigError {
         /// Why a plan on this pile may fail (e.g. a full-size scan for a scale model).
         hint: Option<String>,
     },
+    /// A setting out of its range (names the field and what it takes).
+    #[error("{name} = {value}: expected {expected}")]
+    BadParameter {
+        /// The field, as `Type.field`.
+        name: &'static str,
+        /// The value given.
+        value: f64,
+        /// The range it takes.
+        expected: &'static str,
+    },
     /// A record file of `validate-dig` (a measured CSV, a plan's
     /// `samples.csv`) could not be read.
     #[error("cannot read {}", .path.display())]

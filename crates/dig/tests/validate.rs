@@ -35,7 +35,7 @@ fn planned() -> &'static PlannedRecord {
 }
 
 fn check(model: &MeasurementModel) -> (MeasuredRecord, Validation) {
-    let m = simulate_measurement(planned(), model, Path::new("simulated.csv"));
+    let m = simulate_measurement(planned(), model, Path::new("simulated.csv")).unwrap();
     let v = validate(planned(), &m, &AlignParams::default()).unwrap();
     (m, v)
 }
@@ -142,7 +142,7 @@ fn a_record_outside_the_lag_window_is_refused_with_the_window() {
         delay_s: 3.0,
         ..MeasurementModel::default()
     };
-    let m = simulate_measurement(planned(), &truth, Path::new("late.csv"));
+    let m = simulate_measurement(planned(), &truth, Path::new("late.csv")).unwrap();
     let params = AlignParams {
         max_lag_s: Some(0.5),
         max_stretch: 0.0,
@@ -166,4 +166,29 @@ fn a_record_outside_the_lag_window_is_refused_with_the_window() {
     assert!(e.contains("±0.5 s"), "{e}");
     // The uncut record aligns within the default window.
     assert!(validate(planned(), &m, &AlignParams::default()).is_ok());
+}
+
+#[test]
+fn settings_out_of_range_are_named() {
+    let bad = MeasurementModel {
+        sample_period_s: 0.0,
+        ..MeasurementModel::testbed()
+    };
+    let e = simulate_measurement(planned(), &bad, Path::new("m.csv")).unwrap_err();
+    assert!(
+        e.to_string()
+            .starts_with("MeasurementModel.sample_period_s = 0"),
+        "{e}"
+    );
+    let m =
+        simulate_measurement(planned(), &MeasurementModel::testbed(), Path::new("m.csv")).unwrap();
+    let params = AlignParams {
+        max_stretch: 0.7,
+        ..AlignParams::default()
+    };
+    let e = validate(planned(), &m, &params).unwrap_err();
+    assert!(
+        e.to_string().starts_with("AlignParams.max_stretch = 0.7"),
+        "{e}"
+    );
 }

@@ -40,7 +40,7 @@ use serde::{Deserialize, Serialize};
 
 use crate::constraints::Constraints;
 use crate::error::OptimError;
-use crate::problem::{Evaluation, Problem};
+use crate::problem::{check_bounds, check_start, Evaluation, Problem};
 
 /// Parameters of [`cma_es`].
 #[derive(Clone, Copy, Debug, PartialEq, Serialize, Deserialize)]
@@ -167,7 +167,9 @@ pub fn cma_es<P: Problem + ?Sized>(
             for _ in 0..take {
                 let z = DVector::from_iterator(n, (0..n).map(|_| StandardNormal.sample(&mut rng)));
                 let x = (&run.mean + run.sigma * (&run.bd * z)).map(|v| v.clamp(0.0, 1.0));
-                let e = check(problem.evaluate(&from_unit(&x)), used, &from_unit(&x))?;
+                let at = from_unit(&x);
+                let e = problem.evaluate(&at);
+                e.check(used, 0, || at)?;
                 used += 1;
                 offspring.push((x, e));
             }
@@ -320,48 +322,9 @@ impl Run {
     }
 }
 
-fn check(e: Evaluation, used: usize, x: &[f64]) -> Result<Evaluation, OptimError> {
-    if e.objective.is_nan() {
-        return Err(OptimError::NanObjective {
-            iteration: used,
-            wolf: 0,
-            x: x.to_vec(),
-        });
-    }
-    if e.violation.is_nan() || e.violation < 0.0 {
-        return Err(OptimError::BadViolation {
-            iteration: used,
-            wolf: 0,
-            violation: e.violation,
-            x: x.to_vec(),
-        });
-    }
-    Ok(e)
-}
-
 fn validate(bounds: &[(f64, f64)], start: &[f64], params: &CmaParams) -> Result<(), OptimError> {
-    if bounds.is_empty() {
-        return Err(OptimError::EmptyBounds);
-    }
-    for (dim, &(lower, upper)) in bounds.iter().enumerate() {
-        if !(lower.is_finite() && upper.is_finite() && lower < upper) {
-            return Err(OptimError::BadBounds { dim, lower, upper });
-        }
-    }
-    if start.len() != bounds.len() {
-        return Err(OptimError::WarmStartDimension {
-            wolf: 0,
-            expected: bounds.len(),
-            got: start.len(),
-        });
-    }
-    if let Some((dim, &value)) = start.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-        return Err(OptimError::WarmStartNotFinite {
-            wolf: 0,
-            dim,
-            value,
-        });
-    }
+    check_bounds(bounds)?;
+    check_start(0, start, bounds.len())?;
     if params.evaluations == 0 {
         return Err(OptimError::ZeroIterations);
     }

@@ -17,7 +17,7 @@ use serde::{Deserialize, Serialize};
 use crate::constraints::Constraints;
 use crate::error::OptimError;
 use crate::good_point_set::good_point_set;
-use crate::problem::{Evaluation, Problem};
+use crate::problem::{check_bounds, check_start, Evaluation, Problem};
 
 /// How the initial pack is placed.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
@@ -310,14 +310,7 @@ fn validate(
     params: &GwoParams,
     warm_start: &[Vec<f64>],
 ) -> Result<(), OptimError> {
-    if bounds.is_empty() {
-        return Err(OptimError::EmptyBounds);
-    }
-    for (dim, &(lower, upper)) in bounds.iter().enumerate() {
-        if !(lower.is_finite() && upper.is_finite() && lower < upper) {
-            return Err(OptimError::BadBounds { dim, lower, upper });
-        }
-    }
+    check_bounds(bounds)?;
     if params.population < 4 {
         return Err(OptimError::PopulationTooSmall {
             population: params.population,
@@ -338,16 +331,7 @@ fn validate(
         });
     }
     for (wolf, w) in warm_start.iter().enumerate() {
-        if w.len() != bounds.len() {
-            return Err(OptimError::WarmStartDimension {
-                wolf,
-                expected: bounds.len(),
-                got: w.len(),
-            });
-        }
-        if let Some((dim, &value)) = w.iter().enumerate().find(|(_, v)| !v.is_finite()) {
-            return Err(OptimError::WarmStartNotFinite { wolf, dim, value });
-        }
+        check_start(wolf, w, bounds.len())?;
     }
     Ok(())
 }
@@ -374,22 +358,7 @@ fn evaluate<P: Problem + ?Sized>(
         }
     }
     for (wolf, e) in evals.iter().enumerate() {
-        let at = || x[wolf * d..(wolf + 1) * d].to_vec();
-        if e.objective.is_nan() {
-            return Err(OptimError::NanObjective {
-                iteration,
-                wolf,
-                x: at(),
-            });
-        }
-        if e.violation.is_nan() || e.violation < 0.0 {
-            return Err(OptimError::BadViolation {
-                iteration,
-                wolf,
-                violation: e.violation,
-                x: at(),
-            });
-        }
+        e.check(iteration, wolf, || x[wolf * d..(wolf + 1) * d].to_vec())?;
     }
     Ok(())
 }

@@ -10,6 +10,8 @@
 
 use serde::Serialize;
 
+use crate::error::OptimError;
+
 /// A box-bounded minimisation problem.
 ///
 /// `Sync` so that [`crate::minimize`] can evaluate the wolves on several
@@ -92,5 +94,62 @@ where
 
     fn evaluate(&self, x: &[f64]) -> Evaluation {
         (self.f)(x)
+    }
+}
+
+/// Every bound pair finite with lower < upper, and at least one.
+pub(crate) fn check_bounds(bounds: &[(f64, f64)]) -> Result<(), OptimError> {
+    if bounds.is_empty() {
+        return Err(OptimError::EmptyBounds);
+    }
+    for (dim, &(lower, upper)) in bounds.iter().enumerate() {
+        if !(lower.is_finite() && upper.is_finite() && lower < upper) {
+            return Err(OptimError::BadBounds { dim, lower, upper });
+        }
+    }
+    Ok(())
+}
+
+/// A starting point (warm-start wolf `wolf`) of the problem's dimension,
+/// every coordinate finite.
+pub(crate) fn check_start(wolf: usize, x: &[f64], dims: usize) -> Result<(), OptimError> {
+    if x.len() != dims {
+        return Err(OptimError::WarmStartDimension {
+            wolf,
+            expected: dims,
+            got: x.len(),
+        });
+    }
+    if let Some((dim, &value)) = x.iter().enumerate().find(|(_, v)| !v.is_finite()) {
+        return Err(OptimError::WarmStartNotFinite { wolf, dim, value });
+    }
+    Ok(())
+}
+
+impl Evaluation {
+    /// A value the optimisers can rank: the objective not NaN, the violation
+    /// not NaN nor negative; `x` names the point in the error.
+    pub(crate) fn check(
+        &self,
+        iteration: usize,
+        wolf: usize,
+        x: impl FnOnce() -> Vec<f64>,
+    ) -> Result<(), OptimError> {
+        if self.objective.is_nan() {
+            return Err(OptimError::NanObjective {
+                iteration,
+                wolf,
+                x: x(),
+            });
+        }
+        if self.violation.is_nan() || self.violation < 0.0 {
+            return Err(OptimError::BadViolation {
+                iteration,
+                wolf,
+                violation: self.violation,
+                x: x(),
+            });
+        }
+        Ok(())
     }
 }

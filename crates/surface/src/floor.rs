@@ -43,7 +43,7 @@ use rand_chacha::ChaCha8Rng;
 
 use crate::calibrate::angles_from_normal;
 use crate::error::{Result, SurfaceError};
-use crate::ransac::{least_squares_plane, Plane, RansacParams};
+use crate::ransac::{inliers_of, least_squares_plane, Plane, RansacParams};
 
 /// Largest tilt of the floor in the sensor's frame by default [deg]: a
 /// sensor is mounted within a few degrees of level, and a muck pile's face
@@ -310,15 +310,6 @@ fn grow(
         inliers = next;
     }
     (inliers.len() >= 3).then_some((plane, inliers.len()))
-}
-
-fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> Vec<usize> {
-    points
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| plane.signed_distance(**p).abs() <= threshold)
-        .map(|(i, _)| i)
-        .collect()
 }
 
 /// The points bucketed on an x–y grid, for drawing triples from one

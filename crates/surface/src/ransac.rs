@@ -288,7 +288,8 @@ pub fn least_squares_plane(points: &[[f64; 3]], indices: &[usize]) -> Option<Pla
     )
 }
 
-fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> Vec<usize> {
+/// Indices of the points within `threshold` of `plane`, ascending.
+pub(crate) fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> Vec<usize> {
     points
         .iter()
         .enumerate()

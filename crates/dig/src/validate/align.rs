@@ -48,6 +48,39 @@ impl Default for AlignParams {
     }
 }
 
+impl AlignParams {
+    /// Check the ranges once, at the edge.
+    pub fn validate(&self) -> Result<()> {
+        let bad = |name, value, expected| {
+            Err(DigError::BadParameter {
+                name,
+                value,
+                expected,
+            })
+        };
+        if let Some(l) = self.max_lag_s {
+            if !(l.is_finite() && (0.0..=3600.0).contains(&l)) {
+                return bad("AlignParams.max_lag_s", l, "a time in [0, 3600] s");
+            }
+        }
+        if !(self.max_stretch.is_finite() && (0.0..=0.5).contains(&self.max_stretch)) {
+            return bad(
+                "AlignParams.max_stretch",
+                self.max_stretch,
+                "a share in [0, 0.5]",
+            );
+        }
+        if !(self.min_overlap > 0.0 && self.min_overlap <= 1.0) {
+            return bad(
+                "AlignParams.min_overlap",
+                self.min_overlap,
+                "a share in (0, 1]",
+            );
+        }
+        Ok(())
+    }
+}
+
 /// Step of the time-scale grid.
 const STRETCH_STEP: f64 = 0.0025;
 
@@ -179,8 +212,9 @@ pub fn align(
     source: &std::path::Path,
     params: &AlignParams,
 ) -> Result<Alignment> {
-    let max_lag_s = params.max_lag_s.unwrap_or(0.5 * td_s).max(0.0);
-    let max_stretch = params.max_stretch.clamp(0.0, 0.5);
+    params.validate()?;
+    let max_lag_s = params.max_lag_s.unwrap_or(0.5 * td_s);
+    let max_stretch = params.max_stretch;
     let h = planned
         .median_step_s()
         .min(measured.median_step_s())
@@ -200,7 +234,7 @@ pub fn align(
         t,
     };
     let search = Search {
-        min_points: (params.min_overlap.clamp(0.0, 1.0) * (n_g + 1) as f64).ceil() as usize,
+        min_points: (params.min_overlap * (n_g + 1) as f64).ceil() as usize,
         grid,
         measured,
     };

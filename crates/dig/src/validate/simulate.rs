@@ -10,6 +10,7 @@ use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 
+use crate::error::{DigError, Result};
 use crate::validate::align::interpolate;
 use crate::validate::record::{ForceRecord, MeasuredRecord, PlannedRecord};
 
@@ -69,18 +70,90 @@ impl MeasurementModel {
             ..Self::default()
         }
     }
+
+    /// Check the ranges once, at the edge.
+    pub fn validate(&self) -> Result<()> {
+        for (name, value, lo, hi, expected) in [
+            (
+                "MeasurementModel.noise_n",
+                self.noise_n,
+                0.0,
+                1e6,
+                "a force in [0, 1e6] N",
+            ),
+            (
+                "MeasurementModel.delay_s",
+                self.delay_s,
+                -60.0,
+                60.0,
+                "a time in [-60, 60] s",
+            ),
+            (
+                "MeasurementModel.time_scale",
+                self.time_scale,
+                0.5,
+                2.0,
+                "a ratio in [0.5, 2]",
+            ),
+            (
+                "MeasurementModel.gain_hoist",
+                self.gain_hoist,
+                0.01,
+                100.0,
+                "a gain in [0.01, 100]",
+            ),
+            (
+                "MeasurementModel.gain_crowd",
+                self.gain_crowd,
+                0.01,
+                100.0,
+                "a gain in [0.01, 100]",
+            ),
+            (
+                "MeasurementModel.mass_offset_kg",
+                self.mass_offset_kg,
+                -1e6,
+                1e6,
+                "a mass in [-1e6, 1e6] kg",
+            ),
+            (
+                "MeasurementModel.sample_period_s",
+                self.sample_period_s,
+                1e-4,
+                1.0,
+                "a period in [1e-4, 1] s",
+            ),
+            (
+                "MeasurementModel.tail_s",
+                self.tail_s,
+                0.0,
+                3600.0,
+                "a time in [0, 3600] s",
+            ),
+        ] {
+            if !(value.is_finite() && value >= lo && value <= hi) {
+                return Err(DigError::BadParameter {
+                    name,
+                    value,
+                    expected,
+                });
+            }
+        }
+        Ok(())
+    }
 }
 
 /// The record the logger of `model` would write for `planned`, named
-/// `source`.
+/// `source`; a model out of range ([`MeasurementModel::validate`]) is an error.
 pub fn simulate_measurement(
     planned: &PlannedRecord,
     model: &MeasurementModel,
     source: &std::path::Path,
-) -> MeasuredRecord {
+) -> Result<MeasuredRecord> {
+    model.validate()?;
     let p = &planned.forces;
-    let period = model.sample_period_s.max(1e-6);
-    let end = model.delay_s.max(0.0) + model.time_scale * planned.td_s + model.tail_s.max(0.0);
+    let period = model.sample_period_s;
+    let end = model.delay_s.max(0.0) + model.time_scale * planned.td_s + model.tail_s;
     let n = (end / period).floor() as usize + 1;
     let t_s: Vec<f64> = (0..n).map(|i| i as f64 * period).collect();
     // Plan time at each logger time, clamped to the dig: at rest outside it.
@@ -89,7 +162,7 @@ pub fn simulate_measurement(
         .map(|&t| ((t - model.delay_s) / model.time_scale).clamp(0.0, planned.td_s))
         .collect();
     let mut rng = ChaCha8Rng::seed_from_u64(model.seed);
-    let noise = Normal::new(0.0, model.noise_n.max(0.0)).unwrap_or(Normal::new(0.0, 0.0).unwrap());
+    let noise = Normal::new(0.0, model.noise_n).expect("a validated σ is finite and ≥ 0");
     let mut sensor = |v: &[f64], gain: f64| -> Vec<f64> {
         t_plan
             .iter()
@@ -102,7 +175,7 @@ pub fn simulate_measurement(
         v.as_ref()
             .map(|v| t_plan.iter().map(|&t| interpolate(&p.t_s, v, t)).collect())
     };
-    MeasuredRecord {
+    Ok(MeasuredRecord {
         source: source.to_path_buf(),
         forces: ForceRecord {
             hoist_force_n,
@@ -112,5 +185,5 @@ pub fn simulate_measurement(
             t_s,
         },
         mass_kg: Some(planned.m_dig_kg + model.mass_offset_kg),
-    }
+    })
 }
