@@ -290,7 +290,7 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
     let sub = "plan-dig-typical";
     let dir = sub_out(sub);
     let typical = autoshovel_dig::paper_row(autoshovel_surface::PileShape::Typical);
-    let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile);
+    let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile)?;
     let job = crate::jobs::plan_dig(&pile, &setup, Some(&dir))?;
     let key = "plan-dig typical";
     if !json_only {

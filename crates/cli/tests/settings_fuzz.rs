@@ -254,7 +254,7 @@ proptest! {
         let text = damage(autoshovel_dig::profile::SCALE_MODEL_TOML, &e);
         holds("rope-shovel profile", &text, || {
             let p = MachineProfile::from_toml(&text, "p.toml").map_err(|e| e.to_string())?;
-            let pile = Pile::shape(PileShape::Typical, &p);
+            let pile = Pile::shape(PileShape::Typical, &p).map_err(|e| e.to_string())?;
             let _ = plan_pile(&pile, &small_dig_setup(p));
             Ok(())
         });
@@ -304,7 +304,8 @@ proptest! {
             let wolves = read_pack(&path).map_err(|e| e.to_string())?;
             let mut setup = small_dig_setup(MachineProfile::scale_model());
             setup.warm_start = Some(WarmStart { file: path.clone(), wolves });
-            let _ = plan_pile(&Pile::shape(PileShape::Typical, &setup.profile), &setup);
+            let pile = Pile::shape(PileShape::Typical, &setup.profile).map_err(|e| e.to_string())?;
+            let _ = plan_pile(&pile, &setup);
             Ok(())
         });
     }

@@ -1,11 +1,11 @@
-//! Plan the four piles of the rope-shovel paper's Tables 4–5 and print our
-//! plans beside the paper's; asserts that every plan is feasible, fills the
+//! Plan the four piles of the rope-shovel paper's Tables 4–5 (rebuilt from
+//! those tables, `paper_pile`) and print our plans beside the paper's; asserts that every plan is feasible, fills the
 //! dipper 90–110 % in 9–15 s and digs within 10 % of the paper's mass.
 //!
 //! `cargo run --release -p autoshovel-dig --example table5`
 
 use autoshovel_dig::{
-    plan_dig, search_preset, DigModel, DigSearch, DigSurface, MachineProfile, PAPER_TABLES_4_5,
+    paper_pile, plan_dig, search_preset, DigModel, DigSearch, MachineProfile, PAPER_TABLES_4_5,
 };
 use autoshovel_optim::GwoParams;
 
@@ -21,7 +21,9 @@ fn main() {
             row.m_dig_kg,
             row.fill_pct,
         );
-        let surface = DigSurface::from_shape(shape, profile.dipper.width_m);
+        let surface = paper_pile(&profile, shape)
+            .expect("Table 4's decision fills the dipper on a pile 2-60 cm high")
+            .surface(profile.dipper.width_m);
         let model = DigModel::new(&profile, surface).expect("the scale model reaches the pile");
         let preset = search_preset();
         let gwo = DigSearch {

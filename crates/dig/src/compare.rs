@@ -40,6 +40,8 @@ pub struct SurfaceComparison {
     pub paper: PaperRow,
     /// The paper's plan on our model.
     pub paper_plan_on_this_model: PaperPlanCheck,
+    /// The pile, rebuilt from Tables 4–5 ([`crate::paper::paper_pile`]).
+    pub rebuilt_pile: Option<crate::paper::PaperPile>,
     /// (ours − paper) / paper of m_dig (none without a plan).
     pub m_dig_rel_diff: Option<f64>,
     /// (ours − paper) / paper of f (none without a plan).
@@ -123,7 +125,7 @@ pub fn all_surfaces(
     let mut surfaces = Vec::new();
     let mut piles = Vec::new();
     for paper in &PAPER_TABLES_4_5 {
-        let pile = Pile::shape(paper.shape, &setup.profile);
+        let pile = Pile::shape(paper.shape, &setup.profile)?;
         let planned = plan_pile(&pile, setup)?;
         let model = DigModel::new(&setup.profile, pile.surface.clone())?;
         let theirs = model.evaluate(&paper.decision());
@@ -139,6 +141,7 @@ pub fn all_surfaces(
             f_rel_diff: rel(ours.map(|p| p.f), paper.f),
             plan,
             paper: *paper,
+            rebuilt_pile: pile.rebuilt.clone(),
             paper_plan_on_this_model: PaperPlanCheck {
                 f: theirs.f,
                 m_dig_kg: theirs.m_dig_kg,

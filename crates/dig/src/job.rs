@@ -34,7 +34,7 @@ pub struct DigSetup {
     /// Optimiser settings ([`search_preset`]: the paper's 50 wolves, 100
     /// iterations).
     pub gwo: GwoParams,
-    /// Evaluations of the CMA-ES polish after GWO (default 0: none).
+    /// Evaluations of the CMA-ES polish after GWO ([`search_preset`]: 20 000).
     pub polish_evaluations: usize,
     /// Search coordinates.
     pub search: SearchSpace,
@@ -108,17 +108,23 @@ pub struct Pile {
     pub scan: Option<ScanSource>,
     /// Why a plan on this pile may fail; added to its errors.
     pub hint: Option<String>,
+    /// For a pile of Fig. 7, how it was rebuilt from Tables 4–5.
+    pub rebuilt: Option<crate::paper::PaperPile>,
 }
 
 impl Pile {
-    /// The noiseless synthetic pile of `shape` (Fig. 7) at the 1:30 scale.
-    pub fn shape(shape: PileShape, profile: &MachineProfile) -> Self {
-        Self {
-            surface: DigSurface::from_shape(shape, profile.dipper.width_m),
+    /// The pile `shape` of Fig. 7 rebuilt from Tables 4–5 for the dipper of
+    /// `profile` ([`crate::paper::paper_pile`]): the face height at which
+    /// Table 4's decision digs Table 5's fill, toe at the dig start.
+    pub fn shape(shape: PileShape, profile: &MachineProfile) -> Result<Self> {
+        let rebuilt = crate::paper::paper_pile(profile, shape)?;
+        Ok(Self {
+            surface: rebuilt.surface(profile.dipper.width_m),
             name: shape.name().to_string(),
             scan: None,
             hint: None,
-        }
+            rebuilt: Some(rebuilt),
+        })
     }
 
     /// The scanned pile `path` as perception saw it (`got`,
@@ -136,6 +142,7 @@ impl Pile {
                 perception,
             }),
             hint: cut.hint,
+            rebuilt: None,
         })
     }
 }

@@ -46,7 +46,7 @@ pub use job::{
 };
 pub use kinematics::{Joints, RopeShovel};
 pub use pack::{read_pack, write_pack, PACK_COLUMNS};
-pub use paper::{paper_row, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
+pub use paper::{paper_pile, paper_row, PaperPile, PaperRow, CALIBRATION_PILE, PAPER_TABLES_4_5};
 pub use plan::{
     gwo_preset, plan_dig, search_preset, Bound, ConstraintLimit, DigModel, DigOutcome, DigPlan,
     DigSample, DigSearch, SearchSpace, CONSTRAINT_NAMES, CONSTRAINT_UNITS, SAMPLE_COLUMNS,

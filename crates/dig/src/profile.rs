@@ -57,7 +57,8 @@ pub struct GeometrySpec {
     pub pile_angle_deg: f64,
     /// β: boom angle to the horizontal [deg].
     pub boom_angle_deg: f64,
-    /// δ1: tilt of the tooth back face from the handle normal [deg].
+    /// δ1: tilt of the tooth back face from the normal to the tooth line OD
+    /// [deg] (so δ1 + δ2 from the handle normal; docs/dig.md).
     pub dipper_pitch_deg: f64,
     /// δ2: angle at O between the handle axis and OD [deg].
     pub tip_angle_deg: f64,
@@ -454,6 +455,7 @@ impl MachineProfile {
             boom_foot,
             sheave_top_height: sheave[1] + g.sheave_radius_m,
             dipper_pitch: g.dipper_pitch_deg.to_radians(),
+            back_face_tilt: (g.dipper_pitch_deg + g.tip_angle_deg).to_radians(),
             handle_length: self.handle.length_m,
         })
     }
@@ -483,6 +485,10 @@ pub struct Geometry {
     pub sheave_top_height: f64,
     /// δ1.
     pub dipper_pitch: f64,
+    /// Tilt of the tooth back face from the handle normal, δ1 + δ2: δ1 is
+    /// read from the tooth line OD, which is δ2 from the handle axis
+    /// (docs/dig.md, "Our reading of Table 1").
+    pub back_face_tilt: f64,
     /// L_dg of c17: the handle length, greatest extension d = d₂ + d₂₀.
     pub handle_length: f64,
 }
@@ -510,7 +516,7 @@ pub(crate) mod tests {
 
     #[test]
     fn the_embedded_profile_gives_the_documented_derived_geometry() {
-        assert_relative_eq!(MachineProfile::scale_model().geometry().l1, -0.12);
+        assert_relative_eq!(MachineProfile::scale_model().geometry().l1, -0.0875);
         let g = retracted_start().geometry();
         assert_relative_eq!(g.l3, 0.2558 * 20.43f64.to_radians().sin(), epsilon = 1e-12);
         assert_relative_eq!(g.l3, 0.08929, epsilon = 1e-4);
@@ -585,13 +591,13 @@ pub(crate) mod tests {
     #[test]
     fn a_saddle_too_high_to_reach_the_floor_needs_a_toe_distance() {
         let text = with("saddle_height_m = 0.2473", "saddle_height_m = 0.3");
-        let no_toe = text.replacen("toe_distance_m = 0.12", "", 1);
+        let no_toe = text.replacen("toe_distance_m = 0.0875", "", 1);
         let err = MachineProfile::from_toml(&no_toe, "p.toml")
             .unwrap_err()
             .to_string();
         assert!(err.contains("toe_distance_m"), "{err}");
         let p = MachineProfile::from_toml(&text, "p.toml").unwrap();
-        assert_relative_eq!(p.geometry().l1, -0.12);
+        assert_relative_eq!(p.geometry().l1, -0.0875);
     }
 
     #[test]

@@ -2,15 +2,77 @@
 //! refusals.
 
 use autoshovel_dig::{
-    plan_dig, search_preset, DigError, DigModel, DigSearch, DigSurface, MachineProfile,
-    SearchSpace, PAPER_TABLES_4_5,
+    paper_pile, plan_dig, search_preset, DigError, DigModel, DigSearch, DigSurface, MachineProfile,
+    SearchSpace, CONSTRAINT_NAMES, PAPER_TABLES_4_5,
 };
 use autoshovel_optim::GwoParams;
 use autoshovel_surface::PileShape;
 
-fn model(shape: PileShape) -> DigModel {
+/// The pile `shape` of Fig. 7 rebuilt from Tables 4–5 for the built-in profile.
+fn paper_surface(shape: PileShape) -> DigSurface {
     let p = MachineProfile::scale_model();
-    DigModel::new(&p, DigSurface::from_shape(shape, p.dipper.width_m)).unwrap()
+    paper_pile(&p, shape).unwrap().surface(p.dipper.width_m)
+}
+
+fn model(shape: PileShape) -> DigModel {
+    DigModel::new(&MachineProfile::scale_model(), paper_surface(shape)).unwrap()
+}
+
+#[test]
+fn the_rebuilt_piles_give_table_4_its_fills_and_our_reading_accepts_its_paths() {
+    // The inverse problem of the rebuilt piles: Table 4's decision digs
+    // Table 5's fill on each. Then our reading of what the paper leaves out
+    // (back face δ₁ from the tooth line, H_kk, the placement) must accept
+    // the paper's own paths: every constraint that depends on the geometry
+    // alone, not on the resistance model we calibrated, holds on them.
+    let p = MachineProfile::scale_model();
+    let geometric = [
+        "c1_fill_min",
+        "c2_fill_max",
+        "c3_time_min",
+        "c4_time_max",
+        "c5_back_angle_min",
+        "c6_back_angle_max",
+        "c7_hoist_speed_positive",
+        "c9_crowd_speed_positive",
+        "c15_leaves_surface",
+        "c16_hopper_clearance",
+        "c17_handle_stroke",
+        "c18_sheave_height",
+    ];
+    let mut heights = Vec::new();
+    for row in &PAPER_TABLES_4_5 {
+        let pile = paper_pile(&p, row.shape).unwrap();
+        assert!(
+            (pile.fill_factor - row.fill_factor()).abs() < 1e-4,
+            "{:?}: fill {} vs {}",
+            row.shape,
+            pile.fill_factor,
+            row.fill_factor()
+        );
+        let o = model(row.shape).evaluate(&row.decision());
+        assert!(
+            (o.m_dig_kg / row.m_dig_kg - 1.0).abs() < 1e-3,
+            "{:?}",
+            row.shape
+        );
+        assert!(o.reachable, "{:?}", row.shape);
+        for (i, name) in CONSTRAINT_NAMES.iter().enumerate() {
+            if geometric.contains(name) {
+                assert!(
+                    o.constraints[i] <= 0.0,
+                    "{:?}: {name} = {}",
+                    row.shape,
+                    o.constraints[i]
+                );
+            }
+        }
+        heights.push(pile.face_height_m);
+    }
+    // The typical, convex and convex–concave piles stand within 1 cm of
+    // each other; the concave one is lower (docs/dig.md).
+    assert!((heights[0] - heights[2]).abs() < 0.01 && (heights[0] - heights[3]).abs() < 0.01);
+    assert!(heights[1] < heights[0]);
 }
 
 /// The planner's default search at `seed`.
@@ -186,10 +248,18 @@ fn a_pile_too_small_to_fill_the_dipper_is_refused_before_planning() {
 }
 
 #[test]
+fn a_dipper_no_rebuilt_pile_can_fill_is_an_error_naming_it() {
+    let mut p = MachineProfile::scale_model();
+    p.dipper.capacity_m3 = 0.05;
+    let err = paper_pile(&p, PileShape::Convex).unwrap_err().to_string();
+    assert!(err.contains("convex") && err.contains("0.05 m³"), "{err}");
+}
+
+#[test]
 fn a_toe_out_of_reach_is_refused() {
     let mut p = MachineProfile::scale_model();
     p.geometry.toe_distance_m = Some(0.8);
-    let err = DigModel::new(&p, DigSurface::from_shape(PileShape::Typical, 0.12))
+    let err = DigModel::new(&p, paper_surface(PileShape::Typical))
         .unwrap_err()
         .to_string();
     assert!(err.contains("out of the dipper's reach"), "{err}");
@@ -199,7 +269,7 @@ fn a_toe_out_of_reach_is_refused() {
 fn motors_too_weak_for_the_pile_give_an_error_naming_the_binding_constraints() {
     let mut p = MachineProfile::scale_model();
     p.limits.hoist_force_max_n = 60.0;
-    let m = DigModel::new(&p, DigSurface::from_shape(PileShape::Typical, 0.12)).unwrap();
+    let m = DigModel::new(&p, paper_surface(PileShape::Typical)).unwrap();
     let err = plan_dig(&m, &gwo(1), &[]).unwrap_err().to_string();
     assert!(err.contains("no feasible dig plan"), "{err}");
     assert!(
@@ -214,7 +284,7 @@ fn calibration_finds_k_f_and_epsilon_for_the_typical_pile_from_a_wrong_start() {
     let mut p = MachineProfile::scale_model();
     p.material.cutting_resistance_pa = 24_000.0;
     p.material.fill_resistance_ratio = 3.0;
-    let surface = DigSurface::from_shape(PileShape::Typical, p.dipper.width_m);
+    let surface = paper_surface(PileShape::Typical);
     let target = CalibrationTarget::table5_typical();
     let c = calibrate(&p, &surface, target, &gwo(1)).unwrap();
     assert!((c.f1_j_per_kg / target.f1_j_per_kg - 1.0).abs() < 0.01);
