@@ -4,7 +4,7 @@
 //! pile) or `autoshovel_dig::all_surfaces` (the four piles beside Tables
 //! 4–5), written by `autoshovel_figures::dig`.
 //!
-//! `--out DIR` gets `summary.json`, `samples.csv`, `convergence.csv`,
+//! `--out DIR` gets `summary.json`, `samples.csv`, `convergence.csv`, `polish.csv` (the CMA-ES polish, when one ran),
 //! `pack.csv`, `surface.csv` and the plots `dig_path`, `speeds`, `forces`
 //! and `convergence`; `--all-surfaces` one subfolder per pile, `table.csv`
 //! and `paths`. A scan (`--cloud`) is cut into a dig profile by

@@ -90,8 +90,8 @@ fn check_plan(s: &Value, profile: &str) {
     assert!(s["seed"].is_u64() && s["search_space"].is_string(), "{s:#}");
     assert_eq!(
         s["evaluations"],
-        50 * 101,
-        "50 wolves, 100 iterations + the first pack"
+        50 * 101 + 20_000,
+        "50 wolves, 100 iterations + the first pack, then a CMA-ES polish of 20 000"
     );
     let fill = f64_field(s, "fill_factor");
     let td = f64_field(s, "td_s");
@@ -274,6 +274,7 @@ fn printed_profile_round_trips_and_out_writes_every_file() {
             "summary.json",
             "samples.csv",
             "convergence.csv",
+            "polish.csv",
             "surface.csv",
             "dig_path.svg",
             "dig_path.png",
@@ -329,22 +330,32 @@ fn printed_profile_round_trips_and_out_writes_every_file() {
     let c11 = f64_field(&s["constraints"]["c11_hoist_force_max"], "measured");
     assert!((fh - c11).abs() < 1e-9 * c11.abs(), "{fh} vs {c11}");
     // convergence.csv: the first pack and one row per iteration, best never worse.
-    let conv = std::fs::read_to_string(out.join("convergence.csv")).unwrap();
-    let best: Vec<(f64, f64)> = conv
-        .lines()
-        .skip(1)
-        .map(|l| {
-            let v: Vec<f64> = l.split(',').map(|x| x.parse().unwrap()).collect();
-            (v[1], v[2])
-        })
+    let read_rows = |name: &str| -> Vec<Vec<f64>> {
+        std::fs::read_to_string(out.join(name))
+            .unwrap()
+            .lines()
+            .skip(1)
+            .map(|l| l.split(',').map(|x| x.parse().unwrap()).collect())
+            .collect()
+    };
+    let best: Vec<(f64, f64)> = read_rows("convergence.csv")
+        .iter()
+        .map(|v| (v[1], v[2]))
         .collect();
     assert_eq!(best.len(), 101);
-    let (f_end, viol_end) = best[best.len() - 1];
+    let (f_gwo, viol_end) = best[best.len() - 1];
     assert_eq!(viol_end, 0.0);
-    assert!((f_end - f64_field(&s, "f")).abs() < 1e-9, "{f_end}");
     for w in best.windows(2).filter(|w| w[0].1 == 0.0) {
         assert!(w[1].1 == 0.0 && w[1].0 <= w[0].0, "{w:?}");
     }
+    // polish.csv: the CMA-ES polish after GWO's 5050 evaluations, ending on
+    // the plan's f, never worse than GWO's.
+    let polish = read_rows("polish.csv");
+    let last = polish.last().unwrap();
+    assert!(polish[0][0] > 5050.0 && last[0] <= 25_050.0, "{last:?}");
+    assert_eq!(last[3], 0.0);
+    assert!((last[2] - f64_field(&s, "f")).abs() < 1e-9, "{last:?}");
+    assert!(last[2] <= f_gwo);
 }
 
 #[test]

