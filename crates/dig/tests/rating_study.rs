@@ -82,7 +82,7 @@ fn one_rating_calibrated_on_the_typical_pile() {
         let (mut lo, mut hi) = (lo, hi);
         let mut last = None;
         for _ in 0..10 {
-            let mid = (lo * hi as f64).sqrt();
+            let mid = (lo * hi).sqrt();
             let mut p = base.clone();
             set(&mut p, index, mid);
             match calibrated(&p, &surfaces[0]) {
