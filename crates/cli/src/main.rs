@@ -15,6 +15,7 @@ macro_rules! say {
 pub(crate) use say;
 
 mod demo;
+mod filter;
 mod jobs;
 mod link;
 mod output;
@@ -32,7 +33,7 @@ mod validate_dig;
 use std::path::PathBuf;
 use std::process::ExitCode;
 
-use clap::{Parser, Subcommand, ValueEnum};
+use clap::{CommandFactory, FromArgMatches, Parser, Subcommand, ValueEnum};
 
 /// Autonomy toolkit for mining excavators: perceive, plan the dig, plan the walk, drive.
 #[derive(Debug, Parser)]
@@ -52,6 +53,8 @@ enum Command {
     GeneratePile(pile::Args),
     /// Level, filter and fit a muck-pile scan (rope-shovel paper §3, SPEC §4.1).
     Perceive(perceive::Args),
+    /// Filter any cloud: voxel, statistical, radius, pass-through and level stages in the order given (PCL's semantics).
+    Filter(filter::Args),
     /// Plan the dig: a 6th-order tooth path by the Grey Wolf Optimizer (rope-shovel paper §4, SPEC §4.2–4.3).
     PlanDig(plan_dig::Args),
     /// Planned against measured: compare a plan-dig plan with a testbed record (rope-shovel paper §5, Table 6, Fig. 20).
@@ -138,7 +141,9 @@ fn print_scenario(name: &str) -> anyhow::Result<()> {
 }
 
 fn main() -> ExitCode {
-    let cli = Cli::parse();
+    // The matches are kept: `filter` runs its stages in the order given.
+    let matches = Cli::command().get_matches();
+    let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
     // Ctrl-C stops any job at once; what it had staged in the output folder
     // goes with it, so nothing half-written is left there.
     let _ = ctrlc::set_handler(|| {
@@ -163,6 +168,10 @@ fn main() -> ExitCode {
         Command::Track(args) => track::run(&args),
         Command::GeneratePile(args) => pile::run(&args),
         Command::Perceive(args) => perceive::run(&args),
+        Command::Filter(args) => filter::run(
+            &args,
+            matches.subcommand_matches("filter").unwrap_or(&matches),
+        ),
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::ValidateDig(args) => validate_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),

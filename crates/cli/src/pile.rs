@@ -22,6 +22,17 @@ pub enum EncodingArg {
     BinaryBigEndian,
 }
 
+impl From<EncodingArg> for Encoding {
+    fn from(e: EncodingArg) -> Self {
+        match e {
+            EncodingArg::Ascii => Encoding::Ascii,
+            EncodingArg::Binary => Encoding::Binary,
+            EncodingArg::BinaryCompressed => Encoding::BinaryCompressed,
+            EncodingArg::BinaryBigEndian => Encoding::BinaryBigEndian,
+        }
+    }
+}
+
 /// Arguments of `generate-pile`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -120,10 +131,7 @@ pub fn run(args: &Args) -> Result<()> {
     let gen_ms = t0.elapsed().as_secs_f64() * 1e3;
     let encoding = match args.encoding {
         None => Encoding::default_for(&args.out),
-        Some(EncodingArg::Ascii) => Encoding::Ascii,
-        Some(EncodingArg::Binary) => Encoding::Binary,
-        Some(EncodingArg::BinaryCompressed) => Encoding::BinaryCompressed,
-        Some(EncodingArg::BinaryBigEndian) => Encoding::BinaryBigEndian,
+        Some(e) => e.into(),
     };
     let t1 = std::time::Instant::now();
     autoshovel_report::write_file_atomically::<anyhow::Error>(

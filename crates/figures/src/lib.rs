@@ -12,6 +12,7 @@
 pub mod boulders;
 pub mod dig;
 pub mod excavate;
+pub mod filter;
 pub mod map;
 pub mod perceive;
 pub mod shovel;

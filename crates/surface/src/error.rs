@@ -97,6 +97,18 @@ pub enum SurfaceError {
     /// A point-cloud file could not be read, or a filter refused its input.
     #[error(transparent)]
     Cloud(#[from] autoshovel_cloud::CloudError),
+    /// A filter-chain stage's value could not be read (`autoshovel filter`).
+    #[error("--{flag} {spec}: {problem}; expected {syntax}")]
+    BadStage {
+        /// The stage's flag, without dashes.
+        flag: &'static str,
+        /// The value given.
+        spec: String,
+        /// What is wrong with it.
+        problem: String,
+        /// What a value looks like.
+        syntax: &'static str,
+    },
     /// A filter stage of the perception pipeline failed.
     #[error("{stage} filter")]
     Filter {

@@ -28,6 +28,7 @@
 #![allow(rustdoc::broken_intra_doc_links)]
 
 mod calibrate;
+pub mod chain;
 mod error;
 mod fit;
 mod floor;

@@ -183,15 +183,15 @@ impl Tunable {
                 r
             }
             Tunable::PidPreview => vec![
-                ("kp", 50.0, 5000.0, true),
+                ("kp", 50.0, 50_000.0, true),
                 ("ki", 0.0, 1000.0, false),
-                ("kd", 0.0, 2000.0, false),
+                ("kd", 0.0, 20_000.0, false),
                 ("alpha", 0.0, 1.5, false),
             ],
             Tunable::PidPosition => vec![
-                ("kp", 50.0, 5000.0, true),
+                ("kp", 50.0, 50_000.0, true),
                 ("ki", 0.0, 1000.0, false),
-                ("kd", 0.0, 2000.0, false),
+                ("kd", 0.0, 20_000.0, false),
             ],
             Tunable::PurePursuit => vec![
                 ("lookahead_m", 0.3, 6.0, true),
