@@ -738,6 +738,7 @@ pub fn plan_dig(model: &DigModel, search: &DigSearch, warm_start: &[Vec<f64>]) -
                 initial_step: search.polish_step,
                 constraints: search.gwo.constraints,
                 seed: search.gwo.seed,
+                parallel: search.gwo.parallel,
                 ..CmaParams::default()
             },
         )?;

@@ -38,6 +38,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, StandardNormal};
 use serde::{Deserialize, Serialize};
 
+use rayon::prelude::*;
+
 use crate::constraints::Constraints;
 use crate::error::OptimError;
 use crate::problem::{check_bounds, check_start, Evaluation, Problem};
@@ -60,6 +62,15 @@ pub struct CmaParams {
     pub constraints: Constraints,
     /// Seed of the one random generator.
     pub seed: u64,
+    /// Evaluate each generation's offspring on rayon's thread pool. The
+    /// offspring are drawn first, in order, so the result does not depend
+    /// on it. Default true.
+    #[serde(default = "parallel_default")]
+    pub parallel: bool,
+}
+
+fn parallel_default() -> bool {
+    true
 }
 
 impl Default for CmaParams {
@@ -71,6 +82,7 @@ impl Default for CmaParams {
             min_step: 1e-9,
             constraints: Constraints::FeasibilityRules,
             seed: 0,
+            parallel: true,
         }
     }
 }
@@ -179,12 +191,27 @@ pub fn cma_es<P: Problem + ?Sized>(
                 break;
             }
             let take = lambda.min(params.evaluations - used);
+            // Draw the generation in order, then evaluate it (in parallel
+            // when asked: the draws, and so the result, do not change).
+            let drawn: Vec<(DVector<f64>, Vec<f64>)> = (0..take)
+                .map(|_| {
+                    let z =
+                        DVector::from_iterator(n, (0..n).map(|_| StandardNormal.sample(&mut rng)));
+                    let x = (&run.mean + run.sigma * (&run.bd * z)).map(|v| v.clamp(0.0, 1.0));
+                    let at = from_unit(&x);
+                    (x, at)
+                })
+                .collect();
+            let evals: Vec<Evaluation> = if params.parallel {
+                drawn
+                    .par_iter()
+                    .map(|(_, at)| problem.evaluate(at))
+                    .collect()
+            } else {
+                drawn.iter().map(|(_, at)| problem.evaluate(at)).collect()
+            };
             let mut offspring: Vec<(DVector<f64>, Evaluation)> = Vec::with_capacity(take);
-            for _ in 0..take {
-                let z = DVector::from_iterator(n, (0..n).map(|_| StandardNormal.sample(&mut rng)));
-                let x = (&run.mean + run.sigma * (&run.bd * z)).map(|v| v.clamp(0.0, 1.0));
-                let at = from_unit(&x);
-                let e = problem.evaluate(&at);
+            for ((x, at), e) in drawn.into_iter().zip(evals) {
                 e.check(used, 0, || at)?;
                 used += 1;
                 offspring.push((x, e));
@@ -400,6 +427,12 @@ mod tests {
         let b = cma_es(&p, &start, p.evaluate(&start), &params).unwrap();
         assert_eq!(a, b);
         assert_eq!(a.evaluations, 777);
+        // Evaluated in parallel or not, the same run.
+        let serial = CmaParams {
+            parallel: false,
+            ..params
+        };
+        assert_eq!(cma_es(&p, &start, p.evaluate(&start), &serial).unwrap(), a);
         assert_eq!(p.evaluate(&a.best), a.best_eval);
     }
 
