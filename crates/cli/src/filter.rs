@@ -6,7 +6,7 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Context, Result};
-use autoshovel_cloud::io::{read, write, Encoding};
+use autoshovel_cloud::io::read;
 use autoshovel_surface::chain::{run_chain, FilterSummary, Stage, StageKind};
 use clap::ArgMatches;
 
@@ -102,19 +102,13 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
     let read_ms = t0.elapsed().as_secs_f64() * 1e3;
     let (cloud, report) = run_chain(&got.cloud, &stages)?;
     let filter_ms: f64 = report.iter().map(|r| r.ms).sum();
-    let encoding = match args.encoding {
-        None => Encoding::default_for(&args.output),
-        Some(e) => e.into(),
-    };
     let t1 = std::time::Instant::now();
-    autoshovel_report::write_file_atomically::<anyhow::Error>(
+    let encoding = crate::pile::write_cloud_file(
         &args.output,
         std::slice::from_ref(&args.input),
-        (&Default::default(), args.report.force),
-        |p| {
-            write(p, &cloud, encoding)?;
-            Ok(())
-        },
+        &cloud,
+        args.encoding,
+        args.report.force,
     )?;
     let summary = FilterSummary {
         job: "filter",

@@ -33,6 +33,29 @@ impl From<EncodingArg> for Encoding {
     }
 }
 
+/// Writes `cloud` to `path` (format by extension, `encoding` or its
+/// default) atomically, never over `inputs`, and over an existing file
+/// autoshovel did not write only with `force`; returns the encoding used.
+pub fn write_cloud_file(
+    path: &std::path::Path,
+    inputs: &[PathBuf],
+    cloud: &autoshovel_cloud::PointCloud,
+    encoding: Option<EncodingArg>,
+    force: bool,
+) -> Result<Encoding> {
+    let encoding = encoding.map_or_else(|| Encoding::default_for(path), Encoding::from);
+    autoshovel_report::write_file_atomically::<anyhow::Error>(
+        path,
+        inputs,
+        (&Default::default(), force),
+        |p| {
+            write(p, cloud, encoding)?;
+            Ok(())
+        },
+    )?;
+    Ok(encoding)
+}
+
 /// Arguments of `generate-pile`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
@@ -129,20 +152,8 @@ pub fn run(args: &Args) -> Result<()> {
         e => e.into(),
     })?;
     let gen_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let encoding = match args.encoding {
-        None => Encoding::default_for(&args.out),
-        Some(e) => e.into(),
-    };
     let t1 = std::time::Instant::now();
-    autoshovel_report::write_file_atomically::<anyhow::Error>(
-        &args.out,
-        &[],
-        (&Default::default(), args.force),
-        |p| {
-            write(p, &cloud, encoding)?;
-            Ok(())
-        },
-    )?;
+    let encoding = write_cloud_file(&args.out, &[], &cloud, args.encoding, args.force)?;
     let summary = GeneratePileSummary::new(
         &params,
         cloud.len(),
