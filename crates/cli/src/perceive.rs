@@ -12,9 +12,17 @@ use crate::output::out_dir;
 /// Arguments of `perceive`.
 #[derive(Debug, clap::Args)]
 pub struct Args {
-    /// The scan (.pcd .ply .las .laz .xyz .csv .txt).
+    /// The scan (.pcd .ply .las .laz .xyz .csv .txt), or a folder of
+    /// frames from one sensor pose, perceived in name order with the
+    /// levelling kept between frames (frame mode).
     #[arg(long, required_unless_present = "print_config")]
     pub input: Option<PathBuf>,
+    /// Frame mode: search the floor and level again every N frames (0: once).
+    #[arg(long, default_value_t = 0)]
+    pub relevel_every: usize,
+    /// Frame mode: cell edge of the running height model [m] (default: 4 × the point spacing).
+    #[arg(long)]
+    pub model_cell: Option<f64>,
     /// Pipeline settings (TOML); defaults otherwise (`autoshovel perceive --print-config` shows them).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -46,6 +54,55 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(input), args.config.as_deref()],
         args.output.force,
     )?;
+    if input.is_dir() {
+        let options = autoshovel_surface::frames::FrameOptions {
+            relevel_every: args.relevel_every,
+            model_cell_m: args.model_cell,
+        };
+        let job =
+            crate::jobs::perceive_frames(input, &params, options, out.as_ref(), !args.output.json)?;
+        return job.report(args.output.json, |s| {
+            crate::say!(
+                "perceive {} frames of {}: {} perceived, {} skipped",
+                s.frames,
+                s.input,
+                s.frames_ok,
+                s.frames_skipped
+            );
+            for k in &s.skipped {
+                crate::say!("  skipped frame {} ({}): {}", k.index, k.file, k.reason);
+            }
+            crate::say!(
+                "  latency: first {:.1} ms, then median {:.1} ms, 95 % {:.1} ms, max {:.1} ms ({:.1} frames/s)",
+                s.latency.first_ms,
+                s.latency.median_ms,
+                s.latency.p95_ms,
+                s.latency.max_ms,
+                s.frames_per_s
+            );
+            for stage in ["level", "ground", "radius", "statistical", "voxel", "smooth", "fit"] {
+                if let Some(ms) = s.timings_ms.get(stage) {
+                    crate::say!("  {stage:<12} median {ms:>9.1} ms");
+                }
+            }
+            crate::say!(
+                "  roll {:.3} deg, pitch {:.3} deg; height model {} × {} cells of {:.2} m, {:.0} % seen, median change {:.1} mm a frame",
+                s.roll_deg,
+                s.pitch_deg,
+                s.model_size[0],
+                s.model_size[1],
+                s.model_cell_m,
+                100.0 * s.model_coverage,
+                1e3 * s.model_change_rms_m
+            );
+        });
+    }
+    if args.relevel_every != 0 || args.model_cell.is_some() {
+        anyhow::bail!(
+            "--relevel-every and --model-cell are for a folder of frames; {} is a file",
+            input.display()
+        );
+    }
     let job = crate::jobs::perceive(input, &params, out.as_ref(), !args.output.json)?;
     job.report(args.output.json, |s| {
         crate::say!("perceive {}", s.input);

@@ -1,9 +1,9 @@
 //! `autoshovel generate-pile`: a synthetic LiDAR scan of one of the four
 //! pile shapes of the rope-shovel paper's Fig. 7, written in any format.
 
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 
-use anyhow::Result;
+use anyhow::{Context, Result};
 use autoshovel_cloud::io::{write, Encoding};
 use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern};
 
@@ -90,6 +90,12 @@ pub struct Args {
     /// Output file; its extension picks the format (.pcd .ply .las .laz .xyz .csv).
     #[arg(long)]
     pub out: PathBuf,
+    /// Write a sequence of N frames from the same sensor pose instead of
+    /// one scan (seeds SEED, SEED+1, …), named like --out with -0000,
+    /// -0001, … before the extension (its folder is made if need be): the
+    /// input of `perceive --input FOLDER`.
+    #[arg(long, default_value_t = 1)]
+    pub frames: usize,
     /// PCD/PLY encoding (default binary).
     #[arg(long, value_enum)]
     pub encoding: Option<EncodingArg>,
@@ -121,9 +127,70 @@ pub fn run(args: &Args) -> Result<()> {
         fov_rad: args.fov.to_radians(),
         ..PileParams::default()
     };
+    if !(1..=100_000).contains(&args.frames) {
+        anyhow::bail!("--frames {}: expected 1 to 100000", args.frames);
+    }
+    let paths: Vec<PathBuf> = if args.frames == 1 {
+        vec![args.out.clone()]
+    } else {
+        let stem = args.out.file_stem().unwrap_or_default().to_string_lossy();
+        let ext = args.out.extension().unwrap_or_default().to_string_lossy();
+        (0..args.frames)
+            .map(|i| args.out.with_file_name(format!("{stem}-{i:04}.{ext}")))
+            .collect()
+    };
+    if let Some(parent) = paths[0].parent().filter(|p| !p.as_os_str().is_empty()) {
+        if args.frames > 1 {
+            std::fs::create_dir_all(parent)
+                .with_context(|| format!("cannot create the folder {}", parent.display()))?;
+        }
+    }
+    let mut summary = None;
+    for (i, path) in paths.iter().enumerate() {
+        let params = PileParams {
+            seed: params.seed.wrapping_add(i as u64),
+            ..params.clone()
+        };
+        summary = Some(generate_one(&params, path, args)?);
+    }
+    let mut summary = summary.expect("at least one frame");
+    summary.frames = paths.len();
+    summary.file = paths[0].display().to_string();
+    summary.seed = args.seed;
+    if args.json {
+        print_json(&summary)?;
+    } else if summary.frames > 1 {
+        crate::say!(
+            "wrote {} frames of {} points of a {} pile (roll {} deg, pitch {} deg, seeds {}–{}): {} … {}",
+            summary.frames,
+            summary.points,
+            summary.shape,
+            args.roll,
+            args.pitch,
+            args.seed,
+            args.seed.wrapping_add(summary.frames as u64 - 1),
+            summary.file,
+            summary.last_file
+        );
+    } else {
+        crate::say!(
+            "wrote {} points of a {} pile (roll {} deg, pitch {} deg, seed {}) to {}",
+            summary.points,
+            summary.shape,
+            args.roll,
+            args.pitch,
+            summary.seed,
+            summary.file
+        );
+    }
+    Ok(())
+}
+
+/// Generates one scan with `params` and writes it to `path`.
+fn generate_one(params: &PileParams, path: &Path, args: &Args) -> Result<GeneratePileSummary> {
     let t0 = std::time::Instant::now();
     // The library names its fields; the user wrote flags.
-    let cloud = generate_pile(&params).map_err(|e| match e {
+    let cloud = generate_pile(params).map_err(|e| match e {
         autoshovel_surface::SurfaceError::BadParameter {
             name,
             value,
@@ -153,26 +220,12 @@ pub fn run(args: &Args) -> Result<()> {
     })?;
     let gen_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
-    let encoding = write_cloud_file(&args.out, &[], &cloud, args.encoding, args.force)?;
-    let summary = GeneratePileSummary::new(
-        &params,
+    let encoding = write_cloud_file(path, &[], &cloud, args.encoding, args.force)?;
+    Ok(GeneratePileSummary::new(
+        params,
         cloud.len(),
-        &args.out,
+        path,
         encoding.name(),
         (gen_ms, t1.elapsed().as_secs_f64() * 1e3),
-    );
-    if args.json {
-        print_json(&summary)?;
-    } else {
-        crate::say!(
-            "wrote {} points of a {} pile (roll {} deg, pitch {} deg, seed {}) to {}",
-            summary.points,
-            summary.shape,
-            args.roll,
-            args.pitch,
-            summary.seed,
-            summary.file
-        );
-    }
-    Ok(())
+    ))
 }

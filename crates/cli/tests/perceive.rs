@@ -214,3 +214,116 @@ fn generate_pile_refuses_scales_that_overflow() {
         assert!(!file.exists(), "{scale}: nothing written");
     }
 }
+
+/// Frame mode: `generate-pile --frames` writes a sequence, `perceive` on
+/// the folder levels once, keeps going past a broken frame (counted, named)
+/// and writes its files; each frame's cleaned cloud is what the library
+/// gives for it with the first frame's levelling.
+#[test]
+fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
+    use autoshovel_surface::frames::{FrameOptions, FramePerceiver};
+    use autoshovel_surface::perceive::PerceptionParams;
+    let dir = TempDir::new("frames");
+    let seq = dir.path().join("seq");
+    let g = run(&[
+        "generate-pile".as_ref(),
+        "--points".as_ref(),
+        "20000".as_ref(),
+        "--frames".as_ref(),
+        "4".as_ref(),
+        "--seed".as_ref(),
+        "7".as_ref(),
+        "--out".as_ref(),
+        seq.join("frame.pcd").as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(g["frames"], 4);
+    assert!(g["last_file"].as_str().unwrap().ends_with("frame-0003.pcd"));
+    // A broken frame between the second and third (by name order).
+    let broken = seq.join("frame-0001b.pcd");
+    std::fs::write(
+        &broken,
+        "# .PCD v0.7\nVERSION 0.7\nFIELDS x y z\nSIZE 4 4\n",
+    )
+    .unwrap();
+    let out = dir.path().join("out");
+    let s = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        seq.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(
+        (s["frames"].as_u64(), s["frames_ok"].as_u64()),
+        (Some(5), Some(4))
+    );
+    assert_eq!(s["frames_skipped"], 1);
+    assert_eq!(s["skipped"][0]["index"], 2);
+    let reason = s["skipped"][0]["reason"].as_str().unwrap();
+    assert!(
+        reason.contains("frame-0001b.pcd") && reason.contains("line 4"),
+        "{reason}"
+    );
+    assert_eq!(s["relevelled_frames"], 1);
+    for key in [
+        "roll_deg",
+        "pitch_deg",
+        "r2",
+        "input_points",
+        "output_points",
+    ] {
+        assert!(s[key].is_number(), "{key}");
+    }
+    assert_written(
+        &out,
+        &s,
+        &[
+            "frames.csv",
+            "model.csv",
+            "cleaned.pcd",
+            "latency.svg",
+            "latency.png",
+            "model.svg",
+            "model.png",
+        ],
+    );
+    // The library on the same files gives the same last cloud.
+    let mut lib = FramePerceiver::new(PerceptionParams::default(), FrameOptions::default());
+    for f in autoshovel_surface::frames::frames_in(&seq).unwrap() {
+        lib.push_file(&f);
+    }
+    let done = lib.finish().unwrap();
+    let cleaned = autoshovel_cloud::io::read(&out.join("cleaned.pcd"), &mut |_, _| {})
+        .unwrap()
+        .cloud;
+    assert_eq!(cleaned, done.last.cloud);
+    assert_eq!(
+        s["output_points"].as_u64(),
+        Some(done.last.cloud.len() as u64)
+    );
+    // Frame-mode flags on a single file are refused.
+    let e = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        seq.join("frame-0000.pcd").as_os_str(),
+        "--relevel-every".as_ref(),
+        "5".as_ref(),
+    ])
+    .fails();
+    assert!(e.error_message().contains("--relevel-every"));
+    // An empty folder is refused by name.
+    let empty = dir.path().join("empty");
+    std::fs::create_dir(&empty).unwrap();
+    let e = run(&["perceive".as_ref(), "--input".as_ref(), empty.as_os_str()]).fails();
+    assert!(
+        e.error_message().contains("no frame"),
+        "{}",
+        e.error_message()
+    );
+}

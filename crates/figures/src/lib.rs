@@ -13,6 +13,7 @@ pub mod boulders;
 pub mod dig;
 pub mod excavate;
 pub mod filter;
+pub mod frames;
 pub mod map;
 pub mod perceive;
 pub mod shovel;

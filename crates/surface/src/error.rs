@@ -127,6 +127,14 @@ pub enum SurfaceError {
         #[source]
         source: Box<SurfaceError>,
     },
+    /// A frame sequence could not be listed, or no frame of it perceived.
+    #[error("{dir}: {problem}")]
+    Frames {
+        /// The folder (or what the frames came from).
+        dir: String,
+        /// What is wrong.
+        problem: String,
+    },
     /// The scan holds no finite point.
     #[error("the scan holds no finite points ({non_finite_dropped} non-finite dropped)")]
     NoFinitePoints {

@@ -32,6 +32,7 @@ pub mod chain;
 mod error;
 mod fit;
 mod floor;
+pub mod frames;
 pub mod perceive;
 mod pile;
 mod ransac;

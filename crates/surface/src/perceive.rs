@@ -694,6 +694,52 @@ pub fn perceive_with(
     params: &PerceptionParams,
     on_stage: &mut dyn FnMut(&'static str),
 ) -> Result<Perceived> {
+    perceive_after(cloud, params, None, on_stage)
+}
+
+/// What one scan's perception leaves for the next scan from the same
+/// sensor pose ([`Prior::of`]): the attitude and floor it found, and the
+/// scale and spacing it used. With a prior, [`perceive_after`] levels with
+/// these angles and cuts at this floor without searching for the floor
+/// again (the two RANSAC fits of the level stage), and keeps the scale and
+/// spacing, so that every frame of a sequence is filtered alike.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Prior {
+    /// Roll α of [RS eq. 11] [rad].
+    pub roll_rad: f64,
+    /// Pitch β of [RS eq. 11] [rad].
+    pub pitch_rad: f64,
+    /// The floor found in the levelled scan.
+    pub floor: TiltEstimate,
+    /// Length scale.
+    pub scale: f64,
+    /// Point spacing [m].
+    pub spacing_m: f64,
+}
+
+impl Prior {
+    /// The prior a perceived scan leaves.
+    pub fn of(got: &Perceived) -> Self {
+        Self {
+            roll_rad: got.roll_rad,
+            pitch_rad: got.pitch_rad,
+            floor: got.floor,
+            scale: got.scale,
+            spacing_m: got.spacing_m,
+        }
+    }
+}
+
+/// [`perceive_with`] after an earlier scan from the same pose: with
+/// `prior`, the level stage applies its roll and pitch and its floor (no
+/// floor search), and its scale and spacing are used; without, as
+/// [`perceive_with`].
+pub fn perceive_after(
+    cloud: &PointCloud,
+    params: &PerceptionParams,
+    prior: Option<&Prior>,
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<Perceived> {
     let p = params;
     let input_points = cloud.len();
     if input_points == 0 {
@@ -701,7 +747,10 @@ pub fn perceive_with(
             non_finite_dropped: 0,
         });
     }
-    let (scale, spacing) = scale_and_spacing(cloud, p)?;
+    let (scale, spacing) = match prior {
+        Some(prior) => (prior.scale, prior.spacing_m),
+        None => scale_and_spacing(cloud, p)?,
+    };
     // The work the filters imply on this cloud, before doing it: with a
     // spacing given as a number, the cloud's own may be much finer.
     if let (Some((lo, hi)), ScaleSetting::Factor(_)) = (cloud.bounds(), p.spacing) {
@@ -745,8 +794,13 @@ pub fn perceive_with(
     let t = Instant::now();
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
-    let (cloud, roll, pitch) = match p.level.mode {
-        LevelMode::Estimate => {
+    let (cloud, roll, pitch) = match (prior, p.level.mode) {
+        (Some(prior), _) => (
+            level(cloud, prior.roll_rad, prior.pitch_rad),
+            prior.roll_rad,
+            prior.pitch_rad,
+        ),
+        (None, LevelMode::Estimate) => {
             let est = estimate_tilt(cloud, &tilt_params)
                 .map_err(in_stage("estimating roll and pitch from the floor"))?;
             (
@@ -755,7 +809,7 @@ pub fn perceive_with(
                 est.pitch_rad,
             )
         }
-        LevelMode::Given => {
+        (None, LevelMode::Given) => {
             let (r, q) = (
                 p.level.roll_deg.to_radians(),
                 p.level.pitch_deg.to_radians(),
@@ -769,11 +823,14 @@ pub fn perceive_with(
             }
             (level(cloud, r, q), r, q)
         }
-        LevelMode::None => (cloud.clone(), 0.0, 0.0),
+        (None, LevelMode::None) => (cloud.clone(), 0.0, 0.0),
     };
     // The floor after levelling (for the pass-through threshold).
-    let floor = estimate_tilt(&cloud, &tilt_params)
-        .map_err(in_stage("finding the floor after levelling"))?;
+    let floor = match prior {
+        Some(prior) => prior.floor,
+        None => estimate_tilt(&cloud, &tilt_params)
+            .map_err(in_stage("finding the floor after levelling"))?,
+    };
     stages.push(StageRecord {
         stage: "level",
         points: cloud.len(),

@@ -941,8 +941,13 @@ pub struct GeneratePileSummary {
     pub scale: f64,
     /// Seed of the noise and sampling.
     pub seed: u64,
-    /// The file written.
+    /// The file written (the first, for a sequence).
     pub file: String,
+    /// Files written: 1, or the frames of a sequence (`--frames`), each
+    /// from the same sensor pose with the next seed.
+    pub frames: usize,
+    /// The last file written.
+    pub last_file: String,
     /// Its encoding.
     pub encoding: &'static str,
     /// Time to generate [ms].
@@ -964,6 +969,8 @@ impl GeneratePileSummary {
     ) -> Self {
         Self {
             job: "generate-pile",
+            frames: 1,
+            last_file: file.display().to_string(),
             shape: p.shape.name(),
             points,
             pattern: p.pattern.name(),
