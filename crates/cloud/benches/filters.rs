@@ -11,7 +11,9 @@
 //!
 //! `FILTER_BENCH_WRITE=DIR cargo bench -p autoshovel-cloud --bench filters`
 //! does not run criterion: it writes the two clouds as binary PCD
-//! (`DIR/pile_100k.pcd`, `DIR/pile_1m.pcd`), runs each filter once to warm
+//! (`DIR/pile_100k.pcd`, `DIR/pile_1m.pcd`; `FILTER_BENCH_SIZES=100k,1m,5m,20m`
+//! for others, `FILTER_BENCH_INPUT=FILE` for a scan of your own instead,
+//! labelled by its file stem), runs each filter once to warm
 //! up and then `FILTER_BENCH_RUNS` (default 3) times or for half a second,
 //! whichever is longer, prints the median time as
 //! `ours NAME SIZE MS ms N points`, and writes each output
@@ -132,6 +134,40 @@ fn benches(c: &mut Criterion) {
     }
 }
 
+/// The clouds of the peer mode: `FILTER_BENCH_INPUT=FILE` (any format
+/// `autoshovel_cloud::io` reads; labelled by its file stem), or the bench
+/// pile at the sizes of `FILTER_BENCH_SIZES` (e.g. `100k,1m,5m,20m`;
+/// default `100k,1m`).
+fn peer_clouds() -> Vec<(String, PointCloud)> {
+    if let Ok(path) = std::env::var("FILTER_BENCH_INPUT") {
+        let path = std::path::Path::new(&path);
+        let cloud = autoshovel_cloud::io::read(path, &mut |_, _| {})
+            .expect("read FILTER_BENCH_INPUT")
+            .cloud;
+        let label = path
+            .file_stem()
+            .expect("a file name")
+            .to_string_lossy()
+            .into_owned();
+        return vec![(label, cloud)];
+    }
+    let sizes = std::env::var("FILTER_BENCH_SIZES").unwrap_or_else(|_| "100k,1m".into());
+    sizes
+        .split(',')
+        .map(|label| {
+            let label = label.trim().to_ascii_lowercase();
+            let (digits, unit) = label.split_at(label.len() - 1);
+            let n: usize = match unit {
+                "k" => digits.parse::<usize>().expect("a size like 100k") * 1_000,
+                "m" => digits.parse::<usize>().expect("a size like 5m") * 1_000_000,
+                _ => label.parse().expect("a size like 100k, 5m or 20000"),
+            };
+            let cloud = pile(n, 4);
+            (label, cloud)
+        })
+        .collect()
+}
+
 /// The peer mode: clouds, outputs and median timings for `peer/bench_peers.py`.
 fn write_for_peers(dir: &std::path::Path) {
     std::fs::create_dir_all(dir).expect("create FILTER_BENCH_WRITE");
@@ -141,8 +177,7 @@ fn write_for_peers(dir: &std::path::Path) {
         .unwrap_or(3)
         .max(1);
     let only = std::env::var("FILTER_BENCH_ONLY").ok();
-    for (n, size) in SIZES {
-        let cloud = pile(n, 4);
+    for (size, cloud) in peer_clouds() {
         if only.is_none() || only.as_deref() == Some("clouds") {
             write_binary_pcd(&dir.join(format!("pile_{size}.pcd")), &cloud)
                 .expect("write the bench cloud");

@@ -4,17 +4,23 @@ PCL keeps the very points we keep, and print a table. Run by hand (not by CI):
 
     apt-get install -y pcl-tools && pip install open3d-cpu   # or open3d
     python3 crates/cloud/peer/bench_peers.py [--runs 3] [--dir /tmp/filter_bench]
+        [--sizes 100k,1m,5m,20m | --input SCAN] [--process] [--markdown FILE]
 
 It runs `FILTER_BENCH_WRITE=DIR cargo bench -p autoshovel-cloud --bench
-filters`, which writes the bench clouds; then, for each filter and size, back
-to back so that all three see the same load on the machine: ours (the same
+filters`, which writes the bench clouds (or reads --input, a scan made by
+anything, e.g. `autoshovel generate-pile --pattern rosette`); then, for each
+filter and size, back to back so that all peers see the same load on the
+machine: ours (the same
 bench binary with FILTER_BENCH_ONLY; median of --runs or half a second of
 runs, whichever is longer, after one warm-up run, all threads; it also writes
-our output), the PCL tool (--runs runs; the time the tool
-prints for the filter alone, "[done, N ms : ...]", so loading and saving are
-not counted, but each run is a fresh process) and the Open3D call (timed
-around the call alone, the cloud already in memory, repeated as ours); and it
-compares PCL's kept points with ours bit for bit.
+our output), the PCL tool (--runs runs, --big-runs at 5 M points and more;
+the time the tool prints for the filter alone, "[done, N ms : ...]", so
+loading and saving are not counted, but each run is a fresh process) and
+Open3D's legacy (o3d.geometry) and tensor (o3d.t.geometry, float32, CPU)
+calls (timed around the call alone, the cloud already in memory, repeated as
+ours); and it compares PCL's kept points with ours bit for bit. With
+--process it also times `autoshovel filter` and the PCL tool as whole
+processes (read, filter, write).
 
 Parameters (SPEC §4.1 speed aims, adjusted to this cloud's 1.2-3.9 cm
 spacing): radius 0.05 m with 5 neighbours; statistical k = 50, multiplier 1;
@@ -28,6 +34,7 @@ crop(AxisAlignedBoundingBox(z >= 0.1)).
 import argparse
 import os
 import re
+import resource
 import statistics
 import subprocess
 import sys
@@ -64,28 +71,96 @@ def pcl_time(tool, inp, out, args):
     return ms[1], kept
 
 
-def open3d_time(o3d, cloud, name):
+def open3d_time(o3d, cloud, name, tensor):
+    """Open3D's legacy API (o3d.geometry), or its tensor API (o3d.t.geometry,
+    float32 points on the CPU) with `tensor`."""
     t = time.perf_counter()
     if name == "pass_through":
-        box = o3d.geometry.AxisAlignedBoundingBox([-1e30, -1e30, 0.1], [1e30, 1e30, 1e30])
+        lo, hi = [-1e30, -1e30, 0.1], [1e30, 1e30, 1e30]
+        if tensor:
+            f32 = o3d.core.float32
+            box = o3d.t.geometry.AxisAlignedBoundingBox(o3d.core.Tensor(lo, f32), o3d.core.Tensor(hi, f32))
+        else:
+            box = o3d.geometry.AxisAlignedBoundingBox(lo, hi)
         out = cloud.crop(box)
     elif name == "voxel_grid":
         out = cloud.voxel_down_sample(0.05)
+    elif name == "radius" and tensor:
+        out, _ = cloud.remove_radius_outliers(nb_points=5, search_radius=0.05)
     elif name == "radius":
         out, _ = cloud.remove_radius_outlier(nb_points=5, radius=0.05)
+    elif tensor:
+        out, _ = cloud.remove_statistical_outliers(nb_neighbors=51, std_ratio=1.0)
     else:
         out, _ = cloud.remove_statistical_outlier(nb_neighbors=51, std_ratio=1.0)
-    return (time.perf_counter() - t) * 1e3, len(out.points)
+    ms = (time.perf_counter() - t) * 1e3
+    return ms, len(out.point.positions) if tensor else len(out.points)
+
+
+def repeat(fn, runs):
+    """One warm-up call, then `runs` calls or half a second, as ours; the
+    median and the first result; (None, reason) when the call runs out of
+    the memory limit (Open3D's radius search keeps every neighbour)."""
+    try:
+        fn()
+    except (MemoryError, RuntimeError) as e:
+        return None, f"failed: {str(e).splitlines()[0][:60] or type(e).__name__}"
+    results, started = [], time.perf_counter()
+    while len(results) < runs or time.perf_counter() - started < 0.5:
+        results.append(fn())
+    return statistics.median(r[0] for r in results), results[0][1]
+
+
+# `autoshovel filter` flags of each filter, for the whole-process timing.
+OUR_FLAGS = {
+    "pass_through": ["--pass", "z:0.1:1e30"],
+    "voxel_grid": ["--voxel", "0.05"],
+    "radius": ["--radius", "0.05,5"],
+    "statistical": ["--statistical", "50,1.0"],
+}
+
+
+def process_ms(cmd):
+    t = time.perf_counter()
+    res = subprocess.run(cmd, capture_output=True, text=True)
+    if res.returncode != 0:
+        raise RuntimeError(f"{cmd[0]} failed: {(res.stdout + res.stderr)[-500:]}")
+    return (time.perf_counter() - t) * 1e3
 
 
 def main():
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--big-runs", type=int, default=1,
+                    help="PCL runs (fresh processes) at 5 M points and more; ours and Open3D keep --runs")
     ap.add_argument("--dir", default="/tmp/filter_bench")
+    ap.add_argument("--sizes", default="100k,1m,5m,20m", help="bench pile sizes, e.g. 100k,1m,5m,20m")
+    ap.add_argument("--input", help="a scan of your own (any format autoshovel reads) instead of the bench pile")
+    ap.add_argument("--filters", default=",".join(f[0] for f in FILTERS))
+    ap.add_argument("--process", action="store_true",
+                    help="also time `autoshovel filter` and the PCL tool as whole processes (read, filter, write)")
+    ap.add_argument("--markdown", help="also write the table to this file")
+    ap.add_argument("--memory-limit-gb", type=float, default=None,
+                    help="address-space limit of this script and its children (default: 3/4 of the machine's memory), "
+                         "so that a peer that runs out fails alone instead of the machine killing the run")
     args = ap.parse_args()
+    wanted = args.filters.split(",")
+    limit = args.memory_limit_gb
+    if limit is None:
+        limit = 0.75 * os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES") / 2**30
+    resource.setrlimit(resource.RLIMIT_AS, (int(limit * 2**30), resource.RLIM_INFINITY))
+    lines = []
 
-    def ours(only):
+    def say(line):
+        print(line, flush=True)
+        lines.append(line)
+
+    def ours(only, size):
         env = dict(os.environ, FILTER_BENCH_WRITE=args.dir, FILTER_BENCH_RUNS=str(args.runs), FILTER_BENCH_ONLY=only)
+        if args.input:
+            env["FILTER_BENCH_INPUT"] = os.path.abspath(args.input)
+        else:
+            env["FILTER_BENCH_SIZES"] = size
         out = subprocess.run(["cargo", "bench", "-q", "-p", "autoshovel-cloud", "--bench", "filters"],
                              cwd=ROOT, env=env, capture_output=True, text=True, check=True).stdout
         for line in out.splitlines():
@@ -94,7 +169,16 @@ def main():
                 return float(m.group(3)), int(m.group(4))
         return None
 
-    ours("clouds")
+    if args.input:
+        sizes = [os.path.splitext(os.path.basename(args.input))[0]]
+    else:
+        sizes = [s.strip().lower() for s in args.sizes.split(",")]
+    for size in sizes:
+        ours("clouds", size)
+    binary = None
+    if args.process:
+        subprocess.run(["cargo", "build", "-q", "--release", "-p", "autoshovel"], cwd=ROOT, check=True)
+        binary = os.path.join(ROOT, "target", "release", "autoshovel")
     try:
         import open3d as o3d
         o3d_version = o3d.__version__
@@ -103,20 +187,39 @@ def main():
         o3d_version = "not installed"
     pcl_version = subprocess.run(["dpkg-query", "-W", "-f", "${Version}", "pcl-tools"],
                                  capture_output=True, text=True).stdout.strip()
-    print(f"machine: {os.cpu_count()} cores; load average at start {os.getloadavg()[0]:.2f}; "
-          f"PCL tools {pcl_version}; Open3D {o3d_version}; runs {args.runs} (median)")
-    print("| filter | points | ours [ms] | PCL 1.13 [ms] | Open3D [ms] | PCL / ours | Open3D / ours | kept: ours / PCL / Open3D | same points as PCL |")
-    print("|---|---|---|---|---|---|---|---|---|")
-    for size in ["100k", "1m"]:
+    cpu = "?"
+    try:
+        with open("/proc/cpuinfo") as f:
+            cpu = next(l.split(":", 1)[1].strip() for l in f if l.startswith("model name"))
+    except (OSError, StopIteration):
+        pass
+    say(f"machine: {cpu}, {os.cpu_count()} cores; {time.strftime('%Y-%m-%d %H:%M')}; load average at start "
+        f"{os.getloadavg()[0]:.2f}; PCL tools {pcl_version}; Open3D {o3d_version}; runs {args.runs} "
+        f"(PCL {args.big_runs} at 5 M points and more); times in ms, medians")
+    say("")
+    head = ("| filter | cloud | points | ours | PCL | Open3D | Open3D tensor | best peer ÷ ours "
+            "| kept: ours / PCL / Open3D / Open3D t | same points as PCL |")
+    rule = "|---|---|---|---|---|---|---|---|---|---|"
+    if args.process:
+        head += " ours, whole process | PCL tool, whole process |"
+        rule += "---|---|"
+    say(head)
+    say(rule)
+    for size in sizes:
         inp = os.path.join(args.dir, f"pile_{size}.pcd")
-        cloud = None
+        n_points = len(pcd.read_pcd(inp))
+        cloud = cloud_t = None
         if o3d is not None:
             cloud = o3d.io.read_point_cloud(inp)
+            cloud_t = o3d.t.geometry.PointCloud.from_legacy(cloud, o3d.core.float32)
+        pcl_runs_n = args.runs if n_points < 5_000_000 else args.big_runs
         for name, tool, targs in FILTERS:
+            if name not in wanted:
+                continue
             out = os.path.join(args.dir, f"pcl_{name}_{size}.pcd")
-            our_ms, our_n = ours(f"{name}:{size}")
+            our_ms, our_n = ours(f"{name}:{size}", size)
             pcl_runs = []
-            for _ in range(args.runs):
+            for _ in range(pcl_runs_n):
                 ms, kept = pcl_time(tool, inp, out, targs)
                 pcl_runs.append(ms)
             pcl_ms = statistics.median(pcl_runs)
@@ -126,21 +229,32 @@ def main():
                 same = "yes (1e-5 m, in order)" if same else "NO"
             else:
                 same = "yes (bit for bit, in order)" if np.array_equal(mine.view(np.uint32), kept.view(np.uint32)) else "NO"
+            peers = [pcl_ms]
             if cloud is not None:
-                # One warm-up call, then --runs calls or half a second, as ours.
-                open3d_time(o3d, cloud, name)
-                o3d_runs, started = [], time.perf_counter()
-                while len(o3d_runs) < args.runs or time.perf_counter() - started < 0.5:
-                    o3d_runs.append(open3d_time(o3d, cloud, name))
-                o3d_ms = statistics.median(r[0] for r in o3d_runs)
-                o3d_n = o3d_runs[0][1]
-                o3d_cells = (f"{o3d_ms:.1f}", f"{o3d_ms / our_ms:.1f}", str(o3d_n))
+                o3d_ms, o3d_n = repeat(lambda: open3d_time(o3d, cloud, name, False), args.runs)
+                o3t_ms, o3t_n = repeat(lambda: open3d_time(o3d, cloud_t, name, True), args.runs)
+                peers += [m for m in (o3d_ms, o3t_ms) if m is not None]
+                o3d_cells = tuple(f"{m:.1f}" if m is not None else n for m, n in ((o3d_ms, o3d_n), (o3t_ms, o3t_n))) \
+                    + (str(o3d_n) if o3d_ms is not None else "–", str(o3t_n) if o3t_ms is not None else "–")
             else:
-                o3d_cells = ("n/a", "n/a", "n/a")
-            print(f"| {name} | {size} | {our_ms:.1f} | {pcl_ms:.1f} | {o3d_cells[0]} | {pcl_ms / our_ms:.1f} | "
-                  f"{o3d_cells[1]} | {our_n} / {len(kept)} / {o3d_cells[2]} | {same} |", flush=True)
+                o3d_cells = ("n/a", "n/a", "n/a", "n/a")
+            row = (f"| {name} | {'bench pile' if not args.input else args.input} | {size} | {our_ms:.1f} | {pcl_ms:.1f} "
+                   f"| {o3d_cells[0]} | {o3d_cells[1]} | {min(peers) / our_ms:.1f} "
+                   f"| {our_n} / {len(kept)} / {o3d_cells[2]} / {o3d_cells[3]} | {same} |")
+            if args.process:
+                mine_out = os.path.join(args.dir, f"process_{name}_{size}.pcd")
+                ours_p = statistics.median(
+                    process_ms([binary, "filter", "--input", inp, "--output", mine_out, "--force"] + OUR_FLAGS[name])
+                    for _ in range(pcl_runs_n))
+                pcl_p = statistics.median(process_ms([tool, inp, out] + targs) for _ in range(pcl_runs_n))
+                row += f" {ours_p:.0f} | {pcl_p:.0f} |"
+            say(row)
 
-    print(f"load average at end {os.getloadavg()[0]:.2f}")
+    say("")
+    say(f"load average at end {os.getloadavg()[0]:.2f}")
+    if args.markdown:
+        with open(args.markdown, "w") as f:
+            f.write("\n".join(lines) + "\n")
 
 
 if __name__ == "__main__":

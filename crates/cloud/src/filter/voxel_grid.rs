@@ -18,7 +18,8 @@
 //! overflow.") and returns the input unchanged; here voxel coordinates are
 //! i64, and the points are sorted by voxel through one u64 holding the
 //! linear voxel index and the point index when the occupied box has at most
-//! 2³² voxels (an LSD radix sort on the voxel bits), through (u64 linear
+//! 2³² voxels (bucketed by the voxel bits in parallel chunks, each bucket
+//! sorted: `bucketed_centroids`), through (u64 linear
 //! index, point index) pairs below 2⁶⁴ voxels, and through (z, y, x) i64
 //! triplets beyond, so any leaf whose products stay finite in f32 works.
 //!
@@ -85,6 +86,16 @@ impl VoxelGridParams {
 /// Voxel coordinates are kept below this magnitude, far inside i64.
 const MAX_CELL: f32 = 4.0e18;
 
+/// ⌊v⌋ of a finite `v` with |v| < 4e18, as `v.floor() as i64` gives it.
+/// Why by hand: without SSE4.1 (the x86-64 baseline) `f32::floor` is a
+/// call into libm, a tenth of the voxel grid's time; truncation and one
+/// comparison are exact for every f32 in range.
+#[inline(always)]
+fn floor_i64(v: f32) -> i64 {
+    let t = v as i64;
+    t - i64::from((t as f32) > v)
+}
+
 /// The centroids of the occupied voxels, in PCL's order (x fastest, then y,
 /// then z). Non-finite points are skipped.
 ///
@@ -105,8 +116,10 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
     let cell = |p: &Point| -> Result<[i64; 3]> {
         let mut c = [0_i64; 3];
         for a in 0..3 {
-            let v = (p[a] * inv[a]).floor();
-            if !v.is_finite() || v.abs() >= MAX_CELL {
+            let v = p[a] * inv[a];
+            // |floor(v)| < 4e18 exactly when |v| < 4e18 at f32's spacing
+            // there (2³⁹); NaN and infinities fail too.
+            if !(v.abs() < MAX_CELL) {
                 return Err(bad(
                     FILTER,
                     format!(
@@ -116,7 +129,7 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
                     ),
                 ));
             }
-            c[a] = v as i64;
+            c[a] = floor_i64(v);
         }
         Ok(c)
     };
@@ -159,21 +172,13 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
     // valid: the bounds pass checked every finite point).
     let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
     let linear = |p: &Point| {
-        let c = [0, 1, 2].map(|a| ((p[a] * inv[a]).floor() as i64 - lo[a]) as u64);
+        let c = [0, 1, 2].map(|a| (floor_i64(p[a] * inv[a]) - lo[a]) as u64);
         c[0] + c[1] * ex + c[2] * exy
     };
     let centroids = if voxels <= 1 << 32 && points.len() <= 1 << 32 {
-        // Usual case: voxel index and point index packed in one u64, sorted
-        // by an LSD radix sort on the voxel bits (stable, so each voxel's
-        // points stay in input order).
-        let mut keys: Vec<u64> = points
-            .par_iter()
-            .enumerate()
-            .filter(|(_, p)| is_finite(p))
-            .map(|(i, p)| (linear(p) << 32) | i as u64)
-            .collect();
-        radix_sort_high(&mut keys, (128 - (voxels - 1).leading_zeros()) as usize);
-        centroids_of_runs(points, &keys, |k| k >> 32, |k| (k & 0xffff_ffff) as usize)
+        // Usual case: voxel index and point index packed in one u64,
+        // bucketed by the voxel index's top bits, each bucket sorted.
+        bucketed_centroids(points, voxels as u64, &linear)
     } else if voxels <= u128::from(u64::MAX) {
         let mut keys: Vec<(u64, usize)> = points
             .par_iter()
@@ -190,7 +195,7 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
             .enumerate()
             .filter(|(_, p)| is_finite(p))
             .map(|(i, p)| {
-                let c = [0, 1, 2].map(|a| (p[a] * inv[a]).floor() as i64);
+                let c = [0, 1, 2].map(|a| floor_i64(p[a] * inv[a]));
                 ([c[2], c[1], c[0]], i)
             })
             .collect();
@@ -200,31 +205,81 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
     Ok(PointCloud::new(centroids))
 }
 
-/// Sorts `keys` by their top `bits` bits above bit 32 (the voxel index),
-/// stably, by least-significant-digit radix passes of 11 bits.
-fn radix_sort_high(keys: &mut Vec<u64>, bits: usize) {
-    const DIGIT: usize = 11;
-    let mut other = vec![0u64; keys.len()];
-    let mut shift = 32;
-    while shift < 32 + bits {
-        let mut count = vec![0usize; 1 << DIGIT];
-        for &k in keys.iter() {
-            count[((k >> shift) as usize) & ((1 << DIGIT) - 1)] += 1;
-        }
-        let mut sum = 0;
-        for c in count.iter_mut() {
-            let n = *c;
-            *c = sum;
-            sum += n;
-        }
-        for &k in keys.iter() {
-            let d = ((k >> shift) as usize) & ((1 << DIGIT) - 1);
-            other[count[d]] = k;
-            count[d] += 1;
-        }
-        std::mem::swap(keys, &mut other);
-        shift += DIGIT;
-    }
+/// Points a bucket of [`bucketed_centroids`] holds on average (at most).
+const BUCKET: usize = 8;
+
+/// The centroids of the occupied voxels in linear-index order, for a box
+/// of at most 2³² `voxels` and at most 2³² points; `linear` gives a
+/// finite point's voxel index. Each point becomes a key (voxel index above,
+/// point index below) with its coordinates. Why not one sort of all keys:
+/// the cloud is cut into one chunk per task, and each chunk is counting-
+/// sorted on its own (in cache, in parallel) into buckets by the voxel
+/// index's top bits, a few points a bucket; then each bucket's parts
+/// (in chunk order) are gathered, sorted by key (the point index keeps
+/// each voxel's points in input order) and summed, buckets in parallel. No
+/// pass over the whole cloud is serial, and the centroids read the points
+/// from the gathered parts, not at random from the cloud.
+fn bucketed_centroids<L>(points: &[Point], voxels: u64, linear: &L) -> Vec<Point>
+where
+    L: Fn(&Point) -> u64 + Sync,
+{
+    let n = points.len();
+    let voxel_bits = 64 - (voxels.max(2) - 1).leading_zeros();
+    let bucket_bits = (usize::BITS - (n / BUCKET).max(1).leading_zeros())
+        .min(voxel_bits)
+        .min(22);
+    let shift = voxel_bits - bucket_bits;
+    let buckets = 1usize << bucket_bits;
+    let bucket = |key: u64| ((key >> 32) >> shift) as usize;
+    // Each chunk counting-sorted by bucket: its entries and bucket starts.
+    let chunk = n.div_ceil(rayon::current_num_threads() * 4).max(1 << 12);
+    let parts: Vec<(Vec<(u64, Point)>, Vec<u32>)> = points
+        .par_chunks(chunk)
+        .enumerate()
+        .map(|(c, ps)| {
+            let base = c * chunk;
+            let keyed: Vec<(u64, Point)> = ps
+                .iter()
+                .enumerate()
+                .filter(|(_, p)| is_finite(p))
+                .map(|(i, p)| ((linear(p) << 32) | (base + i) as u64, *p))
+                .collect();
+            let mut start = vec![0u32; buckets + 1];
+            for (k, _) in &keyed {
+                start[bucket(*k) + 1] += 1;
+            }
+            for b in 0..buckets {
+                start[b + 1] += start[b];
+            }
+            let mut next = start.clone();
+            let mut sorted = vec![(0u64, [0.0f32; 3]); keyed.len()];
+            for e in keyed {
+                let slot = &mut next[bucket(e.0)];
+                sorted[*slot as usize] = e;
+                *slot += 1;
+            }
+            (sorted, start)
+        })
+        .collect();
+    // Buckets in parallel ranges; each bucket gathered, sorted, summed.
+    let per_task = buckets.div_ceil(rayon::current_num_threads() * 8).max(1);
+    let out: Vec<Vec<Point>> = (0..buckets.div_ceil(per_task))
+        .into_par_iter()
+        .map(|t| {
+            let mut out = Vec::new();
+            let mut scratch: Vec<(u64, Point)> = Vec::new();
+            for b in t * per_task..((t + 1) * per_task).min(buckets) {
+                scratch.clear();
+                for (sorted, start) in &parts {
+                    scratch.extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
+                }
+                scratch.sort_unstable_by_key(|e| e.0);
+                push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
+            }
+            out
+        })
+        .collect();
+    out.concat()
 }
 
 /// The centroid of each run of equal voxel keys in the sorted `keys`, in
@@ -254,26 +309,71 @@ where
     let chunks: Vec<Vec<Point>> = cuts
         .par_windows(2)
         .map(|w| {
-            let run = &keys[w[0]..w[1]];
             let mut out = Vec::new();
-            let mut start = 0;
-            while start < run.len() {
-                let key = voxel(&run[start]);
-                let mut sum = [0.0_f64; 3];
-                let mut end = start;
-                while end < run.len() && voxel(&run[end]) == key {
-                    let p = points[index(&run[end])];
-                    for a in 0..3 {
-                        sum[a] += f64::from(p[a]);
-                    }
-                    end += 1;
-                }
-                let count = (end - start) as f64;
-                out.push([0, 1, 2].map(|a| (sum[a] / count) as f32));
-                start = end;
-            }
+            push_centroids(&keys[w[0]..w[1]], &voxel, |k| points[index(k)], &mut out);
             out
         })
         .collect();
     chunks.concat()
+}
+
+/// Pushes the centroid of each run of entries with equal `voxel` in
+/// `sorted`, in order, onto `out`; a voxel's points (`point`) are summed in
+/// f64 in the order given, so the result depends neither on the sort nor
+/// on the number of threads when that order is the input order.
+fn push_centroids<T, K, V, P>(sorted: &[T], voxel: V, point: P, out: &mut Vec<Point>)
+where
+    V: Fn(&T) -> K,
+    P: Fn(&T) -> Point,
+    K: PartialEq,
+{
+    let mut start = 0;
+    while start < sorted.len() {
+        let key = voxel(&sorted[start]);
+        let mut sum = [0.0_f64; 3];
+        let mut end = start;
+        while end < sorted.len() && voxel(&sorted[end]) == key {
+            let p = point(&sorted[end]);
+            for a in 0..3 {
+                sum[a] += f64::from(p[a]);
+            }
+            end += 1;
+        }
+        let count = (end - start) as f64;
+        out.push([0, 1, 2].map(|a| (sum[a] / count) as f32));
+        start = end;
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::floor_i64;
+
+    #[test]
+    fn floor_by_hand_is_floor() {
+        let mut v = vec![
+            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, -2.5, 1e-30, -1e-30, 3.9e18, -3.9e18,
+        ];
+        v.extend([
+            8388607.5f32,
+            -8388607.5,
+            16777217.0,
+            -16777217.0,
+            0.99999994,
+            -0.99999994,
+        ]);
+        let mut s = 1u64;
+        for _ in 0..100_000 {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            let x = f32::from_bits((s >> 32) as u32);
+            if x.is_finite() && x.abs() < 4.0e18 {
+                v.push(x);
+            }
+        }
+        for x in v {
+            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+        }
+    }
 }
