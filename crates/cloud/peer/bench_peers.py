@@ -109,7 +109,9 @@ def repeat(fn, runs, warm=True):
         else:
             results.append(fn())
     except (MemoryError, RuntimeError) as e:
-        return None, f"failed: {str(e).splitlines()[0][:60] or type(e).__name__}"
+        text = re.sub(r"\x1b\[[0-9;]*m", "", str(e))
+        why = "out of memory" if isinstance(e, MemoryError) or "Memory" in text else text.splitlines()[0][:60]
+        return None, f"failed: {why or type(e).__name__}"
     if warm:
         started = time.perf_counter()
     while len(results) < runs or time.perf_counter() - started < 0.5:

@@ -118,8 +118,8 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
         for a in 0..3 {
             let v = p[a] * inv[a];
             // |floor(v)| < 4e18 exactly when |v| < 4e18 at f32's spacing
-            // there (2³⁹); NaN and infinities fail too.
-            if !(v.abs() < MAX_CELL) {
+            // there (2³⁹).
+            if !v.is_finite() || v.abs() >= MAX_CELL {
                 return Err(bad(
                     FILTER,
                     format!(
@@ -233,7 +233,9 @@ where
     let bucket = |key: u64| ((key >> 32) >> shift) as usize;
     // Each chunk counting-sorted by bucket: its entries and bucket starts.
     let chunk = n.div_ceil(rayon::current_num_threads() * 4).max(1 << 12);
-    let parts: Vec<(Vec<(u64, Point)>, Vec<u32>)> = points
+    // Per chunk: its (key, point) entries by bucket, and the bucket starts.
+    type Part = (Vec<(u64, Point)>, Vec<u32>);
+    let parts: Vec<Part> = points
         .par_chunks(chunk)
         .enumerate()
         .map(|(c, ps)| {
