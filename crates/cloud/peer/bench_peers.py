@@ -233,8 +233,14 @@ def main():
             pcl_ms = statistics.median(pcl_runs)
             mine = pcd.read_pcd(os.path.join(args.dir, f"ours_{name}_{size}.pcd"))
             if name == "voxel_grid":
-                same = len(mine) == len(kept) and bool(np.all(np.abs(mine - kept) <= 1e-5))
-                same = "yes (1e-5 m, in order)" if same else "NO"
+                # PCL sums a voxel's points in f32, we in f64: centroids
+                # differ by a few f32 ulps of the coordinates (1e-6 relative).
+                if len(mine) == len(kept) and len(mine) > 0:
+                    gap = float(np.abs(mine - kept).max())
+                    tol = max(1e-5, 1e-6 * float(np.abs(kept).max()))
+                    same = f"yes (same voxels in order, centroids within {gap:.1e} m)" if gap <= tol else f"NO ({gap:.1e} m)"
+                else:
+                    same = "NO (voxel counts differ)"
             else:
                 same = "yes (bit for bit, in order)" if np.array_equal(mine.view(np.uint32), kept.view(np.uint32)) else "NO"
             peers = [pcl_ms]
