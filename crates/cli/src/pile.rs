@@ -145,15 +145,21 @@ pub fn run(args: &Args) -> Result<()> {
                 .with_context(|| format!("cannot create the folder {}", parent.display()))?;
         }
     }
-    let mut summary = None;
-    for (i, path) in paths.iter().enumerate() {
-        let params = PileParams {
-            seed: params.seed.wrapping_add(i as u64),
-            ..params.clone()
-        };
-        summary = Some(generate_one(&params, path, args)?);
-    }
-    let mut summary = summary.expect("at least one frame");
+    // Frames are independent (each its own seed, each file written whole):
+    // made on all cores, the same files as one by one; an error stops the run.
+    use rayon::prelude::*;
+    let summaries: Vec<GeneratePileSummary> = paths
+        .par_iter()
+        .enumerate()
+        .map(|(i, path)| {
+            let params = PileParams {
+                seed: params.seed.wrapping_add(i as u64),
+                ..params.clone()
+            };
+            generate_one(&params, path, args)
+        })
+        .collect::<Result<_>>()?;
+    let mut summary = summaries.into_iter().last().expect("at least one frame");
     summary.frames = paths.len();
     summary.file = paths[0].display().to_string();
     summary.seed = args.seed;
