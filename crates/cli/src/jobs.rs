@@ -304,26 +304,22 @@ pub fn perceive_frames(
     out: Option<&OutDir>,
     progress: bool,
 ) -> Result<Job<autoshovel_surface::frames::FramesSummary>> {
-    use autoshovel_surface::frames::{frames_in, FramePerceiver};
-    let files = frames_in(dir)?;
     let bar = progress_bar(
         progress,
         "frames [{bar:40}] {pos}/{len} ({per_sec}, {eta}) {msg}",
     );
-    bar.set_length(files.len() as u64);
-    let mut run =
-        FramePerceiver::new(params.clone(), options).with_input(dir.display().to_string());
-    for f in &files {
-        let r = run.push_file(f);
-        bar.set_message(if r.ok {
-            format!("{:.0} ms", r.latency_ms)
-        } else {
-            format!("skipped {}", r.file)
+    let done =
+        autoshovel_surface::frames::perceive_folder(dir, params, options, &mut |done, total, r| {
+            bar.set_length(total as u64);
+            bar.set_position(done as u64);
+            bar.set_message(if r.ok {
+                format!("{:.0} ms", r.latency_ms)
+            } else {
+                format!("skipped {}", r.file)
+            });
         });
-        bar.inc(1);
-    }
     bar.finish_and_clear();
-    let done = run.finish()?;
+    let done = done?;
     Job::finish(done.summary.clone(), out, |dir, written| {
         Ok(figures::frames::write(dir, &done, written)?)
     })

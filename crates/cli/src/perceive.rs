@@ -80,7 +80,7 @@ pub fn run(args: &Args) -> Result<()> {
                 s.latency.max_ms,
                 s.frames_per_s
             );
-            for stage in ["level", "ground", "radius", "statistical", "voxel", "smooth", "fit"] {
+            for stage in autoshovel_surface::perceive::STAGES {
                 if let Some(ms) = s.timings_ms.get(stage) {
                     crate::say!("  {stage:<12} median {ms:>9.1} ms");
                 }

@@ -130,15 +130,7 @@ pub fn run(args: &Args) -> Result<()> {
     if !(1..=100_000).contains(&args.frames) {
         anyhow::bail!("--frames {}: expected 1 to 100000", args.frames);
     }
-    let paths: Vec<PathBuf> = if args.frames == 1 {
-        vec![args.out.clone()]
-    } else {
-        let stem = args.out.file_stem().unwrap_or_default().to_string_lossy();
-        let ext = args.out.extension().unwrap_or_default().to_string_lossy();
-        (0..args.frames)
-            .map(|i| args.out.with_file_name(format!("{stem}-{i:04}.{ext}")))
-            .collect()
-    };
+    let paths = autoshovel_surface::frames::sequence_paths(&args.out, args.frames);
     if let Some(parent) = paths[0].parent().filter(|p| !p.as_os_str().is_empty()) {
         if args.frames > 1 {
             std::fs::create_dir_all(parent)

@@ -221,7 +221,7 @@ fn generate_pile_refuses_scales_that_overflow() {
 /// gives for it with the first frame's levelling.
 #[test]
 fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
-    use autoshovel_surface::frames::{FrameOptions, FramePerceiver};
+    use autoshovel_surface::frames::FrameOptions;
     use autoshovel_surface::perceive::PerceptionParams;
     let dir = TempDir::new("frames");
     let seq = dir.path().join("seq");
@@ -294,11 +294,13 @@ fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
         ],
     );
     // The library on the same files gives the same last cloud.
-    let mut lib = FramePerceiver::new(PerceptionParams::default(), FrameOptions::default());
-    for f in autoshovel_surface::frames::frames_in(&seq).unwrap() {
-        lib.push_file(&f);
-    }
-    let done = lib.finish().unwrap();
+    let done = autoshovel_surface::frames::perceive_folder(
+        &seq,
+        &PerceptionParams::default(),
+        FrameOptions::default(),
+        &mut |_, _, _| {},
+    )
+    .unwrap();
     let cleaned = autoshovel_cloud::io::read(&out.join("cleaned.pcd"), &mut |_, _| {})
         .unwrap()
         .cloud;

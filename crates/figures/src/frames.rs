@@ -10,19 +10,9 @@ use autoshovel_report::{
     write_csv, write_figure, write_heatmap, Figure, Heatmap, Layer, Rgb, Stroke, Written,
 };
 use autoshovel_surface::frames::FrameRun;
+use autoshovel_surface::perceive::STAGES;
 
 use crate::FiguresError;
-
-/// The stages whose times `frames.csv` gives, in the pipeline's order.
-const STAGES: [&str; 7] = [
-    "level",
-    "ground",
-    "radius",
-    "statistical",
-    "voxel",
-    "smooth",
-    "fit",
-];
 
 /// Writes the files of a frame sequence's run into `dir`.
 pub fn write(dir: &Path, run: &FrameRun, written: &mut Written) -> Result<(), FiguresError> {
@@ -30,6 +20,7 @@ pub fn write(dir: &Path, run: &FrameRun, written: &mut Written) -> Result<(), Fi
     write_cloud(&cleaned, &run.last.cloud, Encoding::Binary)?;
     written.file(dir, &cleaned);
     // One row a frame; a skipped frame has ok = 0 and NaN times.
+    let stage_columns: Vec<String> = STAGES.iter().map(|s| format!("{s}_ms")).collect();
     let mut header = vec![
         "frame",
         "ok",
@@ -41,15 +32,7 @@ pub fn write(dir: &Path, run: &FrameRun, written: &mut Written) -> Result<(), Fi
         "model_ms",
         "latency_ms",
     ];
-    header.extend(STAGES.iter().map(|s| match *s {
-        "level" => "level_ms",
-        "ground" => "ground_ms",
-        "radius" => "radius_ms",
-        "statistical" => "statistical_ms",
-        "voxel" => "voxel_ms",
-        "smooth" => "smooth_ms",
-        _ => "fit_ms",
-    }));
+    header.extend(stage_columns.iter().map(String::as_str));
     header.extend(["r2", "model_cells_updated", "model_change_rms_m"]);
     let frames = dir.join("frames.csv");
     write_csv(

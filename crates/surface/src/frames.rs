@@ -72,6 +72,38 @@ pub fn frames_in(dir: &Path) -> Result<Vec<PathBuf>> {
     Ok(frames)
 }
 
+/// The files of an `n`-frame sequence written as `out`: `out` itself for
+/// one frame, else `out`'s name with `-0000`, `-0001`, … before its
+/// extension (`generate-pile --frames`; [`frames_in`] reads them back in
+/// this order).
+pub fn sequence_paths(out: &Path, n: usize) -> Vec<PathBuf> {
+    if n == 1 {
+        return vec![out.to_path_buf()];
+    }
+    let stem = out.file_stem().unwrap_or_default().to_string_lossy();
+    let ext = out.extension().unwrap_or_default().to_string_lossy();
+    (0..n)
+        .map(|i| out.with_file_name(format!("{stem}-{i:04}.{ext}")))
+        .collect()
+}
+
+/// Perceives every frame of folder `dir` ([`frames_in`]) in order with one
+/// [`FramePerceiver`], calling `on_frame(done, total, record)` after each.
+pub fn perceive_folder(
+    dir: &Path,
+    params: &PerceptionParams,
+    options: FrameOptions,
+    on_frame: &mut dyn FnMut(usize, usize, &FrameRecord),
+) -> Result<FrameRun> {
+    let files = frames_in(dir)?;
+    let mut run =
+        FramePerceiver::new(params.clone(), options).with_input(dir.display().to_string());
+    for (i, f) in files.iter().enumerate() {
+        on_frame(i + 1, files.len(), run.push_file(f));
+    }
+    run.finish()
+}
+
 /// Compares names with runs of digits compared as numbers.
 fn natural_order(a: &str, b: &str) -> std::cmp::Ordering {
     fn parts(s: &str) -> Vec<(bool, String)> {
@@ -621,6 +653,24 @@ mod tests {
             ..PileParams::default()
         })
         .unwrap()
+    }
+
+    #[test]
+    fn a_sequence_is_named_in_the_order_frames_in_reads_it() {
+        let one = sequence_paths(Path::new("s/scan.pcd"), 1);
+        assert_eq!(one, [PathBuf::from("s/scan.pcd")]);
+        let names: Vec<String> = sequence_paths(Path::new("s/f.laz"), 12)
+            .iter()
+            .map(|p| p.display().to_string())
+            .collect();
+        assert_eq!(
+            (names[0].as_str(), names[11].as_str()),
+            ("s/f-0000.laz", "s/f-0011.laz")
+        );
+        let mut sorted = names.clone();
+        sorted.reverse();
+        sorted.sort_by(|a, b| natural_order(a, b));
+        assert_eq!(sorted, names);
     }
 
     #[test]

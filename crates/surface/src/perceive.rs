@@ -548,6 +548,18 @@ impl PerceptionParams {
     }
 }
 
+/// The pipeline's stages after the read, in order (a disabled filter is
+/// skipped, so a run may record fewer).
+pub const STAGES: [&str; 7] = [
+    "level",
+    "ground",
+    "radius",
+    "statistical",
+    "voxel",
+    "smooth",
+    "fit",
+];
+
 /// One stage's record: its name, the points after it and its wall time.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct StageRecord {
