@@ -215,11 +215,13 @@ def main():
     say(rule)
     for size in sizes:
         inp = os.path.join(args.dir, f"pile_{size}.pcd")
-        n_points = len(pcd.read_pcd(inp))
         cloud = cloud_t = None
         if o3d is not None:
             cloud = o3d.io.read_point_cloud(inp)
             cloud_t = o3d.t.geometry.PointCloud.from_legacy(cloud, o3d.core.float32)
+            n_points = len(cloud.points)
+        else:
+            n_points = len(pcd.read_pcd(inp))
         pcl_runs_n = args.runs if n_points < 5_000_000 else args.big_runs
         for name, tool, targs in FILTERS:
             if name not in wanted:
