@@ -94,15 +94,15 @@ pub fn angles_from_normal(normal: [f64; 3]) -> Option<(f64, f64)> {
 
 /// Apply a rotation to every point (f64 arithmetic, f32 storage).
 pub(crate) fn rotate(cloud: &PointCloud, r: &Matrix3<f64>) -> PointCloud {
-    let points = cloud
-        .points
-        .iter()
-        .map(|p| {
-            let v = r * Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-            [v.x as f32, v.y as f32, v.z as f32]
-        })
-        .collect();
+    let points = cloud.points.iter().map(|p| rotate_point(r, p)).collect();
     PointCloud { points }
+}
+
+/// One point of [`rotate`]: `r · p` in f64, stored as f32.
+#[inline]
+pub(crate) fn rotate_point(r: &Matrix3<f64>, p: &[f32; 3]) -> [f32; 3] {
+    let v = r * Vector3::new(f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+    [v.x as f32, v.y as f32, v.z as f32]
 }
 
 #[cfg(test)]

@@ -135,6 +135,40 @@ pub enum SurfaceError {
         /// What is wrong.
         problem: String,
     },
+    /// The files of a survey do not belong together (scale or coordinate
+    /// system differ), or one is not a LAS/LAZ file.
+    #[error("{path}: {problem}")]
+    Survey {
+        /// The file at fault.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// A tile (with its margin) needs more memory than the limit allows.
+    #[error(
+        "tile {tile} holds {points} points with its margin, about {need} of working memory, \
+         more than the limit of {limit}: give a smaller tile (--tile-size) or a larger limit \
+         (--memory-limit)"
+    )]
+    TileTooLarge {
+        /// The tile, as `(column, row)` and its box.
+        tile: String,
+        /// Points of the tile and its margin.
+        points: u64,
+        /// The memory they need, in words.
+        need: String,
+        /// The limit, in words.
+        limit: String,
+    },
+    /// A tile's working file could not be written or read back.
+    #[error("tile working file {path}: {source}")]
+    Spill {
+        /// The file.
+        path: std::path::PathBuf,
+        /// Why.
+        #[source]
+        source: std::io::Error,
+    },
     /// The scan holds no finite point.
     #[error("the scan holds no finite points ({non_finite_dropped} non-finite dropped)")]
     NoFinitePoints {

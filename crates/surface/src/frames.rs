@@ -149,7 +149,7 @@ pub struct FrameOptions {
 /// frame's cleaned cloud (grown by a tenth on every side), each cell the
 /// mean height of the cleaned points of the latest frame that saw it, in
 /// the levelled frame.
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, PartialEq)]
 pub struct HeightModel {
     /// x, y of the grid's lower corner [m].
     pub origin: [f64; 2],
@@ -193,19 +193,32 @@ impl HeightModel {
             non_finite_dropped: 0,
         })?;
         let grow = |a: usize| 0.1 * f64::from(hi[a] - lo[a]);
-        let origin = [0, 1].map(|a| f64::from(lo[a]) - grow(a));
-        let size = [0, 1].map(|a| {
-            (((f64::from(hi[a]) + grow(a) - origin[a]) / cell_m).ceil() as usize).clamp(1, 1 << 14)
-        });
+        Ok(Self::over_box(
+            [0, 1].map(|a| f64::from(lo[a]) - grow(a)),
+            [0, 1].map(|a| f64::from(hi[a]) + grow(a)),
+            cell_m,
+        ))
+    }
+
+    /// An empty model over the rectangle `lo`–`hi` (x, y) [m], of cells
+    /// `cell_m` wide (at most 16 384 a side: coarser cells past that).
+    pub fn over_box(lo: [f64; 2], hi: [f64; 2], cell_m: f64) -> Self {
+        let origin = lo;
+        let side = (0..2)
+            .map(|a| (hi[a] - lo[a]) / 16384.0)
+            .fold(cell_m, f64::max);
+        let cell_m = side;
+        let size =
+            [0, 1].map(|a| (((hi[a] - origin[a]) / cell_m).ceil() as usize).clamp(1, 1 << 14));
         let cells = size[0] * size[1];
-        Ok(Self {
+        Self {
             origin,
             cell_m,
             size,
             z: vec![f64::NAN; cells],
             seen: vec![0; cells],
             last: vec![0; cells],
-        })
+        }
     }
 
     /// The cell of (x, y), if inside.

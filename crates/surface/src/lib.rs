@@ -37,6 +37,7 @@ pub mod perceive;
 mod pile;
 mod ransac;
 mod sample;
+pub mod tiles;
 mod volume;
 
 pub use calibrate::{angles_from_normal, level, level_from_sensor, sensor_from_level, tilt};

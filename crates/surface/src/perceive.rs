@@ -657,6 +657,17 @@ pub fn scale_and_spacing(cloud: &PointCloud, params: &PerceptionParams) -> Resul
     let (lo, hi) = cloud.bounds().ok_or(SurfaceError::NoFinitePoints {
         non_finite_dropped: 0,
     })?;
+    scale_and_spacing_of(lo, hi, cloud.len() as u64, params)
+}
+
+/// [`scale_and_spacing`] of a cloud of `n` points with bounds `lo`, `hi`
+/// (a survey read in pieces).
+pub fn scale_and_spacing_of(
+    lo: [f32; 3],
+    hi: [f32; 3],
+    n: u64,
+    params: &PerceptionParams,
+) -> Result<(f64, f64)> {
     let scale = match params.scale {
         ScaleSetting::Factor(s) if s.is_finite() && s > 0.0 => s,
         ScaleSetting::Factor(s) => {
@@ -682,7 +693,7 @@ pub fn scale_and_spacing(cloud: &PointCloud, params: &PerceptionParams) -> Resul
         }
         ScaleSetting::Word(AutoWord::Auto) => {
             let area = f64::from(hi[0] - lo[0]) * f64::from(hi[1] - lo[1]);
-            let s = (area / cloud.len() as f64).sqrt();
+            let s = (area / n as f64).sqrt();
             if !(s.is_finite() && s > 0.0) {
                 return Err(SurfaceError::NoHorizontalExtent);
             }
@@ -965,7 +976,7 @@ pub fn perceive_after(
 /// an emptied cloud names the TOML keys to change, and a bad value says
 /// which setting it came from (the filters speak of `radius_m`, `leaf_m`;
 /// the settings of spacings).
-fn in_settings_terms(
+pub(crate) fn in_settings_terms(
     stage: &str,
     e: autoshovel_cloud::CloudError,
     p: &PerceptionParams,

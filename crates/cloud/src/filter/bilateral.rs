@@ -123,6 +123,10 @@ pub fn bilateral_normal_smoothing(
         let current = tree.points();
         points = tree.map_points(Vec::new, |found, pos, p| {
             tree.within(p, r2, found);
+            // In input order, so that the sums' rounding does not depend on
+            // the tree (the same points give the same result in any cloud
+            // that holds their neighbourhood: a tile with its margin).
+            found.sort_unstable_by_key(|&q| tree.id(q as usize));
             let Some(n) = pca_normal(found.iter().map(|&q| current[q as usize])) else {
                 return *p;
             };

@@ -114,7 +114,7 @@ impl KdTree {
     }
 
     /// The input index of the point at tree position `pos`.
-    #[cfg(test)]
+    #[inline]
     pub(crate) fn id(&self, pos: usize) -> usize {
         self.ids[pos] as usize
     }

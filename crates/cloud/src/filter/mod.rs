@@ -38,7 +38,8 @@ pub use radius_outlier::{
     radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams,
 };
 pub use statistical_outlier::{
-    statistical_outlier_removal, statistical_outlier_removal_indices, OutlierSides,
+    mean_distances_and_reach, mean_distances_and_reach_at, statistical_outlier_removal,
+    statistical_outlier_removal_indices, DistanceSums, OutlierCut, OutlierSides,
     StatisticalOutlierParams,
 };
-pub use voxel_grid::{voxel_grid, VoxelGridParams};
+pub use voxel_grid::{voxel_grid, VoxelCells, VoxelGridParams};

@@ -161,54 +161,145 @@ pub fn statistical_outlier_removal(
 /// nearest first, divided by k, stored as f32).
 pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f32> {
     let tree = KdTree::new(points);
-    tree.map_k_nearest_distances(mean_k + 1, |nearest| {
-        let sum = nearest[1..]
-            .iter()
-            .fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
-        (sum / mean_k as f64) as f32
-    })
+    tree.map_k_nearest_distances(mean_k + 1, |nearest| mean_of(nearest, mean_k))
+}
+
+/// The mean distance d̄_i of every point to its k nearest neighbours (as
+/// [`statistical_outlier_removal`] computes it) and the squared distance
+/// to the k-th of them: how far the point's neighbourhood reaches, so that a
+/// caller holding part of a larger cloud (a tile with its margin) can tell
+/// whether the neighbours it did not load could have mattered.
+pub fn mean_distances_and_reach(points: &[Point], mean_k: usize) -> Result<Vec<(f32, f32)>> {
+    enough_points(points.len(), mean_k)?;
+    let tree = KdTree::new(points);
+    Ok(tree.map_k_nearest_distances(mean_k + 1, |nearest| {
+        (mean_of(nearest, mean_k), nearest[nearest.len() - 1])
+    }))
+}
+
+/// `mean_k` nearest neighbours need `mean_k + 1` points.
+fn enough_points(n: usize, mean_k: usize) -> Result<()> {
+    if mean_k == 0 || mean_k >= n {
+        return Err(bad(
+            FILTER,
+            format!(
+                "mean_k = {mean_k} needs at least {} finite points, the cloud has {n}",
+                mean_k + 1,
+            ),
+        ));
+    }
+    Ok(())
+}
+
+/// [`mean_distances_and_reach`] of the points `queries` among `points`
+/// (each query one of `points`: the first of its k + 1 nearest is itself).
+pub fn mean_distances_and_reach_at(
+    points: &[Point],
+    queries: &[Point],
+    mean_k: usize,
+) -> Result<Vec<(f32, f32)>> {
+    use rayon::prelude::*;
+    enough_points(points.len(), mean_k)?;
+    let tree = KdTree::new(points);
+    Ok(queries
+        .par_iter()
+        .map_init(
+            || super::kdtree::Nearest::new(mean_k + 1),
+            |knn, q| {
+                tree.nearest(q, knn);
+                let nearest = knn.distances();
+                (mean_of(nearest, mean_k), nearest[nearest.len() - 1])
+            },
+        )
+        .collect())
+}
+
+/// d̄_i from the k + 1 nearest squared distances, nearest first, as PCL
+/// computes it.
+fn mean_of(nearest: &[f32], mean_k: usize) -> f32 {
+    let sum = nearest[1..]
+        .iter()
+        .fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
+    (sum / mean_k as f64) as f32
+}
+
+/// The global sums of [RS eq. 14] in PCL's arithmetic (f64 sums, the square
+/// in f32), to be added in input order: the order fixes the rounding, so a
+/// caller that computes d̄_i by parts adds them back in the cloud's order.
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
+pub struct DistanceSums {
+    sum: f64,
+    sq_sum: f64,
+    n: u64,
+}
+
+impl DistanceSums {
+    /// Adds the next point's d̄_i.
+    #[inline]
+    pub fn add(&mut self, d: f32) {
+        self.sum += f64::from(d);
+        self.sq_sum += f64::from(d * d);
+        self.n += 1;
+    }
+
+    /// How many d̄_i were added.
+    pub fn count(&self) -> u64 {
+        self.n
+    }
+
+    /// The cut of [RS eq. 15]–[RS eq. 16] these sums give.
+    pub fn cut(&self, params: &StatisticalOutlierParams) -> OutlierCut {
+        let n = self.n as f64;
+        // [RS eq. 14]: the mean d̄ and standard deviation δ (n − 1) of the mean distances;
+        let mean = self.sum / n;
+        let variance = (self.sq_sum - self.sum * self.sum / n) / (n - 1.0);
+        // [RS eq. 15]: d̄_i ~ N(d̄, δ²), so the cut sits at d̄ + α·δ.
+        let spread = params.std_mul * variance.sqrt();
+        let threshold = mean + spread;
+        // [RS eq. 16]: removed when d̄_i > threshold (PCL), or also when
+        // d̄_i < d̄ − α·δ (two-sided); a NaN threshold removes nothing.
+        let low = match params.sides {
+            OutlierSides::Above => f64::NEG_INFINITY,
+            OutlierSides::Both => mean - spread,
+        };
+        OutlierCut {
+            low,
+            high: threshold,
+        }
+    }
+}
+
+/// Which d̄_i are kept ([RS eq. 16]).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct OutlierCut {
+    /// Kept at or above (−∞ one-sided).
+    pub low: f64,
+    /// Kept at or below; NaN keeps every point, as in PCL.
+    pub high: f64,
+}
+
+impl OutlierCut {
+    /// Whether a point with mean distance `d` is kept.
+    #[inline]
+    pub fn keeps(&self, d: f32) -> bool {
+        let d = f64::from(d);
+        self.high.is_nan() || (d <= self.high && d >= self.low)
+    }
 }
 
 /// The kept indices of `points` (all finite, not empty).
 fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<Vec<usize>> {
-    if params.mean_k >= points.len() {
-        return Err(bad(
-            FILTER,
-            format!(
-                "mean_k = {} needs at least {} finite points, the cloud has {}",
-                params.mean_k,
-                params.mean_k + 1,
-                points.len()
-            ),
-        ));
-    }
+    enough_points(points.len(), params.mean_k)?;
     let distances = mean_neighbour_distances(points, params.mean_k);
-    // Eq. 14 in PCL's arithmetic: sequential f64 sums, the square in f32.
-    let (mut sum, mut sq_sum) = (0.0_f64, 0.0_f64);
+    let mut sums = DistanceSums::default();
     for &d in &distances {
-        sum += f64::from(d);
-        sq_sum += f64::from(d * d);
+        sums.add(d);
     }
-    let n = distances.len() as f64;
-    // [RS eq. 14]: the mean d̄ and standard deviation δ (n − 1) of the mean distances;
-    let mean = sum / n;
-    let variance = (sq_sum - sum * sum / n) / (n - 1.0);
-    // [RS eq. 15]: d̄_i ~ N(d̄, δ²), so the cut sits at d̄ + α·δ.
-    let spread = params.std_mul * variance.sqrt();
-    let threshold = mean + spread;
-    // [RS eq. 16]: removed when d̄_i > threshold (PCL), or also when
-    // d̄_i < d̄ − α·δ (two-sided); a NaN threshold removes nothing.
-    let low = match params.sides {
-        OutlierSides::Above => f64::NEG_INFINITY,
-        OutlierSides::Both => mean - spread,
-    };
+    let cut = sums.cut(params);
     Ok(distances
         .iter()
         .enumerate()
-        .filter(|(_, &d)| {
-            let d = f64::from(d);
-            threshold.is_nan() || (d <= threshold && d >= low)
-        })
+        .filter(|(_, &d)| cut.keeps(d))
         .map(|(i, _)| i)
         .collect())
 }

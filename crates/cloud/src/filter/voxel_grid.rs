@@ -205,6 +205,30 @@ pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointC
     Ok(PointCloud::new(centroids))
 }
 
+/// The voxel of a point as [`voxel_grid`] computes it (PCL's
+/// `floor(p · (1 / leaf))` in f32), for a caller that must know which
+/// points share a voxel before calling it (a tile deciding which voxels
+/// are its own).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VoxelCells {
+    inv: [f32; 3],
+}
+
+impl VoxelCells {
+    /// The cells of `params`' leaf (an error for a leaf [`voxel_grid`] refuses).
+    pub fn new(params: &VoxelGridParams) -> Result<Self> {
+        Ok(Self {
+            inv: params.inverse_leaf()?,
+        })
+    }
+
+    /// The voxel (x, y, z indices) of the finite point `p`.
+    #[inline]
+    pub fn of(&self, p: &Point) -> [i64; 3] {
+        [0, 1, 2].map(|a| floor_i64(p[a] * self.inv[a]))
+    }
+}
+
 /// Points a bucket of [`bucketed_centroids`] holds on average (at most).
 const BUCKET: usize = 8;
 

@@ -207,18 +207,52 @@ impl<R: BufRead> BufRead for Input<'_, R> {
     }
 }
 
-/// The points read so far, with the non-finite ones counted, not kept.
-#[derive(Debug, Default)]
-pub(crate) struct Points {
-    /// The finite points.
+/// The points read so far, with the non-finite ones counted, not kept;
+/// when streaming ([`Points::streaming`]), handed on a chunk at a time.
+#[derive(Default)]
+pub(crate) struct Points<'s> {
+    /// The finite points (when streaming, those not yet handed on).
     pub(crate) points: Vec<Point>,
     /// How many non-finite points were dropped.
     pub(crate) non_finite: usize,
     /// Columns of a text header other than x, y and z.
     pub(crate) ignored_columns: usize,
+    /// Chunk size and the receiver of full chunks, when streaming.
+    sink: Option<(usize, Sink<'s>)>,
+    /// Points handed to the sink so far.
+    pub(crate) streamed: u64,
 }
 
-impl Points {
+/// The receiver of a stream's chunks.
+pub(crate) type Sink<'s> = &'s mut dyn FnMut(&[Point]) -> crate::Result<()>;
+
+impl<'s> Points<'s> {
+    /// Points that go to `sink` in chunks of `chunk`, not kept.
+    pub(crate) fn streaming(chunk: usize, sink: Sink<'s>) -> Self {
+        Self {
+            sink: Some((chunk.max(1), sink)),
+            ..Self::default()
+        }
+    }
+
+    /// Hands the points held to the sink when a chunk is full (or, with
+    /// `all`, whatever is held); without a sink, nothing.
+    pub(crate) fn hand_on(&mut self, all: bool) -> crate::Result<()> {
+        if let Some((chunk, sink)) = &mut self.sink {
+            if self.points.len() >= *chunk || (all && !self.points.is_empty()) {
+                sink(&self.points)?;
+                self.streamed += self.points.len() as u64;
+                self.points.clear();
+            }
+        }
+        Ok(())
+    }
+
+    /// Whether points go to a sink rather than stay.
+    pub(crate) fn is_streaming(&self) -> bool {
+        self.sink.is_some()
+    }
+
     /// Reserves room for at most `claimed` points, never more than
     /// `bytes_left / min_bytes_per_point`: a header's count is a claim,
     /// the file's size is a fact.
@@ -228,6 +262,9 @@ impl Points {
         bytes_left: u64,
         min_bytes_per_point: u64,
     ) {
+        if self.is_streaming() {
+            return;
+        }
         let possible = bytes_left / min_bytes_per_point.max(1);
         let n = claimed.min(possible);
         if let Ok(n) = usize::try_from(n) {

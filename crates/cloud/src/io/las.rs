@@ -501,7 +501,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
     total: u64,
     path: &Path,
     progress: &mut dyn FnMut(u64, u64),
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<&'static str> {
     progress(0, total);
     let c = check(&mut src, total).map_err(|what| CloudError::Format {
@@ -532,6 +532,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             .map_err(|e| las_err(path, e, Some(i), &c, total))?
         {
             out.push([p.x as f32, p.y as f32, p.z as f32]);
+            out.hand_on(false)?;
             i += 1;
             if i.is_multiple_of(PROGRESS_POINTS) {
                 let done = if c.compressed {
@@ -542,10 +543,81 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
                 progress(done.min(total), total);
             }
         }
-        Ok(())
+        out.hand_on(true)
     })?;
     progress(total, total);
-    Ok(match (c.compressed, c.major, c.minor) {
+    Ok(version_name(c.compressed, c.major, c.minor))
+}
+
+/// What a LAS or LAZ file's header says: enough to lay tiles over a
+/// survey and to check that its files agree, without reading a point.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LasHeader {
+    /// E.g. `"laz 1.4"`.
+    pub format: &'static str,
+    /// The point count of the header.
+    pub points: u64,
+    /// Scale factor per axis [m per step].
+    pub scale: [f64; 3],
+    /// Offset per axis [m].
+    pub offset: [f64; 3],
+    /// The header's bounds [m].
+    pub min: [f64; 3],
+    /// The header's bounds [m].
+    pub max: [f64; 3],
+    /// The coordinate system records (`LASF_Projection`: GeoTIFF keys
+    /// 34735–34737, WKT 2111–2112), as (record id, bytes), in record-id
+    /// order; empty when the file states none.
+    pub crs: Vec<(u16, Vec<u8>)>,
+}
+
+/// Reads the header of the LAS or LAZ stream `src` of `total` bytes (after
+/// the same checks as [`read`]).
+pub(crate) fn header<R: Read + Seek + Send + Sync + 'static>(
+    mut src: R,
+    total: u64,
+    path: &Path,
+) -> crate::Result<LasHeader> {
+    let c = check(&mut src, total).map_err(|what| CloudError::Format {
+        path: path.to_path_buf(),
+        what,
+    })?;
+    src.seek(SeekFrom::Start(0))
+        .map_err(|source| CloudError::Io {
+            path: path.to_path_buf(),
+            source,
+        })?;
+    let src = Patched {
+        inner: src,
+        pos: 0,
+        patch: c.patch,
+    };
+    without_panics(path, || {
+        let reader = las::Reader::new(src).map_err(|e| las_err(path, e, None, &c, total))?;
+        let h = reader.header();
+        let t = h.transforms();
+        let b = h.bounds();
+        let mut crs: Vec<(u16, Vec<u8>)> = h
+            .all_vlrs()
+            .filter(|v| v.user_id == "LASF_Projection")
+            .map(|v| (v.record_id, v.data.clone()))
+            .collect();
+        crs.sort();
+        Ok(LasHeader {
+            format: version_name(c.compressed, c.major, c.minor),
+            points: c.count,
+            scale: [t.x.scale, t.y.scale, t.z.scale],
+            offset: [t.x.offset, t.y.offset, t.z.offset],
+            min: [b.min.x, b.min.y, b.min.z],
+            max: [b.max.x, b.max.y, b.max.z],
+            crs,
+        })
+    })
+}
+
+/// The name of a LAS version, e.g. `"laz 1.4"`.
+fn version_name(compressed: bool, major: u8, minor: u8) -> &'static str {
+    match (compressed, major, minor) {
         (false, 1, 0) => "las 1.0",
         (false, 1, 1) => "las 1.1",
         (false, 1, 2) => "las 1.2",
@@ -558,7 +630,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
         (true, 1, 3) => "laz 1.3",
         (true, 1, 4) => "laz 1.4",
         (true, _, _) => "laz",
-    })
+    }
 }
 
 /// LAS version written.

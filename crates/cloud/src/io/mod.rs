@@ -32,6 +32,6 @@ mod write;
 mod xyz;
 
 pub use format::{Encoding, Format};
-pub use las::{LasVersion, LAS_SCALE_M, LAZ_MAX_POINTS_PER_BYTE, LAZ_MIN_CHUNK_BYTES};
-pub use read::{read, read_from_bytes, ReadReport};
+pub use las::{LasHeader, LasVersion, LAS_SCALE_M, LAZ_MAX_POINTS_PER_BYTE, LAZ_MIN_CHUNK_BYTES};
+pub use read::{las_header, read, read_chunks, read_from_bytes, ReadReport, StreamReport};
 pub use write::{write, write_with, WriteOptions};

@@ -320,7 +320,7 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
 /// Reads a PCD stream into `out`; returns the format's name.
 pub(crate) fn read<R: BufRead>(
     input: &mut Input<'_, R>,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<&'static str> {
     let h = read_header(input)?;
     match h.data {
@@ -333,7 +333,7 @@ pub(crate) fn read<R: BufRead>(
 fn read_ascii<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<()> {
     // At least "0 " per value.
     out.reserve_bounded(h.points, input.remaining(), 2 * h.values_per_point as u64);
@@ -446,7 +446,7 @@ fn check_padding<R: BufRead>(input: &mut Input<'_, R>, extra: u64) -> crate::Res
 fn read_binary<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<()> {
     let step = h.point_step;
     let extra = check_data_size(input, h.points.checked_mul(step as u64), h, "binary data")?;
@@ -486,7 +486,7 @@ fn f32le(b: &[u8]) -> f32 {
 fn read_compressed<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<()> {
     let at = input.pos();
     let mut sizes = [0u8; 8];

@@ -189,7 +189,7 @@ fn vertex_axes<R: BufRead>(
 /// Reads a PLY stream into `out`; returns the format's name.
 pub(crate) fn read<R: BufRead>(
     input: &mut Input<'_, R>,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<&'static str> {
     let h = read_header(input)?;
     let vertex = h.elements.iter().position(|e| e.name == "vertex");
@@ -227,7 +227,7 @@ fn read_binary_element<R: BufRead>(
     input: &mut Input<'_, R>,
     el: &Element,
     big: bool,
-    vertex: Option<([(usize, Scalar); 3], &mut Points)>,
+    vertex: Option<([(usize, Scalar); 3], &mut Points<'_>)>,
 ) -> crate::Result<()> {
     if let Some(size) = el.fixed_size() {
         let total = el.count.checked_mul(size as u64).ok_or_else(|| {
@@ -337,7 +337,7 @@ fn read_ascii<R: BufRead>(
     h: &Header,
     vertex: usize,
     axes: [(usize, Scalar); 3],
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<()> {
     let mut line = Vec::new();
     let mut line_no = h.lines;

@@ -7,7 +7,8 @@ use std::io::{BufRead, BufReader, Cursor};
 use std::path::{Path, PathBuf};
 
 use super::input::{Input, Points};
-use super::{las, pcd, ply, xyz, Format};
+use super::las::{self, LasHeader};
+use super::{pcd, ply, xyz, Format};
 use crate::{CloudError, PointCloud};
 
 /// Buffer size of file readers [bytes].
@@ -61,12 +62,7 @@ impl fmt::Display for ReadReport {
 /// merely claims is allocated.
 pub fn read(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> crate::Result<ReadReport> {
     let format = Format::from_path(path)?;
-    let io = |source| CloudError::Io {
-        path: path.to_path_buf(),
-        source,
-    };
-    let file = File::open(path).map_err(io)?;
-    let total = file.metadata().map_err(io)?.len();
+    let (file, total) = open(path)?;
     let mut out = Points::default();
     let name = match format {
         Format::Las | Format::Laz => las::read(
@@ -87,6 +83,83 @@ pub fn read(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> crate::Result<Re
         }
     };
     Ok(report(out, name))
+}
+
+/// What [`read_chunks`] found.
+#[derive(Debug, Clone, PartialEq, Eq)]
+pub struct StreamReport {
+    /// Finite points handed on.
+    pub points: u64,
+    /// Points dropped because a coordinate was NaN or infinite.
+    pub non_finite_dropped: usize,
+    /// The format and encoding read, as [`ReadReport::format`].
+    pub format: &'static str,
+}
+
+/// Reads `path` as [`read`] does, handing the finite points on in file
+/// order, at most `chunk` at a time, to `on_chunk`, whose error stops the
+/// read. LAS and LAZ are decoded point by point, so memory stays at one
+/// chunk whatever the file's size (a survey of 100 M points); the other
+/// formats are read whole first, then handed on.
+pub fn read_chunks(
+    path: &Path,
+    chunk: usize,
+    progress: &mut dyn FnMut(u64, u64),
+    on_chunk: &mut dyn FnMut(&[crate::Point]) -> crate::Result<()>,
+) -> crate::Result<StreamReport> {
+    let format = Format::from_path(path)?;
+    if !matches!(format, Format::Las | Format::Laz) {
+        let r = read(path, progress)?;
+        for c in r.cloud.points.chunks(chunk.max(1)) {
+            on_chunk(c)?;
+        }
+        return Ok(StreamReport {
+            points: r.cloud.len() as u64,
+            non_finite_dropped: r.non_finite_dropped,
+            format: r.format,
+        });
+    }
+    let (file, total) = open(path)?;
+    let mut out = Points::streaming(chunk, on_chunk);
+    let name = las::read(
+        BufReader::with_capacity(BUFFER, file),
+        total,
+        path,
+        progress,
+        &mut out,
+    )?;
+    Ok(StreamReport {
+        points: out.streamed,
+        non_finite_dropped: out.non_finite,
+        format: name,
+    })
+}
+
+/// The header of the LAS or LAZ file `path` (its count, scale, offset,
+/// bounds and coordinate system), checked as [`read`] checks it; no point
+/// is decoded.
+pub fn las_header(path: &Path) -> crate::Result<LasHeader> {
+    match Format::from_path(path)? {
+        Format::Las | Format::Laz => {
+            let (file, total) = open(path)?;
+            las::header(BufReader::with_capacity(1 << 16, file), total, path)
+        }
+        f => Err(CloudError::Format {
+            path: path.to_path_buf(),
+            what: format!("not a LAS or LAZ file (a .{} file)", f.extension()),
+        }),
+    }
+}
+
+/// Opens `path` and reads its size.
+fn open(path: &Path) -> crate::Result<(File, u64)> {
+    let io = |source| CloudError::Io {
+        path: path.to_path_buf(),
+        source,
+    };
+    let file = File::open(path).map_err(io)?;
+    let total = file.metadata().map_err(io)?.len();
+    Ok((file, total))
 }
 
 /// Reads a cloud from memory, through the same readers as [`read`]
@@ -117,7 +190,7 @@ pub fn read_from_bytes(format: Format, bytes: &[u8]) -> crate::Result<ReadReport
 fn read_text_or_binary<R: BufRead>(
     format: Format,
     input: &mut Input<'_, R>,
-    out: &mut Points,
+    out: &mut Points<'_>,
 ) -> crate::Result<&'static str> {
     let name = match format {
         Format::Pcd => pcd::read(input, out)?,
@@ -136,7 +209,7 @@ fn read_text_or_binary<R: BufRead>(
     Ok(name)
 }
 
-fn report(out: Points, format: &'static str) -> ReadReport {
+fn report(out: Points<'_>, format: &'static str) -> ReadReport {
     let mut points = out.points;
     points.shrink_to_fit();
     ReadReport {

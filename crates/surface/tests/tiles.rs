@@ -1,0 +1,242 @@
+//! Tiles give the whole cloud's result: a survey perceived by tiles much
+//! smaller than the pile (so that many points, outliers among them, lie near
+//! a tile edge) keeps, stage by stage, the same number of points as the
+//! whole-cloud pipeline with the same roll, pitch and floor, and its cleaned
+//! cloud is the whole cloud's bit for bit (as a set: tiles hand points on
+//! tile by tile). Also: a survey in several files is the concatenation of
+//! its files, files that do not share a scale are refused naming the file,
+//! a tile over the memory limit is refused naming the tile, and no working
+//! file is left behind.
+
+use std::path::{Path, PathBuf};
+
+use autoshovel_cloud::io::{read, write, Encoding};
+use autoshovel_cloud::{Point, PointCloud};
+use autoshovel_surface::perceive::{perceive_after, PerceptionParams, Prior};
+use autoshovel_surface::tiles::{perceive_tiled, Survey, TileOptions, TiledPerceived};
+use autoshovel_surface::{generate_pile, PileParams, ScanPattern, SurfaceError};
+
+fn dir(name: &str) -> PathBuf {
+    let d = std::env::temp_dir().join(format!("autoshovel-tiles-{name}-{}", std::process::id()));
+    let _ = std::fs::remove_dir_all(&d);
+    std::fs::create_dir_all(&d).unwrap();
+    d
+}
+
+fn pile(points: usize, seed: u64, pattern: ScanPattern) -> PointCloud {
+    generate_pile(&PileParams {
+        points,
+        seed,
+        pattern,
+        ..PileParams::default()
+    })
+    .expect("pile")
+}
+
+fn options(tile_m: f64, work: &Path) -> TileOptions {
+    TileOptions {
+        tile_m: Some(tile_m),
+        sample_points: 50_000,
+        work_dir: work.to_path_buf(),
+        ..TileOptions::default()
+    }
+}
+
+/// The survey by tiles, and its cleaned points gathered.
+fn tiled(
+    files: &[PathBuf],
+    params: &PerceptionParams,
+    opt: &TileOptions,
+) -> (TiledPerceived, Vec<Point>) {
+    let survey = Survey::open(files).expect("survey");
+    let mut cleaned = Vec::new();
+    let got = perceive_tiled(&survey, params, opt, &mut |_, _, _| {}, &mut |tile| {
+        cleaned.extend_from_slice(&tile.cloud.points);
+        Ok(())
+    })
+    .expect("tiled");
+    (got, cleaned)
+}
+
+fn sorted_bits(points: &[Point]) -> Vec<[u32; 3]> {
+    let mut v: Vec<[u32; 3]> = points.iter().map(|p| p.map(f32::to_bits)).collect();
+    v.sort_unstable();
+    v
+}
+
+/// The tiled run against the whole cloud with the same roll, pitch, floor,
+/// scale and spacing.
+fn check_against_whole(
+    whole: &PointCloud,
+    params: &PerceptionParams,
+    got: &TiledPerceived,
+    cleaned: &[Point],
+) {
+    let prior = Prior {
+        roll_rad: got.roll_rad,
+        pitch_rad: got.pitch_rad,
+        floor: got.floor.clone(),
+        scale: got.scale,
+        spacing_m: got.spacing_m,
+    };
+    let reference = perceive_after(whole, params, Some(&prior), &mut |_| {}).expect("whole");
+    assert_eq!(got.input_points, whole.len() as u64);
+    let counts =
+        |stages: &[autoshovel_surface::perceive::StageRecord]| -> Vec<(&'static str, usize)> {
+            stages
+                .iter()
+                .filter(|s| !matches!(s.stage, "read" | "level" | "fit"))
+                .map(|s| (s.stage, s.points))
+                .collect()
+        };
+    println!(
+        "tiles {:?} of {} m, halo {:.3} m, {} searched again; stages {:?}",
+        got.grid,
+        got.tile_m,
+        got.halo_m,
+        got.statistical_researched,
+        counts(&got.stages)
+    );
+    assert_eq!(counts(&got.stages), counts(&reference.stages));
+    assert_eq!(cleaned.len() as u64, got.output_points);
+    assert!(
+        sorted_bits(cleaned) == sorted_bits(&reference.cloud.points),
+        "the cleaned points differ from the whole cloud's"
+    );
+}
+
+#[test]
+fn tiles_keep_what_the_whole_cloud_keeps_bit_for_bit() {
+    let d = dir("whole");
+    let file = d.join("pile.laz");
+    write(
+        &file,
+        &pile(120_000, 7, ScanPattern::Rosette),
+        Encoding::Binary,
+    )
+    .expect("write");
+    // The whole cloud as the survey reader sees it (LAZ stores millimetres).
+    let whole = read(&file, &mut |_, _| {}).expect("read").cloud;
+    let params = PerceptionParams::default();
+    // Tiles of 3 m over a ~30 m pile: about a hundred, most points within a
+    // few halos of an edge.
+    let (got, cleaned) = tiled(&[file], &params, &options(3.0, &d));
+    assert!(got.tiles_used >= 30, "{} tiles used", got.tiles_used);
+    assert!(
+        got.statistical_researched > 0,
+        "no outlier needed a wider search"
+    );
+    check_against_whole(&whole, &params, &got, &cleaned);
+    // Nothing left in the work folder but the survey itself.
+    let left: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_survey_in_several_files_is_their_concatenation() {
+    let d = dir("files");
+    let scan = pile(80_000, 11, ScanPattern::Area);
+    // Three files of unequal parts, as a survey's flight lines might be.
+    let cuts = [0, 17_000, 55_000, scan.len()];
+    let mut files = Vec::new();
+    for (i, w) in cuts.windows(2).enumerate() {
+        let f = d.join(format!("part-{i}.laz"));
+        write(
+            &f,
+            &PointCloud::new(scan.points[w[0]..w[1]].to_vec()),
+            Encoding::Binary,
+        )
+        .unwrap();
+        files.push(f);
+    }
+    let mut whole = Vec::new();
+    for f in &files {
+        whole.extend(read(f, &mut |_, _| {}).unwrap().cloud.points);
+    }
+    let params = PerceptionParams::default();
+    // The folder, read in natural order, is the same survey.
+    let (got, cleaned) = tiled(&[d.clone()], &params, &options(4.0, &d));
+    check_against_whole(&PointCloud::new(whole), &params, &got, &cleaned);
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn files_of_another_scale_are_refused_naming_the_file() {
+    let d = dir("scale");
+    let scan = pile(20_000, 3, ScanPattern::Area);
+    let a = d.join("a.las");
+    write(&a, &scan, Encoding::Binary).unwrap();
+    // The same points at a 1 cm scale: written by hand with `las`.
+    let b = d.join("b.las");
+    let mut builder = las::Builder::from((1, 2));
+    builder.transforms = las::Vector {
+        x: las::Transform {
+            scale: 0.01,
+            offset: 0.0,
+        },
+        y: las::Transform {
+            scale: 0.01,
+            offset: 0.0,
+        },
+        z: las::Transform {
+            scale: 0.01,
+            offset: 0.0,
+        },
+    };
+    let mut w = las::Writer::from_path(&b, builder.into_header().unwrap()).unwrap();
+    for p in &scan.points {
+        w.write_point(las::Point {
+            x: f64::from(p[0]),
+            y: f64::from(p[1]),
+            z: f64::from(p[2]),
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+    drop(w);
+    let err = Survey::open(&[a, b.clone()]).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, SurfaceError::Survey { .. }), "{msg}");
+    assert!(
+        msg.starts_with(&b.display().to_string()) && msg.contains("scale"),
+        "{msg}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_tile_over_the_memory_limit_is_refused_naming_it_and_leaves_nothing() {
+    let d = dir("limit");
+    let file = d.join("pile.laz");
+    write(&file, &pile(40_000, 5, ScanPattern::Area), Encoding::Binary).unwrap();
+    let survey = Survey::open(&[file]).unwrap();
+    let opt = TileOptions {
+        memory_limit: 1 << 20,
+        ..options(100.0, &d)
+    };
+    let err = perceive_tiled(
+        &survey,
+        &PerceptionParams::default(),
+        &opt,
+        &mut |_, _, _| {},
+        &mut |_| Ok(()),
+    )
+    .unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, SurfaceError::TileTooLarge { .. }), "{msg}");
+    assert!(
+        msg.contains("tile (0, 0)") && msg.contains("--tile-size"),
+        "{msg}"
+    );
+    let left: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
