@@ -325,6 +325,73 @@ pub fn perceive_frames(
     })
 }
 
+/// `perceive --tiles`: a survey by tiles, with a progress bar over each
+/// pass; the cleaned tiles are written into the output's `tiles/` as LAZ
+/// as they come (staged: nothing is left of a failed run).
+pub fn perceive_tiles(
+    input: &Path,
+    params: &PerceptionParams,
+    mut options: autoshovel_surface::tiles::TileOptions,
+    out: Option<&OutDir>,
+    progress: bool,
+) -> Result<Job<autoshovel_surface::tiles::TiledSummary>> {
+    use autoshovel_surface::tiles::{perceive_tiled, Survey, TiledSummary};
+    let survey = Survey::open(&[input.to_path_buf()])?;
+    let staging = out.map(OutDir::stage).transpose()?;
+    let tiles_dir = staging.as_ref().map(|s| s.path().join("tiles"));
+    if let Some(s) = &staging {
+        options.work_dir = s.path().to_path_buf();
+    }
+    if let Some(d) = &tiles_dir {
+        std::fs::create_dir_all(d).with_context(|| format!("creating {}", d.display()))?;
+    }
+    let bar = progress_bar(
+        progress,
+        "{prefix:>18} [{bar:40}] {pos}/{len} ({eta}) {msg}",
+    );
+    let mut tile_files = Vec::new();
+    let got = perceive_tiled(
+        &survey,
+        params,
+        &options,
+        &mut |what, done, total| {
+            if bar.prefix() != what {
+                bar.set_prefix(what.to_string());
+                bar.reset();
+            }
+            bar.set_length(total);
+            bar.set_position(done);
+        },
+        &mut |tile| {
+            if let Some(d) = &tiles_dir {
+                let f = d.join(format!("tile-{:03}-{:03}.laz", tile.tile[0], tile.tile[1]));
+                autoshovel_cloud::io::write(
+                    &f,
+                    &tile.cloud,
+                    autoshovel_cloud::io::Encoding::Binary,
+                )?;
+                tile_files.push(f);
+            }
+            Ok(())
+        },
+    );
+    bar.finish_and_clear();
+    let got = got?;
+    let summary = TiledSummary::new(
+        &input.display().to_string(),
+        &survey,
+        params,
+        &options,
+        &got,
+    );
+    Job::finish_in(summary.clone(), staging, |dir, written| {
+        for f in &tile_files {
+            written.file(dir, f);
+        }
+        Ok(figures::tiles::write(dir, &got, &summary, written)?)
+    })
+}
+
 /// The pile of a scan for `plan-dig --cloud`: the perception pipeline, then
 /// the dig profile cut by the library's rule.
 pub fn scan_pile(

@@ -20,9 +20,23 @@ pub struct Args {
     /// Frame mode: search the floor and level again every N frames (0: once).
     #[arg(long, default_value_t = 0)]
     pub relevel_every: usize,
-    /// Frame mode: cell edge of the running height model [m] (default: 4 × the point spacing).
+    /// Frame mode: cell edge of the running height model [m] (default: 4 × the
+    /// point spacing); survey mode: of the survey's height model (default 1 m).
     #[arg(long)]
     pub model_cell: Option<f64>,
+    /// Survey mode: perceive a LAS/LAZ survey (a file, or a folder of
+    /// files taken as one survey) by tiles with halos, in bounded memory,
+    /// with the whole cloud's result; the cleaned tiles go to `--out`'s
+    /// `tiles/`.
+    #[arg(long)]
+    pub tiles: bool,
+    /// Survey mode: tile side [m] (default: from the memory limit and the
+    /// survey's density). Implies --tiles.
+    #[arg(long)]
+    pub tile_size: Option<f64>,
+    /// Survey mode: most working memory of a tile [GiB].
+    #[arg(long, default_value_t = 2.0)]
+    pub memory_limit: f64,
     /// Pipeline settings (TOML); defaults otherwise (`autoshovel perceive --print-config` shows them).
     #[arg(long)]
     pub config: Option<PathBuf>,
@@ -54,6 +68,56 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(input), args.config.as_deref()],
         args.output.force,
     )?;
+    if args.tiles || args.tile_size.is_some() {
+        if args.relevel_every != 0 {
+            anyhow::bail!("--relevel-every is for a folder of frames, not --tiles");
+        }
+        if !(args.memory_limit.is_finite() && args.memory_limit > 0.0) {
+            anyhow::bail!(
+                "--memory-limit {}: expected a size > 0 in GiB",
+                args.memory_limit
+            );
+        }
+        let defaults = autoshovel_surface::tiles::TileOptions::default();
+        let options = autoshovel_surface::tiles::TileOptions {
+            tile_m: args.tile_size,
+            memory_limit: (args.memory_limit * f64::from(1u32 << 30)) as u64,
+            model_cell_m: args.model_cell.unwrap_or(defaults.model_cell_m),
+            ..defaults
+        };
+        let job =
+            crate::jobs::perceive_tiles(input, &params, options, out.as_ref(), !args.output.json)?;
+        return job.report(args.output.json, |s| {
+            crate::say!(
+                "perceive {} by tiles: {} file(s), {} points in {} tiles of {:.1} m (halo {:.2} m)",
+                s.input,
+                s.files.len(),
+                s.input_points,
+                s.tiles_used,
+                s.tile_m,
+                s.halo_m
+            );
+            for st in &s.stages {
+                crate::say!("  {:<12} {:>11} points  {:>10.1} ms", st.stage, st.points, st.ms);
+            }
+            crate::say!(
+                "  {:.2} M points/s; largest tile {} points with its halo; peak memory {}; {} outlier(s) searched past the halo",
+                s.points_per_s / 1e6,
+                s.largest_tile_points,
+                s.peak_memory_bytes
+                    .map_or("unknown".into(), |b| format!("{:.2} GiB", b as f64 / f64::from(1u32 << 30))),
+                s.statistical_researched
+            );
+            crate::say!(
+                "  roll {:.3} deg, pitch {:.3} deg from a sample of {} points; fit degree {}, R² {:.4}",
+                s.roll_deg,
+                s.pitch_deg,
+                s.sample_points,
+                s.fit.degree,
+                s.r2
+            );
+        });
+    }
     if input.is_dir() {
         let options = autoshovel_surface::frames::FrameOptions {
             relevel_every: args.relevel_every,

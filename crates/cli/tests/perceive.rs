@@ -329,3 +329,120 @@ fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
         e.error_message()
     );
 }
+
+#[test]
+fn a_survey_by_tiles_writes_its_tiles_and_refuses_a_tile_over_the_limit() {
+    let dir = TempDir::new("survey");
+    let scan = dir.path().join("survey.laz");
+    run(&[
+        "generate-pile",
+        "--points",
+        "60000",
+        "--seed",
+        "4",
+        "--out",
+        scan.to_str().unwrap(),
+        "--json",
+    ])
+    .ok();
+    let out = dir.path().join("out");
+    let s = run(&[
+        "perceive",
+        "--input",
+        scan.to_str().unwrap(),
+        "--tile-size",
+        "8",
+        "--out",
+        out.to_str().unwrap(),
+        "--json",
+    ])
+    .ok()
+    .json();
+    assert_eq!(s["mode"], "tiles");
+    assert_eq!(s["input_points"], 60000);
+    for key in [
+        "roll_deg",
+        "pitch_deg",
+        "r2",
+        "output_points",
+        "peak_memory_bytes",
+        "halo_m",
+    ] {
+        assert!(s[key].is_number(), "{key}: {}", s[key]);
+    }
+    // Every cleaned point is in exactly one tile file.
+    let files: Vec<String> = s["files"]
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|f| f.as_str().unwrap().to_string())
+        .collect();
+    let tiles: Vec<&String> = files.iter().filter(|f| f.starts_with("tiles/")).collect();
+    assert_eq!(tiles.len() as u64, s["tiles_used"].as_u64().unwrap());
+    let mut points = 0;
+    for t in &tiles {
+        points += autoshovel_cloud::io::read(&out.join(t), &mut |_, _| {})
+            .unwrap()
+            .cloud
+            .len();
+    }
+    assert_eq!(points as u64, s["output_points"].as_u64().unwrap());
+    assert_written(
+        &out,
+        &s,
+        &[
+            "model.csv",
+            "stages.csv",
+            "model.svg",
+            "model.png",
+            "stages.svg",
+        ],
+    );
+    // No working file is left in the output.
+    let hidden: Vec<_> = std::fs::read_dir(&out)
+        .unwrap()
+        .filter_map(|e| e.ok())
+        .filter(|e| e.file_name().to_string_lossy().starts_with('.'))
+        .collect();
+    assert!(hidden.is_empty(), "{hidden:?}");
+    // A tile over the memory limit: a clear error, nothing written.
+    let out2 = dir.path().join("out2");
+    let e = run(&[
+        "perceive",
+        "--input",
+        scan.to_str().unwrap(),
+        "--tile-size",
+        "100",
+        "--memory-limit",
+        "0.001",
+        "--out",
+        out2.to_str().unwrap(),
+    ])
+    .fails();
+    assert!(
+        e.error_message().contains("tile (0, 0)"),
+        "{}",
+        e.error_message()
+    );
+    let left: Vec<_> = std::fs::read_dir(&out2)
+        .map(|d| d.filter_map(|e| e.ok()).collect())
+        .unwrap_or_default();
+    assert!(left.is_empty(), "{left:?}");
+    // A survey file that is not LAS/LAZ is refused by name.
+    let pcd = dir.path().join("scan.pcd");
+    run(&[
+        "generate-pile",
+        "--points",
+        "5000",
+        "--out",
+        pcd.to_str().unwrap(),
+        "--json",
+    ])
+    .ok();
+    let e = run(&["perceive", "--input", pcd.to_str().unwrap(), "--tiles"]).fails();
+    assert!(
+        e.error_message().contains("scan.pcd") && e.error_message().contains("LAS"),
+        "{}",
+        e.error_message()
+    );
+}

@@ -9,7 +9,7 @@ use autoshovel_cloud::io::{write as write_cloud, Encoding};
 use autoshovel_report::{
     write_csv, write_figure, write_heatmap, Figure, Heatmap, Layer, Rgb, Stroke, Written,
 };
-use autoshovel_surface::frames::FrameRun;
+use autoshovel_surface::frames::{FrameRun, HeightModel};
 use autoshovel_surface::perceive::STAGES;
 
 use crate::FiguresError;
@@ -121,26 +121,36 @@ pub fn write(dir: &Path, run: &FrameRun, written: &mut Written) -> Result<(), Fi
     }
     written.plot(dir, write_figure(&fig, dir, "latency")?);
     // The running model's height map.
-    let xs: Vec<f64> = (0..m.size[0]).map(|i| m.centre(i)[0]).collect();
-    let ys: Vec<f64> = (0..m.size[1]).map(|j| m.centre(j * m.size[0])[1]).collect();
-    let z: Vec<Vec<f64>> = (0..m.size[1])
-        .map(|j| (0..m.size[0]).map(|i| m.z[j * m.size[0] + i]).collect())
-        .collect();
-    let hm = Heatmap::new(
+    height_map(
+        dir,
+        m,
         format!(
             "Running height model after {} frames ({:.0} % of cells seen, {:.2} m cells)",
             s.frames_ok,
             100.0 * s.model_coverage,
             m.cell_m
         ),
-        "x [m]",
-        "y [m]",
-        xs,
-        ys,
-        z,
+        "model",
+        written,
     )
-    .z_label("height [m]")
-    .equal_aspect();
-    written.plot(dir, write_heatmap(&hm, dir, "model")?);
+}
+
+/// Writes the height map of `m` as `name`.svg/png under `dir`.
+pub fn height_map(
+    dir: &Path,
+    m: &HeightModel,
+    title: String,
+    name: &str,
+    written: &mut Written,
+) -> Result<(), FiguresError> {
+    let xs: Vec<f64> = (0..m.size[0]).map(|i| m.centre(i)[0]).collect();
+    let ys: Vec<f64> = (0..m.size[1]).map(|j| m.centre(j * m.size[0])[1]).collect();
+    let z: Vec<Vec<f64>> = (0..m.size[1])
+        .map(|j| (0..m.size[0]).map(|i| m.z[j * m.size[0] + i]).collect())
+        .collect();
+    let hm = Heatmap::new(title, "x [m]", "y [m]", xs, ys, z)
+        .z_label("height [m]")
+        .equal_aspect();
+    written.plot(dir, write_heatmap(&hm, dir, name)?);
     Ok(())
 }

@@ -18,6 +18,7 @@ pub mod map;
 pub mod perceive;
 pub mod shovel;
 pub mod study;
+pub mod tiles;
 pub mod track;
 pub mod tune;
 pub mod validate;

@@ -1050,6 +1050,22 @@ pub struct FitSummary {
     pub coefficients: Vec<Term>,
 }
 
+impl FitSummary {
+    /// The summary of `fit`.
+    pub fn of(fit: &SurfaceFit) -> Self {
+        Self {
+            degree: fit.degree,
+            r2: fit.r2,
+            adjusted_r2: fit.adjusted_r2,
+            rms_residual_m: fit.rms_residual_m,
+            r2_all_points: fit.r2_all_points,
+            rms_all_points_m: fit.rms_all_points_m,
+            samples: fit.samples.len(),
+            coefficients: fit.coefficients_xy(),
+        }
+    }
+}
+
 /// The summary of `autoshovel perceive` (SPEC §6).
 #[derive(Debug, Clone, Serialize)]
 pub struct PerceiveSummary {
@@ -1126,16 +1142,7 @@ impl PerceiveSummary {
             r2: fit.r2,
             timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
             total_ms: got.total_ms(),
-            fit: FitSummary {
-                degree: fit.degree,
-                r2: fit.r2,
-                adjusted_r2: fit.adjusted_r2,
-                rms_residual_m: fit.rms_residual_m,
-                r2_all_points: fit.r2_all_points,
-                rms_all_points_m: fit.rms_all_points_m,
-                samples: fit.samples.len(),
-                coefficients: fit.coefficients_xy(),
-            },
+            fit: FitSummary::of(fit),
             pipeline: params.clone(),
             success: true,
         }

@@ -50,6 +50,7 @@
 //! or not. Tiles are independent units of work within a stage: the same
 //! loop could hand them to other machines.
 
+use std::collections::BTreeMap;
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
@@ -65,6 +66,7 @@ use autoshovel_cloud::io::{las_header, read_chunks, LasHeader};
 use autoshovel_cloud::{CloudError, Point, PointCloud};
 use autoshovel_core::config;
 use nalgebra::Matrix3;
+use serde::Serialize;
 
 use crate::calibrate::{level, level_from_sensor, rotate_point};
 use crate::error::{Result, SurfaceError};
@@ -72,7 +74,7 @@ use crate::fit::{fit_surface, FitParams, SurfaceFit};
 use crate::floor::{estimate_tilt, TiltEstimate, TiltParams};
 use crate::frames::HeightModel;
 use crate::perceive::{
-    in_settings_terms, scale_and_spacing_of, LevelMode, PerceptionParams, StageRecord,
+    in_settings_terms, scale_and_spacing_of, FitSummary, LevelMode, PerceptionParams, StageRecord,
 };
 
 /// Working memory a point of a tile needs through the heaviest stage
@@ -300,6 +302,142 @@ impl TiledPerceived {
     /// Total time of the stages [ms].
     pub fn total_ms(&self) -> f64 {
         self.stages.iter().map(|s| s.ms).sum()
+    }
+}
+
+/// The summary of `autoshovel perceive --tiles` (`summary.json`): the
+/// fields of [`crate::perceive::PerceiveSummary`] (SPEC §6) and the tiles'.
+#[derive(Debug, Clone, Serialize)]
+pub struct TiledSummary {
+    /// "perceive".
+    pub job: &'static str,
+    /// "tiles".
+    pub mode: &'static str,
+    /// The survey as given.
+    pub input: String,
+    /// Its files.
+    pub files: Vec<String>,
+    /// The format read (the first file's).
+    pub format: &'static str,
+    /// Finite points read.
+    pub input_points: u64,
+    /// Non-finite points dropped while reading.
+    pub non_finite_dropped: u64,
+    /// Points of the cleaned survey.
+    pub output_points: u64,
+    /// Points after each stage, by stage name.
+    pub stage_points: BTreeMap<&'static str, usize>,
+    /// Every stage, in order.
+    pub stages: Vec<StageRecord>,
+    /// Roll α used to level [deg].
+    pub roll_deg: f64,
+    /// Pitch β used to level [deg].
+    pub pitch_deg: f64,
+    /// Floor height, levelled frame [m].
+    pub floor_height_m: f64,
+    /// Sample points on the floor plane.
+    pub floor_points: usize,
+    /// Their share of the sample.
+    pub floor_share: f64,
+    /// Sample points more than the below margin under the floor.
+    pub points_below_floor: usize,
+    /// RMS distance of the floor points from the plane [m].
+    pub floor_rms_m: f64,
+    /// Points of the sample the floor and tilt came from.
+    pub sample_points: usize,
+    /// Length scale used.
+    pub scale: f64,
+    /// Point spacing used [m].
+    pub spacing_m: f64,
+    /// R² of the fit on the grid samples.
+    pub r2: f64,
+    /// Wall time of each stage [ms].
+    pub timings_ms: BTreeMap<&'static str, f64>,
+    /// Wall time of all stages [ms].
+    pub total_ms: f64,
+    /// Points read per second of the whole run.
+    pub points_per_s: f64,
+    /// Tile side [m].
+    pub tile_m: f64,
+    /// Tiles along x and y.
+    pub grid: [usize; 2],
+    /// Tiles that held points.
+    pub tiles_used: usize,
+    /// Halo width [m].
+    pub halo_m: f64,
+    /// Most points a tile held with its halo.
+    pub largest_tile_points: u64,
+    /// Statistical-filter points searched again past the halo.
+    pub statistical_researched: u64,
+    /// The memory limit of a tile [bytes].
+    pub memory_limit_bytes: u64,
+    /// Peak resident memory of the process [bytes] (null where unknown).
+    pub peak_memory_bytes: Option<u64>,
+    /// Height model cell [m] and cells along x and y.
+    pub model_cell_m: f64,
+    /// Cells of the height model along x and y.
+    pub model_size: [usize; 2],
+    /// The fit.
+    pub fit: FitSummary,
+    /// The settings used.
+    pub pipeline: PerceptionParams,
+    /// Always true (a failed run is an error).
+    pub success: bool,
+}
+
+impl TiledSummary {
+    /// The summary of `got`, a run on `survey` (given as `input`).
+    pub fn new(
+        input: &str,
+        survey: &Survey,
+        params: &PerceptionParams,
+        options: &TileOptions,
+        got: &TiledPerceived,
+    ) -> Self {
+        let total_ms = got.total_ms();
+        Self {
+            job: "perceive",
+            mode: "tiles",
+            input: input.into(),
+            files: survey
+                .files
+                .iter()
+                .map(|f| f.display().to_string())
+                .collect(),
+            format: got.format,
+            input_points: got.input_points,
+            non_finite_dropped: got.non_finite_dropped,
+            output_points: got.output_points,
+            stage_points: got.stages.iter().map(|s| (s.stage, s.points)).collect(),
+            stages: got.stages.clone(),
+            roll_deg: got.roll_rad.to_degrees(),
+            pitch_deg: got.pitch_rad.to_degrees(),
+            floor_height_m: got.floor.floor_height_m,
+            floor_points: got.floor.inliers,
+            floor_share: got.floor.inliers as f64 / got.floor.candidates.max(1) as f64,
+            points_below_floor: got.floor.below,
+            floor_rms_m: got.floor.rms_m,
+            sample_points: got.sample_points,
+            scale: got.scale,
+            spacing_m: got.spacing_m,
+            r2: got.fit.r2,
+            timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
+            total_ms,
+            points_per_s: got.input_points as f64 / (total_ms / 1e3).max(1e-9),
+            tile_m: got.tile_m,
+            grid: got.grid,
+            tiles_used: got.tiles_used,
+            halo_m: got.halo_m,
+            largest_tile_points: got.largest_tile_points,
+            statistical_researched: got.statistical_researched,
+            memory_limit_bytes: options.memory_limit,
+            peak_memory_bytes: got.peak_memory,
+            model_cell_m: got.model.cell_m,
+            model_size: got.model.size,
+            fit: FitSummary::of(&got.fit),
+            pipeline: params.clone(),
+            success: true,
+        }
     }
 }
 
