@@ -109,13 +109,15 @@ pub fn run(args: &Args) -> Result<()> {
                 s.statistical_researched
             );
             crate::say!(
-                "  roll {:.3} deg, pitch {:.3} deg from a sample of {} points; fit degree {}, R² {:.4}",
+                "  roll {:.3} deg, pitch {:.3} deg from a sample of {} points; fit {}",
                 s.roll_deg,
                 s.pitch_deg,
                 s.sample_points,
-                s.fit.degree,
-                s.r2
+                s.fit.as_ref().map_or("none".into(), |f| format!("degree {}, R² {:.4}", f.degree, f.r2))
             );
+            if let Some(note) = &s.fit_note {
+                crate::say!("  {note}");
+            }
         });
     }
     if input.is_dir() {

@@ -97,6 +97,13 @@ pub struct Args {
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
     /// PCD/PLY encoding (default binary).
+    /// Write a survey of NX × NY scans instead of one (e.g. `10,10`): piles
+    /// side by side, each scan shifted by the scan window less 5 % (so
+    /// neighbours overlap), all in one frame (tilted by --roll and
+    /// --pitch), seeds SEED, SEED+1, …, named like --frames: the input of
+    /// `perceive --tiles --input FOLDER`.
+    #[arg(long, value_parser = parse_survey)]
+    pub survey: Option<[usize; 2]>,
     #[arg(long, value_enum)]
     pub encoding: Option<EncodingArg>,
     /// Replace an existing file at --out.
@@ -130,9 +137,14 @@ pub fn run(args: &Args) -> Result<()> {
     if !(1..=100_000).contains(&args.frames) {
         anyhow::bail!("--frames {}: expected 1 to 100000", args.frames);
     }
-    let paths = autoshovel_surface::frames::sequence_paths(&args.out, args.frames);
+    if args.survey.is_some() && args.frames > 1 {
+        anyhow::bail!("--survey and --frames: give one or the other");
+    }
+    let files = args.survey.map_or(args.frames, |[nx, ny]| nx * ny);
+    let step = params.survey_step_m();
+    let paths = autoshovel_surface::frames::sequence_paths(&args.out, files);
     if let Some(parent) = paths[0].parent().filter(|p| !p.as_os_str().is_empty()) {
-        if args.frames > 1 {
+        if files > 1 {
             std::fs::create_dir_all(parent)
                 .with_context(|| format!("cannot create the folder {}", parent.display()))?;
         }
@@ -144,8 +156,12 @@ pub fn run(args: &Args) -> Result<()> {
         .par_iter()
         .enumerate()
         .map(|(i, path)| {
+            let offset_m = args.survey.map_or([0.0, 0.0], |[nx, _]| {
+                [(i % nx) as f64 * step[0], (i / nx) as f64 * step[1]]
+            });
             let params = PileParams {
                 seed: params.seed.wrapping_add(i as u64),
+                offset_m,
                 ..params.clone()
             };
             generate_one(&params, path, args)
@@ -157,6 +173,20 @@ pub fn run(args: &Args) -> Result<()> {
     summary.seed = args.seed;
     if args.json {
         print_json(&summary)?;
+    } else if let Some([nx, ny]) = args.survey {
+        crate::say!(
+            "wrote a survey of {nx} × {ny} scans of {} points each ({} piles side by side every {:.1} m × {:.1} m, roll {} deg, pitch {} deg, seeds {}–{}): {} … {}",
+            summary.points,
+            summary.shape,
+            step[0],
+            step[1],
+            args.roll,
+            args.pitch,
+            args.seed,
+            args.seed.wrapping_add(summary.frames as u64 - 1),
+            summary.file,
+            summary.last_file
+        );
     } else if summary.frames > 1 {
         crate::say!(
             "wrote {} frames of {} points of a {} pile (roll {} deg, pitch {} deg, seeds {}–{}): {} … {}",
@@ -185,6 +215,23 @@ pub fn run(args: &Args) -> Result<()> {
 }
 
 /// Generates one scan with `params` and writes it to `path`.
+/// `NX,NY` of `--survey`.
+fn parse_survey(s: &str) -> std::result::Result<[usize; 2], String> {
+    let bad =
+        || format!("{s}: expected NX,NY, two whole numbers of scans from 1 to 1000, e.g. 10,10");
+    let (a, b) = s.split_once(',').ok_or_else(bad)?;
+    let n = |v: &str| {
+        v.trim()
+            .parse::<usize>()
+            .ok()
+            .filter(|n| (1..=1000).contains(n))
+    };
+    match (n(a), n(b)) {
+        (Some(x), Some(y)) => Ok([x, y]),
+        _ => Err(bad()),
+    }
+}
+
 fn generate_one(params: &PileParams, path: &Path, args: &Args) -> Result<GeneratePileSummary> {
     let t0 = std::time::Instant::now();
     // The library names its fields; the user wrote flags.

@@ -307,6 +307,10 @@ pub struct PileParams {
     pub fov_rad: f64,
     /// Seed of the ChaCha8 generator. Default 1.
     pub seed: u64,
+    /// Shift of the whole scene, sensor included, in the level frame's
+    /// (x, y) [m], before the tilt: the scans of a survey of many piles
+    /// share one frame this way ([`PileParams::survey_step_m`]). Default 0.
+    pub offset_m: [f64; 2],
 }
 
 impl Default for PileParams {
@@ -331,6 +335,7 @@ impl Default for PileParams {
             pattern: ScanPattern::Area,
             fov_rad: 70.4f64.to_radians(),
             seed: 1,
+            offset_m: [0.0, 0.0],
         }
     }
 }
@@ -433,6 +438,12 @@ impl PileParams {
                 return bad(name, v, "an angle within ±45° [rad]");
             }
         }
+        for v in self.offset_m {
+            // f32 coordinates resolve a centimetre out to 100 km.
+            if !(v.is_finite() && v.abs() <= 1e5) {
+                return bad("PileParams.offset_m", v, "a shift within ±100 km [m]");
+            }
+        }
         Ok(())
     }
 
@@ -445,6 +456,14 @@ impl PileParams {
     pub fn toe_x_m(&self, y: f64) -> f64 {
         let w = self.scale * self.width_m;
         self.scale * (self.toe_distance_m - self.toe_bow_m * (PI * y / w).cos())
+    }
+
+    /// The shift from one scan of a survey to the next along x and y [m]:
+    /// the scan window's extent less 5 %, so that neighbouring scans
+    /// overlap a little, as a survey's passes do.
+    pub fn survey_step_m(&self) -> [f64; 2] {
+        let ([x0, x1], [y0, y1]) = self.window_m();
+        [0.95 * (x1 - x0), 0.95 * (y1 - y0)]
     }
 
     /// The x range `[near, far]` and the y range `[−W/2, W/2]` scanned, scaled [m].
@@ -534,10 +553,11 @@ pub fn generate_pile(params: &PileParams) -> Result<PointCloud> {
     scene.shuffle(&mut rng);
 
     let sensor_from_level = sensor_from_level(params.roll_rad, params.pitch_rad);
+    let offset = Vector3::new(params.offset_m[0], params.offset_m[1], 0.0);
     let points = scene
         .into_iter()
         .map(|p| {
-            let q = sensor_from_level * p;
+            let q = sensor_from_level * (p + offset);
             [q.x as f32, q.y as f32, q.z as f32]
         })
         .collect();

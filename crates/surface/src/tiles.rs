@@ -290,8 +290,13 @@ pub struct TiledPerceived {
     pub stages: Vec<StageRecord>,
     /// Points of the cleaned survey.
     pub output_points: u64,
-    /// The surface fit on every n-th cleaned point.
-    pub fit: SurfaceFit,
+    /// The surface fit on every n-th cleaned point ([RS eq. 21]); `None`
+    /// when the points do not determine one (see `fit_note`).
+    pub fit: Option<SurfaceFit>,
+    /// Why the fit is missing, or that it falls below the settings' R²
+    /// threshold: a survey of many piles is not one face, so neither stops
+    /// the run (the height model is the survey's surface).
+    pub fit_note: Option<String>,
     /// Mean height of the cleaned points per cell.
     pub model: HeightModel,
     /// Peak resident memory of the process [bytes], where the system tells.
@@ -377,8 +382,10 @@ pub struct TiledSummary {
     pub model_cell_m: f64,
     /// Cells of the height model along x and y.
     pub model_size: [usize; 2],
-    /// The fit.
-    pub fit: FitSummary,
+    /// The fit (null when the points did not determine one).
+    pub fit: Option<FitSummary>,
+    /// Why the fit is missing or below the R² threshold.
+    pub fit_note: Option<String>,
     /// The settings used.
     pub pipeline: PerceptionParams,
     /// Always true (a failed run is an error).
@@ -420,7 +427,7 @@ impl TiledSummary {
             sample_points: got.sample_points,
             scale: got.scale,
             spacing_m: got.spacing_m,
-            r2: got.fit.r2,
+            r2: got.fit.as_ref().map_or(f64::NAN, |f| f.r2),
             timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
             total_ms,
             points_per_s: got.input_points as f64 / (total_ms / 1e3).max(1e-9),
@@ -434,7 +441,8 @@ impl TiledSummary {
             peak_memory_bytes: got.peak_memory,
             model_cell_m: got.model.cell_m,
             model_size: got.model.size,
-            fit: FitSummary::of(&got.fit),
+            fit: got.fit.as_ref().map(FitSummary::of),
+            fit_note: got.fit_note.clone(),
             pipeline: params.clone(),
             success: true,
         }
@@ -1048,16 +1056,27 @@ pub fn perceive_tiled(
         }
     }
     // Fit [RS eq. 21], on every n-th cleaned point.
+    // One survey may hold many piles: the fit is reported, never enforced.
     let fit_params = FitParams {
         max_degree: p.fit.max_degree,
-        r2_threshold: (p.fit.r2_threshold > 0.0).then_some(p.fit.r2_threshold),
+        r2_threshold: None,
         ..FitParams::default()
     };
-    let fit = fit_surface(&PointCloud::new(fit_points), &fit_params)
-        .map_err(in_stage("fitting the surface"))?;
+    let (fit, fit_note) = match fit_surface(&PointCloud::new(fit_points), &fit_params) {
+        Ok(fit) => {
+            let note = (p.fit.r2_threshold > 0.0 && fit.r2 <= p.fit.r2_threshold).then(|| {
+                format!(
+                    "R² = {:.4} <= the threshold {}: one polynomial does not describe this survey (many piles?); its height model does",
+                    fit.r2, p.fit.r2_threshold
+                )
+            });
+            (Some(fit), note)
+        }
+        Err(e) => (None, Some(format!("no surface fit: {e}"))),
+    };
     stages.push(StageRecord {
         stage: "fit",
-        points: fit.samples.len(),
+        points: fit.as_ref().map_or(0, |f| f.samples.len()),
         ms: elapsed_ms(t),
     });
     Ok(TiledPerceived {
@@ -1079,6 +1098,7 @@ pub fn perceive_tiled(
         stages,
         output_points,
         fit,
+        fit_note,
         model,
         peak_memory: peak_memory(),
     })
