@@ -62,7 +62,7 @@ use autoshovel_cloud::filter::{
     DistanceSums, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams, VoxelCells,
     VoxelGridParams,
 };
-use autoshovel_cloud::io::{las_header, read_chunks, LasHeader};
+use autoshovel_cloud::io::{las_header, read_files_in_order, LasHeader};
 use autoshovel_cloud::{CloudError, Point, PointCloud};
 use autoshovel_core::config;
 use nalgebra::Matrix3;
@@ -96,12 +96,16 @@ const FLUSH_POINTS: usize = 1 << 14;
 /// Points per chunk read from the survey.
 const READ_CHUNK: usize = 1 << 16;
 
+/// Points the files ahead of the one being read may buffer (decoded by
+/// other threads; 12 bytes a point).
+const LOOKAHEAD: usize = 8 << 20;
+
 /// How the survey is cut and held.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TileOptions {
     /// Side of a square tile in the levelled (x, y) plane [m]; `None`:
-    /// chosen so that a tile and its halo take about a quarter of the
-    /// memory limit (at most 4 M points).
+    /// chosen so that a tile takes about a million points (less if a
+    /// quarter of the memory limit holds fewer).
     pub tile_m: Option<f64>,
     /// Most working memory a tile may take [bytes].
     pub memory_limit: u64,
@@ -575,11 +579,25 @@ impl Lists {
         if self.own[t].len() >= FLUSH_POINTS {
             self.flush_one(t, false)?;
         }
+        // Only a point within halo_m of its tile's edge (or outside it)
+        // can lie within halo_m of another tile's box.
+        let b = grid.bounds(t);
+        let edge: Vec<Rec> = recs
+            .iter()
+            .filter(|r| {
+                let (x, y) = (f64::from(r.p[0]), f64::from(r.p[1]));
+                (x - b[0]).min(b[2] - x).min(y - b[1]).min(b[3] - y) <= halo_m
+            })
+            .copied()
+            .collect();
+        if edge.is_empty() {
+            return Ok(());
+        }
         // The tiles whose halo may take a point of `t`: its neighbours
         // within halo_m (points may lie a little outside their tile).
         for u in grid.around(t, 2.0 * halo_m) {
             let before = self.halo[u].len();
-            self.halo[u].extend(recs.iter().filter(|r| grid.gap(u, &r.p) <= halo_m));
+            self.halo[u].extend(edge.iter().filter(|r| grid.gap(u, &r.p) <= halo_m));
             if self.halo[u].len() >= FLUSH_POINTS && self.halo[u].len() > before {
                 self.flush_one(u, true)?;
             }
@@ -606,17 +624,24 @@ impl Lists {
             .append(true)
             .open(&path)
             .map_err(spill)?;
-        let mut w = BufWriter::with_capacity(1 << 16, file);
-        let mut bytes = [0u8; RECORD];
-        for r in buf.iter() {
-            bytes[..8].copy_from_slice(&r.id.to_le_bytes());
-            for a in 0..3 {
-                bytes[8 + 4 * a..12 + 4 * a].copy_from_slice(&r.p[a].to_le_bytes());
-            }
-            w.write_all(&bytes).map_err(spill)?;
-        }
-        w.flush().map_err(spill)?;
+        // Encoded on every core, written in one piece.
+        use rayon::prelude::*;
+        let mut bytes = vec![0u8; buf.len() * RECORD];
+        bytes
+            .par_chunks_exact_mut(RECORD)
+            .zip(buf.par_iter())
+            .for_each(|(b, r)| {
+                b[..8].copy_from_slice(&r.id.to_le_bytes());
+                for a in 0..3 {
+                    b[8 + 4 * a..12 + 4 * a].copy_from_slice(&r.p[a].to_le_bytes());
+                }
+            });
+        let mut file = file;
+        file.write_all(&bytes).map_err(spill)?;
+        // A whole tile's survivors pass through at once: keep no more
+        // than a buffer's worth, or every tile would hold its size.
         buf.clear();
+        buf.shrink_to(FLUSH_POINTS);
         Ok(())
     }
 
@@ -653,13 +678,13 @@ fn read_recs(path: &Path) -> Result<Vec<Rec>> {
         path: path.to_path_buf(),
         source,
     };
-    let mut bytes = Vec::new();
-    match File::open(path) {
-        Ok(mut f) => f.read_to_end(&mut bytes).map_err(spill)?,
+    let bytes = match fs::read(path) {
+        Ok(b) => b,
         Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
         Err(e) => return Err(spill(e)),
     };
-    Ok(bytes.chunks_exact(RECORD).map(decode).collect())
+    use rayon::prelude::*;
+    Ok(bytes.par_chunks_exact(RECORD).map(decode).collect())
 }
 
 #[inline]
@@ -745,12 +770,15 @@ pub fn perceive_tiled(
     let mut lo = [f32::INFINITY; 3];
     let mut hi = [f32::NEG_INFINITY; 3];
     let mut n = 0u64;
-    let mut non_finite = 0u64;
     let mut sample: Vec<Point> = Vec::new();
-    let mut format = "";
-    for f in &survey.files {
-        let mut bar = |done: u64, total: u64| progress("reading (1 of 2)", done, total);
-        let report = read_chunks(f, READ_CHUNK, &mut bar, &mut |chunk: &[Point]| {
+    let threads = rayon::current_num_threads();
+    let reports = read_files_in_order(
+        &survey.files,
+        READ_CHUNK,
+        threads,
+        LOOKAHEAD,
+        &mut |done, _| progress("reading (1 of 2)", done, claimed),
+        &mut |_, chunk: &[Point]| {
             for q in chunk {
                 for a in 0..3 {
                     lo[a] = lo[a].min(q[a]);
@@ -762,12 +790,10 @@ pub fn perceive_tiled(
                 n += 1;
             }
             Ok(())
-        })?;
-        non_finite += report.non_finite_dropped as u64;
-        if format.is_empty() {
-            format = report.format;
-        }
-    }
+        },
+    )?;
+    let non_finite: u64 = reports.iter().map(|r| r.non_finite_dropped as u64).sum();
+    let format = reports.first().map_or("", |r| r.format);
     if n == 0 {
         return Err(SurfaceError::NoFinitePoints {
             non_finite_dropped: non_finite as usize,
@@ -853,9 +879,13 @@ pub fn perceive_tiled(
     let mut by_tile: Vec<Vec<Rec>> = vec![Vec::new(); grid.tiles()];
     let mut level_ms = 0.0;
     let mut failed: Option<SurfaceError> = None;
-    for f in &survey.files {
-        let mut bar = |done: u64, total: u64| progress("reading (2 of 2)", done, total);
-        let read = read_chunks(f, READ_CHUNK, &mut bar, &mut |chunk: &[Point]| {
+    let read = read_files_in_order(
+        &survey.files,
+        READ_CHUNK,
+        threads,
+        LOOKAHEAD,
+        &mut |done, _| progress("reading (2 of 2)", done, n),
+        &mut |f, chunk: &[Point]| {
             let t = Instant::now();
             let levelled = PointCloud::new(chunk.iter().map(|q| rotate_point(&r, q)).collect());
             level_ms += elapsed_ms(t);
@@ -880,21 +910,22 @@ pub fn perceive_tiled(
                     if let Err(e) = lists.put(&grid, t, &recs, halo) {
                         failed = Some(e);
                         return Err(CloudError::Format {
-                            path: f.clone(),
+                            path: survey.files[f].clone(),
                             what: "stopped: a tile's working file failed".into(),
                         });
                     }
                 }
             }
             Ok(())
-        });
-        if let Some(e) = failed.take() {
-            return Err(e);
-        }
-        read?;
+        },
+    );
+    if let Some(e) = failed.take() {
+        return Err(e);
     }
+    read?;
     lists.flush()?;
     let read2_ms = elapsed_ms(t1);
+
     stages[0].ms += read2_ms - level_ms;
     stages.push(StageRecord {
         stage: "level",
@@ -1156,8 +1187,10 @@ fn grid_over(
     let side = match options.tile_m {
         Some(t) => t,
         None => {
-            // A tile and its halo in a quarter of the limit, 4 M points at most.
-            let per_tile = (options.memory_limit / BYTES_PER_POINT / 4).clamp(1 << 16, 4 << 20);
+            // A tile and its halo in a quarter of the limit, and about a
+            // million points at most: the filters' k-d trees stay close
+            // to the cache, and the halo is still thin beside the tile.
+            let per_tile = (options.memory_limit / BYTES_PER_POINT / 4).clamp(1 << 16, 1 << 20);
             let density = n as f64 / (extent[0] * extent[1]);
             let mut side = (per_tile as f64 / density).sqrt();
             while ((extent[0] / side).ceil() * (extent[1] / side).ceil()) as usize > MAX_TILES {
@@ -1452,18 +1485,49 @@ fn voxels_of_tile(
     params: &VoxelGridParams,
     cells: &VoxelCells,
 ) -> Result<Vec<Rec>> {
-    // (voxel z, y, x, position) of every loaded point: a voxel's run
-    // starts with its first point.
-    let mut keys: Vec<([i64; 3], u32)> = loaded
-        .recs
-        .iter()
-        .enumerate()
-        .map(|(i, r)| {
-            let c = cells.of(&r.p);
-            ([c[2], c[1], c[0]], i as u32)
-        })
-        .collect();
-    keys.sort_unstable();
+    use rayon::prelude::*;
+    // (voxel z, y, x, position) of every loaded point, sorted: a voxel's
+    // run starts with its first point. Packed into one u64 (voxel index
+    // above, position below) when the tile's voxels number at most 2³².
+    let voxel: Vec<[i64; 3]> = loaded.recs.par_iter().map(|r| cells.of(&r.p)).collect();
+    let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+    for c in &voxel {
+        for a in 0..3 {
+            lo[a] = lo[a].min(c[a]);
+            hi[a] = hi[a].max(c[a]);
+        }
+    }
+    let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]) as u128 + 1);
+    let keys: Vec<([i64; 3], u32)> = if extent[0] * extent[1] * extent[2] <= 1 << 32 {
+        let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
+        let mut packed: Vec<u64> = voxel
+            .par_iter()
+            .enumerate()
+            .map(|(i, c)| {
+                let l = (c[0] - lo[0]) as u64
+                    + (c[1] - lo[1]) as u64 * ex
+                    + (c[2] - lo[2]) as u64 * exy;
+                (l << 32) | i as u64
+            })
+            .collect();
+        packed.par_sort_unstable();
+        packed
+            .into_iter()
+            .map(|k| {
+                let i = (k & 0xffff_ffff) as usize;
+                let c = voxel[i];
+                ([c[2], c[1], c[0]], i as u32)
+            })
+            .collect()
+    } else {
+        let mut keys: Vec<([i64; 3], u32)> = voxel
+            .iter()
+            .enumerate()
+            .map(|(i, c)| ([c[2], c[1], c[0]], i as u32))
+            .collect();
+        keys.par_sort_unstable();
+        keys
+    };
     let mut mine = vec![false; loaded.recs.len()];
     let mut owners = Vec::new();
     let mut s = 0;

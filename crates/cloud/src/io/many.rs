@@ -1,0 +1,138 @@
+//! Reading a list of files as one stream, in order, while decoding them in
+//! parallel: a survey of many LAZ files is decode-bound (one file decodes
+//! on one core), so the files ahead of the one being consumed are decoded
+//! by other threads into a bounded buffer.
+
+use std::collections::VecDeque;
+use std::path::PathBuf;
+use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
+use std::sync::{Condvar, Mutex};
+
+use super::read::{read_chunks, StreamReport};
+use crate::{CloudError, Point};
+
+/// What a decoding thread hands over for one file.
+enum Piece {
+    Chunk(Vec<Point>),
+    Done(crate::Result<StreamReport>),
+}
+
+/// The files' queues and the points buffered ahead of the consumer.
+struct Shared {
+    queues: Vec<VecDeque<Piece>>,
+    /// Points buffered in queues of files after the one being consumed.
+    ahead: usize,
+}
+
+/// Reads `paths` as one stream: `on_chunk(file, points)` gets every file's
+/// finite points in file order, files in the given order, at most `chunk`
+/// at a time, exactly as [`read_chunks`] file after file would give them.
+/// Up to `threads` files are decoded at once; files after the one being
+/// consumed may buffer at most `lookahead` points between them (the
+/// memory this costs: 12 bytes a point). `progress(points, files)` is
+/// called as chunks are consumed. An error (a file's, or `on_chunk`'s)
+/// stops every thread and is returned.
+pub fn read_files_in_order(
+    paths: &[PathBuf],
+    chunk: usize,
+    threads: usize,
+    lookahead: usize,
+    progress: &mut dyn FnMut(u64, usize),
+    on_chunk: &mut dyn FnMut(usize, &[Point]) -> crate::Result<()>,
+) -> crate::Result<Vec<StreamReport>> {
+    let shared = Mutex::new(Shared {
+        queues: (0..paths.len()).map(|_| VecDeque::new()).collect(),
+        ahead: 0,
+    });
+    let ready = Condvar::new(); // a queue got a piece
+    let room = Condvar::new(); // the buffer ahead shrank, or the consumer moved on
+    let next_file = AtomicUsize::new(0);
+    let current = AtomicUsize::new(0);
+    let stop = AtomicBool::new(false);
+    let lock = || shared.lock().unwrap_or_else(|e| e.into_inner());
+    std::thread::scope(|scope| {
+        for _ in 0..threads.max(1).min(paths.len().max(1)) {
+            scope.spawn(|| loop {
+                let f = next_file.fetch_add(1, Ordering::SeqCst);
+                if f >= paths.len() || stop.load(Ordering::SeqCst) {
+                    return;
+                }
+                let report = read_chunks(&paths[f], chunk, &mut |_, _| {}, &mut |points| {
+                    let mut s = lock();
+                    // Files ahead of the consumer wait for room.
+                    while f != current.load(Ordering::SeqCst)
+                        && s.ahead + points.len() > lookahead
+                        && !stop.load(Ordering::SeqCst)
+                    {
+                        s = room.wait(s).unwrap_or_else(|e| e.into_inner());
+                    }
+                    if stop.load(Ordering::SeqCst) {
+                        return Err(CloudError::Format {
+                            path: paths[f].clone(),
+                            what: "reading stopped".into(),
+                        });
+                    }
+                    if f != current.load(Ordering::SeqCst) {
+                        s.ahead += points.len();
+                    }
+                    s.queues[f].push_back(Piece::Chunk(points.to_vec()));
+                    ready.notify_all();
+                    Ok(())
+                });
+                lock().queues[f].push_back(Piece::Done(report));
+                ready.notify_all();
+            });
+        }
+        // The consumer, on this thread, file after file.
+        let result = (|| {
+            let mut reports = Vec::with_capacity(paths.len());
+            let mut points = 0u64;
+            for f in 0..paths.len() {
+                {
+                    // This file's buffered points no longer count as ahead.
+                    let mut s = lock();
+                    current.store(f, Ordering::SeqCst);
+                    let buffered: usize = s.queues[f]
+                        .iter()
+                        .map(|p| match p {
+                            Piece::Chunk(c) => c.len(),
+                            Piece::Done(_) => 0,
+                        })
+                        .sum();
+                    s.ahead -= buffered;
+                    room.notify_all();
+                }
+                loop {
+                    let piece = {
+                        let mut s = lock();
+                        loop {
+                            if let Some(p) = s.queues[f].pop_front() {
+                                break p;
+                            }
+                            s = ready.wait(s).unwrap_or_else(|e| e.into_inner());
+                        }
+                    };
+                    match piece {
+                        Piece::Chunk(c) => {
+                            on_chunk(f, &c)?;
+                            points += c.len() as u64;
+                            progress(points, f);
+                        }
+                        Piece::Done(report) => {
+                            reports.push(report?);
+                            break;
+                        }
+                    }
+                }
+            }
+            progress(points, paths.len());
+            Ok(reports)
+        })();
+        if result.is_err() {
+            stop.store(true, Ordering::SeqCst);
+            let _s = lock();
+            room.notify_all();
+        }
+        result
+    })
+}
