@@ -209,6 +209,49 @@ fn files_of_another_scale_are_refused_naming_the_file() {
     let _ = std::fs::remove_dir_all(&d);
 }
 
+/// A LAS file of `points` with a WKT coordinate system record.
+fn las_with_wkt(path: &Path, points: &[Point], wkt: &str) {
+    let mut builder = las::Builder::from((1, 4));
+    builder.vlrs.push(las::Vlr {
+        user_id: "LASF_Projection".into(),
+        record_id: 2112,
+        description: "OGC WKT".into(),
+        data: wkt.as_bytes().to_vec(),
+    });
+    let mut w = las::Writer::from_path(path, builder.into_header().unwrap()).unwrap();
+    for p in points {
+        w.write_point(las::Point {
+            x: f64::from(p[0]),
+            y: f64::from(p[1]),
+            z: f64::from(p[2]),
+            ..Default::default()
+        })
+        .unwrap();
+    }
+    w.close().unwrap();
+}
+
+#[test]
+fn files_of_another_coordinate_system_are_refused_naming_the_file() {
+    let d = dir("crs");
+    let scan = pile(10_000, 3, ScanPattern::Area);
+    let (a, b, c) = (d.join("a.las"), d.join("b.las"), d.join("c.las"));
+    las_with_wkt(&a, &scan.points, "PROJCS[\"WGS 84 / UTM zone 33N\"]");
+    las_with_wkt(&b, &scan.points, "PROJCS[\"WGS 84 / UTM zone 33N\"]");
+    las_with_wkt(&c, &scan.points, "PROJCS[\"WGS 84 / UTM zone 34N\"]");
+    // The same system twice is one survey.
+    assert_eq!(Survey::open(&[a.clone(), b]).unwrap().files.len(), 2);
+    let err = Survey::open(&[a, c.clone()]).unwrap_err();
+    let msg = err.to_string();
+    assert!(
+        msg.starts_with(&c.display().to_string())
+            && msg.contains("zone 34N")
+            && msg.contains("zone 33N"),
+        "{msg}"
+    );
+    let _ = std::fs::remove_dir_all(&d);
+}
+
 #[test]
 fn a_tile_over_the_memory_limit_is_refused_naming_it_and_leaves_nothing() {
     let d = dir("limit");
