@@ -217,6 +217,30 @@ impl Survey {
         Ok(Self { files, headers })
     }
 
+    /// The origin the survey is read relative to [m], per axis: zero where
+    /// every coordinate the headers bound lies within 10 km of zero (f32
+    /// keeps a millimetre there); otherwise the headers' smallest value
+    /// rounded down to a kilometre, so that UTM coordinates keep their
+    /// millimetres in f32.
+    pub fn origin(&self) -> [f64; 3] {
+        [0, 1, 2].map(|a| {
+            let far = self
+                .headers
+                .iter()
+                .any(|h| h.min[a].abs() > 1e4 || h.max[a].abs() > 1e4);
+            let lo = self
+                .headers
+                .iter()
+                .map(|h| h.min[a])
+                .fold(f64::INFINITY, f64::min);
+            if far && lo.is_finite() {
+                (lo / 1000.0).floor() * 1000.0
+            } else {
+                0.0
+            }
+        })
+    }
+
     /// Points the headers claim.
     pub fn header_points(&self) -> u64 {
         self.headers.iter().map(|h| h.points).sum()
@@ -290,7 +314,8 @@ pub struct TiledPerceived {
     /// Statistical-filter points searched again past the halo.
     pub statistical_researched: u64,
     /// Each stage's count and time, as [`crate::perceive::Perceived::stages`]
-    /// ("read" is both passes over the files).
+    /// ("read" is both passes over the files; "write" hands the cleaned
+    /// tiles on and fills the height model).
     pub stages: Vec<StageRecord>,
     /// Points of the cleaned survey.
     pub output_points: u64,
@@ -305,6 +330,8 @@ pub struct TiledPerceived {
     pub model: HeightModel,
     /// Peak resident memory of the process [bytes], where the system tells.
     pub peak_memory: Option<u64>,
+    /// The origin subtracted from the files' coordinates ([`Survey::origin`]) [m].
+    pub origin_m: [f64; 3],
 }
 
 impl TiledPerceived {
@@ -378,6 +405,10 @@ pub struct TiledSummary {
     pub largest_tile_points: u64,
     /// Statistical-filter points searched again past the halo.
     pub statistical_researched: u64,
+    /// The origin subtracted from the files' coordinates before levelling
+    /// (zero near the origin; a kilometre corner for UTM) [m]: the cleaned
+    /// tiles and the height model are relative to it.
+    pub origin_m: [f64; 3],
     /// The memory limit of a tile [bytes].
     pub memory_limit_bytes: u64,
     /// Peak resident memory of the process [bytes] (null where unknown).
@@ -441,6 +472,7 @@ impl TiledSummary {
             halo_m: got.halo_m,
             largest_tile_points: got.largest_tile_points,
             statistical_researched: got.statistical_researched,
+            origin_m: got.origin_m,
             memory_limit_bytes: options.memory_limit,
             peak_memory_bytes: got.peak_memory,
             model_cell_m: got.model.cell_m,
@@ -772,8 +804,10 @@ pub fn perceive_tiled(
     let mut n = 0u64;
     let mut sample: Vec<Point> = Vec::new();
     let threads = rayon::current_num_threads();
+    let origin = survey.origin();
     let reports = read_files_in_order(
         &survey.files,
+        origin,
         READ_CHUNK,
         threads,
         LOOKAHEAD,
@@ -881,6 +915,7 @@ pub fn perceive_tiled(
     let mut failed: Option<SurfaceError> = None;
     let read = read_files_in_order(
         &survey.files,
+        origin,
         READ_CHUNK,
         threads,
         LOOKAHEAD,
@@ -904,9 +939,9 @@ pub fn perceive_tiled(
                 });
             }
             id += chunk.len() as u64;
-            for t in 0..by_tile.len() {
-                if !by_tile[t].is_empty() {
-                    let recs = std::mem::take(&mut by_tile[t]);
+            for (t, pending) in by_tile.iter_mut().enumerate() {
+                if !pending.is_empty() {
+                    let recs = std::mem::take(pending);
                     if let Err(e) = lists.put(&grid, t, &recs, halo) {
                         failed = Some(e);
                         return Err(CloudError::Format {
@@ -1087,6 +1122,12 @@ pub fn perceive_tiled(
         }
     }
     // Fit [RS eq. 21], on every n-th cleaned point.
+    stages.push(StageRecord {
+        stage: "write",
+        points: output_points as usize,
+        ms: elapsed_ms(t),
+    });
+    let t = Instant::now();
     // One survey may hold many piles: the fit is reported, never enforced.
     let fit_params = FitParams {
         max_degree: p.fit.max_degree,
@@ -1132,6 +1173,7 @@ pub fn perceive_tiled(
         fit_note,
         model,
         peak_memory: peak_memory(),
+        origin_m: origin,
     })
 }
 
@@ -1388,7 +1430,9 @@ impl TileRun {
         // [RS eq. 14]: the sums in survey order, merging the tiles' lists.
         let mut sums = DistanceSums::default();
         {
-            let mut heads: Vec<(BufReader<File>, Option<(u64, f32)>)> = Vec::new();
+            // Each tile's list and its next (id, d̄_i).
+            type Head = (BufReader<File>, Option<(u64, f32)>);
+            let mut heads: Vec<Head> = Vec::new();
             for t in 0..tiles {
                 if lists.counts[t] == 0 {
                     continue;

@@ -75,7 +75,7 @@ fn check_against_whole(
     let prior = Prior {
         roll_rad: got.roll_rad,
         pitch_rad: got.pitch_rad,
-        floor: got.floor.clone(),
+        floor: got.floor,
         scale: got.scale,
         spacing_m: got.spacing_m,
     };
@@ -85,7 +85,7 @@ fn check_against_whole(
         |stages: &[autoshovel_surface::perceive::StageRecord]| -> Vec<(&'static str, usize)> {
             stages
                 .iter()
-                .filter(|s| !matches!(s.stage, "read" | "level" | "fit"))
+                .filter(|s| !matches!(s.stage, "read" | "level" | "write" | "fit"))
                 .map(|s| (s.stage, s.points))
                 .collect()
         };
@@ -159,7 +159,7 @@ fn a_survey_in_several_files_is_their_concatenation() {
     }
     let params = PerceptionParams::default();
     // The folder, read in natural order, is the same survey.
-    let (got, cleaned) = tiled(&[d.clone()], &params, &options(4.0, &d));
+    let (got, cleaned) = tiled(std::slice::from_ref(&d), &params, &options(4.0, &d));
     check_against_whole(&PointCloud::new(whole), &params, &got, &cleaned);
     let _ = std::fs::remove_dir_all(&d);
 }
@@ -281,5 +281,61 @@ fn a_tile_over_the_memory_limit_is_refused_naming_it_and_leaves_nothing() {
         .map(|e| e.unwrap().file_name())
         .collect();
     assert_eq!(left.len(), 1, "{left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_survey_in_utm_metres_keeps_its_millimetres() {
+    let d = dir("utm");
+    let scan = pile(60_000, 9, ScanPattern::Area);
+    // The same scan at UTM coordinates (E 500 km, N 5 000 km, where f32
+    // steps by half a metre) and 1 km from the origin, both stored in mm.
+    let write_at = |path: &Path, shift: [f64; 2]| {
+        let mut builder = las::Builder::from((1, 2));
+        let t = |offset| las::Transform {
+            scale: 0.001,
+            offset,
+        };
+        builder.transforms = las::Vector {
+            x: t(shift[0]),
+            y: t(shift[1]),
+            z: t(0.0),
+        };
+        let mut w = las::Writer::from_path(path, builder.into_header().unwrap()).unwrap();
+        for p in &scan.points {
+            w.write_point(las::Point {
+                x: f64::from(p[0]) + shift[0],
+                y: f64::from(p[1]) + shift[1],
+                z: f64::from(p[2]),
+                ..Default::default()
+            })
+            .unwrap();
+        }
+        w.close().unwrap();
+    };
+    let (near, utm) = (d.join("near.las"), d.join("utm.las"));
+    // 1 km from the origin: the frame the UTM survey is read in.
+    write_at(&near, [1_000.0, 1_000.0]);
+    write_at(&utm, [500_000.0, 5_000_000.0]);
+    let params = PerceptionParams::default();
+    let (a, ca) = tiled(&[near], &params, &options(6.0, &d));
+    let survey = Survey::open(std::slice::from_ref(&utm)).unwrap();
+    let origin = survey.origin();
+    assert_eq!(origin, [499_000.0, 4_999_000.0, 0.0]);
+    let (b, cb) = tiled(&[utm], &params, &options(6.0, &d));
+    assert_eq!(b.origin_m, origin);
+    // The same survey, read 1 km from the origin either way: the same
+    // points kept, each within a tenth of a millimetre.
+    assert_eq!(a.output_points, b.output_points);
+    let (mut ca, mut cb) = (ca, cb);
+    let key = |p: &Point| (p[0] + 1000.0 * p[1]) as i64;
+    ca.sort_by_key(key);
+    cb.sort_by_key(key);
+    let worst = ca
+        .iter()
+        .zip(&cb)
+        .map(|(p, q)| (0..3).map(|k| (q[k] - p[k]).abs()).fold(0.0f32, f32::max))
+        .fold(0.0f32, f32::max);
+    assert!(worst < 1e-4, "worst {worst} m");
     let _ = std::fs::remove_dir_all(&d);
 }

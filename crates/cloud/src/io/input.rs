@@ -221,6 +221,8 @@ pub(crate) struct Points<'s> {
     sink: Option<(usize, Sink<'s>)>,
     /// Points handed to the sink so far.
     pub(crate) streamed: u64,
+    /// Subtracted from LAS/LAZ coordinates in f64, before they become f32.
+    pub(crate) origin: [f64; 3],
 }
 
 /// The receiver of a stream's chunks.
@@ -270,6 +272,14 @@ impl<'s> Points<'s> {
         if let Ok(n) = usize::try_from(n) {
             self.points.reserve(n);
         }
+    }
+
+    /// Keeps a finite point given in f64, less the origin; counts a
+    /// non-finite one.
+    #[inline]
+    pub(crate) fn push_f64(&mut self, x: f64, y: f64, z: f64) {
+        let o = self.origin;
+        self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32]);
     }
 
     /// Keeps a finite point, counts a non-finite one.

@@ -531,7 +531,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             .read_point()
             .map_err(|e| las_err(path, e, Some(i), &c, total))?
         {
-            out.push([p.x as f32, p.y as f32, p.z as f32]);
+            out.push_f64(p.x, p.y, p.z);
             out.hand_on(false)?;
             i += 1;
             if i.is_multiple_of(PROGRESS_POINTS) {

@@ -26,7 +26,8 @@ struct Shared {
 
 /// Reads `paths` as one stream: `on_chunk(file, points)` gets every file's
 /// finite points in file order, files in the given order, at most `chunk`
-/// at a time, exactly as [`read_chunks`] file after file would give them.
+/// at a time, less `origin`, exactly as [`read_chunks`] file after file
+/// would give them.
 /// Up to `threads` files are decoded at once; files after the one being
 /// consumed may buffer at most `lookahead` points between them (the
 /// memory this costs: 12 bytes a point). `progress(points, files)` is
@@ -34,6 +35,7 @@ struct Shared {
 /// stops every thread and is returned.
 pub fn read_files_in_order(
     paths: &[PathBuf],
+    origin: [f64; 3],
     chunk: usize,
     threads: usize,
     lookahead: usize,
@@ -57,7 +59,7 @@ pub fn read_files_in_order(
                 if f >= paths.len() || stop.load(Ordering::SeqCst) {
                     return;
                 }
-                let report = read_chunks(&paths[f], chunk, &mut |_, _| {}, &mut |points| {
+                let report = read_chunks(&paths[f], origin, chunk, &mut |_, _| {}, &mut |points| {
                     let mut s = lock();
                     // Files ahead of the consumer wait for room.
                     while f != current.load(Ordering::SeqCst)

@@ -100,16 +100,25 @@ pub struct StreamReport {
 /// order, at most `chunk` at a time, to `on_chunk`, whose error stops the
 /// read. LAS and LAZ are decoded point by point, so memory stays at one
 /// chunk whatever the file's size (a survey of 100 M points); the other
-/// formats are read whole first, then handed on.
+/// formats are read whole first, then handed on. Points come less
+/// `origin`, subtracted in f64 before the coordinates become f32: a survey
+/// in UTM metres (northings of millions, where f32 steps by 0.5 m) keeps
+/// millimetres near an origin of its own. `[0.0; 3]` gives [`read`]'s points.
 pub fn read_chunks(
     path: &Path,
+    origin: [f64; 3],
     chunk: usize,
     progress: &mut dyn FnMut(u64, u64),
     on_chunk: &mut dyn FnMut(&[crate::Point]) -> crate::Result<()>,
 ) -> crate::Result<StreamReport> {
     let format = Format::from_path(path)?;
     if !matches!(format, Format::Las | Format::Laz) {
-        let r = read(path, progress)?;
+        let mut r = read(path, progress)?;
+        if origin != [0.0; 3] {
+            for p in &mut r.cloud.points {
+                *p = [0, 1, 2].map(|a| (f64::from(p[a]) - origin[a]) as f32);
+            }
+        }
         for c in r.cloud.points.chunks(chunk.max(1)) {
             on_chunk(c)?;
         }
@@ -121,6 +130,7 @@ pub fn read_chunks(
     }
     let (file, total) = open(path)?;
     let mut out = Points::streaming(chunk, on_chunk);
+    out.origin = origin;
     let name = las::read(
         BufReader::with_capacity(BUFFER, file),
         total,
