@@ -24,6 +24,7 @@
 
 mod bilateral;
 mod common;
+mod grid;
 mod kdtree;
 mod normals;
 mod pass_through;

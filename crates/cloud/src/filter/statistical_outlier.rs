@@ -48,6 +48,7 @@
 //! sample standard deviation.
 
 use super::common::{bad, emptied, empty_input, gather, on_finite_points};
+use super::grid::Grid;
 use super::kdtree::KdTree;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
@@ -158,10 +159,23 @@ pub fn statistical_outlier_removal(
 
 /// The mean distance d̄_i of every point to its k nearest neighbours, as PCL
 /// computes it (f64 sum of f64 square roots of f32 squared distances,
-/// nearest first, divided by k, stored as f32).
+/// nearest first, divided by k, stored as f32; see `mean_of`).
 pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f32> {
-    let tree = KdTree::new(points);
-    tree.map_k_nearest_distances(mean_k + 1, |nearest| mean_of(nearest, mean_k))
+    k_nearest_distances(points, mean_k + 1, |nearest| mean_of(nearest, mean_k))
+}
+
+/// `f` of every point's k nearest squared distances (the point itself
+/// counted; in any order, the k-th last), in input order: on the grid of columns when the
+/// cloud suits one (`grid.rs`), else on the k-d tree; the same bits either way.
+fn k_nearest_distances<T, F>(points: &[Point], k: usize, f: F) -> Vec<T>
+where
+    T: Send + Sync + Clone + Default,
+    F: Fn(&[f32]) -> T + Sync + Send,
+{
+    match Grid::for_k_nearest(points, k) {
+        Some(grid) => grid.map_k_nearest_distances(k, f),
+        None => KdTree::new(points).map_k_nearest_distances(k, f),
+    }
 }
 
 /// The mean distance d̄_i of every point to its k nearest neighbours (as
@@ -171,8 +185,7 @@ pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f
 /// whether the neighbours it did not load could have mattered.
 pub fn mean_distances_and_reach(points: &[Point], mean_k: usize) -> Result<Vec<(f32, f32)>> {
     enough_points(points.len(), mean_k)?;
-    let tree = KdTree::new(points);
-    Ok(tree.map_k_nearest_distances(mean_k + 1, |nearest| {
+    Ok(k_nearest_distances(points, mean_k + 1, |nearest| {
         (mean_of(nearest, mean_k), nearest[nearest.len() - 1])
     }))
 }
@@ -214,13 +227,46 @@ pub fn mean_distances_and_reach_at(
         .collect())
 }
 
-/// d̄_i from the k + 1 nearest squared distances, nearest first, as PCL
-/// computes it.
+/// d̄_i from the k + 1 nearest squared distances (the first of them, in
+/// PCL's order, is the point itself at 0, which adds nothing), as PCL
+/// computes it: the f64 sum of their f64 roots nearest first, over k, as f32.
+///
+/// The k + 1 come in any order (the k-th last): sorting them for every
+/// point would cost more than the search. They are summed in four lanes,
+/// and the sum is PCL's to the bit whenever it is clear of an f32 rounding
+/// boundary by more than the two sums can differ: any order of summing
+/// k + 1 positive terms lies within (k + 1)·2⁻⁵³ of their exact sum, so
+/// PCL's and ours within twice that of each other. In the rare other case
+/// (about 1 point in 10⁷) the distances are sorted and summed in PCL's order.
 fn mean_of(nearest: &[f32], mean_k: usize) -> f32 {
-    let sum = nearest[1..]
+    let mut lanes = [0.0f64; 4];
+    let mut chunks = nearest.chunks_exact(4);
+    for c in &mut chunks {
+        for (lane, &d) in lanes.iter_mut().zip(c) {
+            *lane += f64::from(d).sqrt();
+        }
+    }
+    let rest: f64 = chunks
+        .remainder()
+        .iter()
+        .map(|&d| f64::from(d).sqrt())
+        .sum();
+    let sum = (lanes[0] + lanes[1]) + (lanes[2] + lanes[3]) + rest;
+    let k = mean_k as f64;
+    let mean = sum / k;
+    // Both sums within n·2⁻⁵³·sum of the exact one; a relative 4n·2⁻⁵³
+    // (and two f64 roundings of the quotient) bounds where PCL's quotient can lie.
+    let gap = mean * (4.0 * (nearest.len() as f64 + 2.0) * f64::EPSILON);
+    let (low, high) = ((mean - gap) as f32, (mean + gap) as f32);
+    if low == high {
+        return low;
+    }
+    let mut sorted = nearest.to_vec();
+    sorted.sort_unstable_by(f32::total_cmp);
+    let sum = sorted[1..]
         .iter()
         .fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
-    (sum / mean_k as f64) as f32
+    (sum / k) as f32
 }
 
 /// The global sums of [RS eq. 14] in PCL's arithmetic (f64 sums, the square
@@ -302,4 +348,43 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
         .filter(|(_, &d)| cut.keeps(d))
         .map(|(i, _)| i)
         .collect())
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// PCL's d̄_i: sorted, the first skipped, summed nearest first.
+    fn in_pcl_order(nearest: &[f32], mean_k: usize) -> f32 {
+        let mut sorted = nearest.to_vec();
+        sorted.sort_unstable_by(f32::total_cmp);
+        let sum = sorted[1..]
+            .iter()
+            .fold(0.0_f64, |s, &d| s + f64::from(d).sqrt());
+        (sum / mean_k as f64) as f32
+    }
+
+    #[test]
+    fn the_mean_in_any_order_is_pcls_to_the_bit() {
+        // Shuffled distances of every scale from 1e-12 to 1e4 m², k from 1 to 100.
+        let mut s = 7u64;
+        let mut u = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 11) as f64) / (1u64 << 53) as f64
+        };
+        for trial in 0..100_000 {
+            let k = [1, 2, 5, 20, 50, 51, 100][trial % 7];
+            let scale = 10f64.powi((trial % 17) as i32 - 12);
+            let mut d: Vec<f32> = (0..k).map(|_| (u() * scale) as f32).collect();
+            d.push(0.0);
+            d.rotate_right(trial % (k + 1));
+            assert_eq!(
+                mean_of(&d, k).to_bits(),
+                in_pcl_order(&d, k).to_bits(),
+                "{d:?}"
+            );
+        }
+    }
 }

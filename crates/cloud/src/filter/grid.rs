@@ -1,0 +1,450 @@
+//! Exact k nearest distances on a uniform grid of columns, for dense scans.
+//!
+//! Why beside the k-d tree: on a LiDAR scan the k nearest of a point lie in
+//! a ball whose radius changes slowly over the cloud. Points are filed in
+//! vertical columns of side `h` (about the k-th distance), each column
+//! sorted by height, and queried in that order. A query takes the k-th
+//! distance of the point before it, a little more, as a radius r; the
+//! columns that meet the box q ± r give, by a binary search each, the
+//! points whose height is within r, and one pass of plain arithmetic over
+//! those contiguous runs (which the compiler vectorises) gives their
+//! squared distances. If k of them lie within r, they are the k nearest;
+//! otherwise r grows (by the count found, as on a surface) and the query is
+//! repeated. In place of the tree's walk with a branch a node, a query
+//! costs a few binary searches and about twice k distances. A cloud whose
+//! grid would need far more columns than points (two scans kilometres
+//! apart) is declined and the caller uses the k-d tree; both give the same
+//! distances, bit for bit.
+//!
+//! Arithmetic as in `kdtree.rs`: squared distances in f32 in FLANN's order,
+//! so that the sums agree with PCL's; the box is the radius widened by a
+//! relative 1e-4, far above the f32 rounding of a squared distance, so no
+//! point within r is left out of it.
+
+use std::sync::OnceLock;
+
+use rayon::prelude::*;
+
+use super::kdtree::{KdTree, Nearest};
+
+use crate::Point;
+
+/// Columns allowed per point before the grid is declined.
+const COLUMNS_PER_POINT: usize = 8;
+
+/// Relative widening of the box (see the module docs).
+const SLACK: f64 = 1e-4;
+
+/// Points filed by column (row-major over x, y), each column by height.
+pub(crate) struct Grid {
+    /// Corner of the grid (the cloud's minimum) and cell side.
+    origin: [f64; 3],
+    h: f64,
+    /// Columns along x and y.
+    nx: usize,
+    ny: usize,
+    /// First sorted position of each column; `nx·ny + 1` entries.
+    start: Vec<u32>,
+    /// Coordinates in sorted order.
+    x: Vec<f32>,
+    y: Vec<f32>,
+    z: Vec<f32>,
+    /// Input index of each sorted position.
+    ids: Vec<u32>,
+    /// A k-d tree over the points in sorted order, built at the first
+    /// query far from the rest (an outlier), which it answers better.
+    tree: OnceLock<KdTree>,
+}
+
+impl Grid {
+    /// Files `points` (finite, more than `k`) on columns whose side suits
+    /// their k-th neighbour distance, or `None` when the cloud is too
+    /// sparse for a grid (see the module docs).
+    pub(crate) fn for_k_nearest(points: &[Point], k: usize) -> Option<Self> {
+        let n = points.len();
+        if n <= k || u32::try_from(n).is_err() {
+            return None;
+        }
+        let (lo, hi) = bounds(points);
+        // A side from the density over the columns the points occupy (a
+        // scan is a surface: k points in a disc of radius h), found on a
+        // first grid of 16 points a column on the box's floor.
+        let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
+        let first = (16.0 * area / n as f64).sqrt();
+        let side = match Columns::new(points, lo, hi, first) {
+            Some(columns) => {
+                let occupied = columns.counts().filter(|&c| c > 0).count();
+                let covered = occupied as f64 * columns.h * columns.h;
+                (covered * k as f64 / (std::f64::consts::PI * n as f64)).sqrt()
+            }
+            None => first,
+        };
+        Self::new(points, lo, hi, side)
+    }
+
+    /// Files the points on columns of side about `wanted`.
+    fn new(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<Self> {
+        let n = points.len();
+        let columns = Columns::new(points, lo, hi, wanted)?;
+        let Columns { h, nx, ny, of, .. } = columns;
+        let mut start = vec![0u32; nx * ny + 1];
+        for &c in &of {
+            start[c as usize + 1] += 1;
+        }
+        for c in 0..nx * ny {
+            start[c + 1] += start[c];
+        }
+        // Counting sort by column, then each column by height.
+        let mut next = start.clone();
+        let mut entries = vec![(0u64, 0u32); n];
+        for (i, &c) in of.iter().enumerate() {
+            let slot = &mut next[c as usize];
+            // Heights ordered as integers (finite f32, sign folded).
+            let bits = points[i][2].to_bits();
+            let key = if bits >> 31 == 1 {
+                !bits
+            } else {
+                bits | 1 << 31
+            };
+            entries[*slot as usize] = ((u64::from(c) << 32) | u64::from(key), i as u32);
+            *slot += 1;
+        }
+        entries
+            .par_chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32)
+            .for_each(|column| column.sort_unstable());
+        let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
+        let coordinate =
+            |a: usize| -> Vec<f32> { ids.par_iter().map(|&i| points[i as usize][a]).collect() };
+        Some(Self {
+            origin: lo,
+            h,
+            nx,
+            ny,
+            start,
+            x: coordinate(0),
+            y: coordinate(1),
+            z: coordinate(2),
+            ids,
+            tree: OnceLock::new(),
+        })
+    }
+
+    /// The squared distances (as ordered bits) from `q` to every point
+    /// within `r` of it, into `bits`; `dist` is scratch.
+    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>, dist: &mut Vec<u32>) {
+        bits.clear();
+        let wide = r * (1.0 + SLACK);
+        let cap = (r * r) as f32;
+        let cap = cap.to_bits();
+        let column = |c: f64, a: usize, last: usize| {
+            (((c - self.origin[a]) / self.h).max(0.0) as usize).min(last)
+        };
+        let (qx, qy) = (f64::from(q[0]), f64::from(q[1]));
+        let (x0, x1) = (
+            column(qx - wide, 0, self.nx - 1),
+            column(qx + wide, 0, self.nx - 1),
+        );
+        let (y0, y1) = (
+            column(qy - wide, 1, self.ny - 1),
+            column(qy + wide, 1, self.ny - 1),
+        );
+        let z_lo = (f64::from(q[2]) - wide) as f32;
+        let z_hi = (f64::from(q[2]) + wide) as f32;
+        let [qx, qy, qz] = q;
+        for cy in y0..=y1 {
+            for cx in x0..=x1 {
+                let c = cy * self.nx + cx;
+                let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
+                if s == e {
+                    continue;
+                }
+                let zs = &self.z[s..e];
+                let (s, e) = (
+                    s + zs.partition_point(|&z| z < z_lo),
+                    s + zs.partition_point(|&z| z <= z_hi),
+                );
+                if s >= e {
+                    continue;
+                }
+                // One pass of arithmetic alone, which the compiler
+                // vectorises (FLANN's order, as `squared_distance`) ...
+                dist.clear();
+                let coords = self.x[s..e].iter().zip(&self.y[s..e]).zip(&self.z[s..e]);
+                dist.extend(coords.map(|((x, y), z)| {
+                    let (dx, dy, dz) = (qx - x, qy - y, qz - z);
+                    (dx * dx + dy * dy + dz * dz).to_bits()
+                }));
+                // ... then those within r kept (squared distances are
+                // ≥ +0, whose bits order as the numbers).
+                let base = bits.len();
+                bits.resize(base + dist.len(), 0);
+                let out = &mut bits[base..];
+                let mut kept = 0;
+                for &b in dist.iter() {
+                    out[kept] = b;
+                    kept += usize::from(b <= cap);
+                }
+                bits.truncate(base + kept);
+            }
+        }
+    }
+
+    /// The k nearest squared distances of `q`, in any order but the k-th
+    /// last, left in `bits[..k]`, starting from the radius `guess` (which may be too
+    /// small or too large); returns the k-th.
+    fn k_nearest(&self, q: [f32; 3], guess: f64, k: usize, scratch: &mut Scratch) -> f32 {
+        let mut r = guess;
+        loop {
+            self.within(q, r, &mut scratch.bits, &mut scratch.dist);
+            let found = scratch.bits.len();
+            if found >= k {
+                let bits = &mut scratch.bits;
+                bits.select_nth_unstable(k - 1);
+                return f32::from_bits(bits[k - 1]);
+            }
+            // Too few within r: on a surface the count grows as r², so
+            // grow r by the shortfall (at least ×1.25, at most ×4) ...
+            let grow = (k as f64 / found.max(1) as f64).sqrt() * 1.1;
+            r *= grow.clamp(1.25, 4.0);
+            if r > FAR * self.h {
+                // ... but a point far from the rest (an outlier above the
+                // scan) would sweep a wide box of points much nearer to
+                // each other than to it: the tree prunes those.
+                return self.from_tree(q, k, scratch);
+            }
+        }
+    }
+
+    /// The k nearest squared distances of `q` from the tree, as `k_nearest`.
+    fn from_tree(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
+        let tree = self.tree.get_or_init(|| {
+            let points: Vec<Point> = (0..self.ids.len())
+                .map(|p| [self.x[p], self.y[p], self.z[p]])
+                .collect();
+            KdTree::new(&points)
+        });
+        let knn = scratch.knn.get_or_insert_with(|| Nearest::new(k));
+        tree.nearest(&q, knn);
+        scratch.bits.clear();
+        scratch
+            .bits
+            .extend(knn.distances().iter().map(|d| d.to_bits()));
+        knn.distances()[k - 1]
+    }
+
+    /// `f` of the k nearest squared distances (the point itself counted;
+    /// in any order, the k-th last) of every point, in input order; runs of columns in
+    /// parallel.
+    pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
+    where
+        T: Send + Sync + Clone + Default,
+        F: Fn(&[f32]) -> T + Sync + Send,
+    {
+        let n = self.ids.len();
+        let runs: Vec<(usize, usize)> = (0..n.div_ceil(RUN))
+            .map(|i| (i * RUN, ((i + 1) * RUN).min(n)))
+            .collect();
+        let parts: Vec<Vec<T>> = runs
+            .par_iter()
+            .map_init(Scratch::default, |scratch, &(s, e)| {
+                let mut out = Vec::with_capacity(e - s);
+                let mut guess = self.h;
+                for p in s..e {
+                    let q = [self.x[p], self.y[p], self.z[p]];
+                    let kth = self.k_nearest(q, guess, k, scratch);
+                    // The next point is near (same column, a little
+                    // higher, mostly): its k-th distance is likely within
+                    // a little more, and rarely far more than a column.
+                    guess = (f64::from(kth).sqrt() * GUESS)
+                        .min(2.0 * self.h)
+                        .max(self.h * 1e-3);
+                    let dist = &mut scratch.nearest;
+                    dist.clear();
+                    dist.extend(scratch.bits[..k].iter().map(|&b| f32::from_bits(b)));
+                    out.push(f(dist));
+                }
+                out
+            })
+            .collect();
+        let mut result = vec![T::default(); n];
+        for (part, &(s, _)) in parts.into_iter().zip(&runs) {
+            for (j, value) in part.into_iter().enumerate() {
+                result[self.ids[s + j] as usize] = value;
+            }
+        }
+        result
+    }
+}
+
+/// Points per parallel task.
+const RUN: usize = 4096;
+
+/// The next query's radius: this times the k-th distance of the last.
+const GUESS: f64 = 1.1;
+
+/// A query whose radius grows past this many columns goes to the tree.
+const FAR: f64 = 3.0;
+
+/// The column of every point on a grid of side `h` over the box.
+struct Columns {
+    h: f64,
+    nx: usize,
+    ny: usize,
+    of: Vec<u32>,
+}
+
+impl Columns {
+    /// Columns of side `wanted` (grown until they number at most
+    /// `COLUMNS_PER_POINT` a point; `None` past 4× `wanted`).
+    fn new(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<Self> {
+        let n = points.len();
+        let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
+        let largest = extent.iter().cloned().fold(0.0, f64::max);
+        if largest <= 0.0 || !wanted.is_finite() {
+            return None;
+        }
+        // No side below the cloud's extent over 2^20 (duplicates give a
+        // k-th distance of zero).
+        let wanted = wanted.max(largest / f64::from(1u32 << 20));
+        let cells = |h: f64, e: f64| (e / h).floor() as usize + 1;
+        let limit = COLUMNS_PER_POINT * n + 1024;
+        let count = |h: f64| cells(h, extent[0]).saturating_mul(cells(h, extent[1]));
+        let mut h = wanted;
+        while count(h) > limit {
+            h *= 1.25;
+            if h > 4.0 * wanted {
+                return None;
+            }
+        }
+        let (nx, ny) = (cells(h, extent[0]), cells(h, extent[1]));
+        let of = points
+            .par_iter()
+            .map(|p| {
+                let cx = (((f64::from(p[0]) - lo[0]) / h) as usize).min(nx - 1);
+                let cy = (((f64::from(p[1]) - lo[1]) / h) as usize).min(ny - 1);
+                (cy * nx + cx) as u32
+            })
+            .collect();
+        Some(Self { h, nx, ny, of })
+    }
+
+    /// Points in each column.
+    fn counts(&self) -> impl Iterator<Item = u32> {
+        let mut counts = vec![0u32; self.nx * self.ny];
+        for &c in &self.of {
+            counts[c as usize] += 1;
+        }
+        counts.into_iter()
+    }
+}
+
+/// Buffers of one task.
+#[derive(Default)]
+struct Scratch {
+    bits: Vec<u32>,
+    dist: Vec<u32>,
+    nearest: Vec<f32>,
+    knn: Option<Nearest>,
+}
+
+/// The cloud's bounding box, in f64.
+fn bounds(points: &[Point]) -> ([f64; 3], [f64; 3]) {
+    let (lo, hi) = points
+        .par_iter()
+        .fold(
+            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            |(mut lo, mut hi), p| {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+                (lo, hi)
+            },
+        )
+        .reduce(
+            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
+            |(l1, h1), (l2, h2)| {
+                (
+                    std::array::from_fn(|a| l1[a].min(l2[a])),
+                    std::array::from_fn(|a| h1[a].max(h2[a])),
+                )
+            },
+        );
+    (lo.map(f64::from), hi.map(f64::from))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::kdtree::KdTree;
+    use super::*;
+
+    fn cloud(n: usize, seed: u64) -> Vec<Point> {
+        let mut s = seed;
+        let mut u = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 40) as f32) / (1u64 << 24) as f32
+        };
+        // A rough surface with noise, a few outliers high above it and
+        // duplicated points.
+        let mut points: Vec<Point> = (0..n)
+            .map(|_| {
+                let (x, y) = (u() * 20.0, u() * 10.0);
+                [x, y, (x * 0.3).sin() + 0.01 * u()]
+            })
+            .collect();
+        for i in 0..n / 100 {
+            points[i * 97 % n][2] += 3.0 + u() * 5.0;
+        }
+        for i in 0..n / 200 {
+            points[i * 31 % n] = points[i * 37 % n];
+        }
+        points
+    }
+
+    /// The distances as sorted bits, after checking that the k-th is last.
+    fn bits(d: &[f32]) -> Vec<u32> {
+        let mut b: Vec<u32> = d.iter().map(|x| x.to_bits()).collect();
+        assert_eq!(b.iter().max(), b.last(), "the k-th is last");
+        b.sort_unstable();
+        b
+    }
+
+    fn both(points: &[Point], k: usize) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
+        let grid = Grid::for_k_nearest(points, k).expect("a grid");
+        let tree = KdTree::new(points);
+        (
+            grid.map_k_nearest_distances(k, bits),
+            tree.map_k_nearest_distances(k, bits),
+        )
+    }
+
+    #[test]
+    fn the_k_nearest_are_the_trees_bit_for_bit() {
+        // (with outliers: some queries answered by the grid's own tree)
+        for (n, k, seed) in [(20_000, 21, 1), (5_000, 51, 2), (300, 8, 3), (60, 59, 4)] {
+            let points = cloud(n, seed);
+            let (grid, tree) = both(&points, k);
+            assert_eq!(grid, tree, "n {n}, k {k}");
+        }
+    }
+
+    #[test]
+    fn a_flat_or_vertical_cloud_and_far_clusters_agree_too() {
+        // All in one plane (one slab), all in one column, and two
+        // clusters far apart (the grid grows its cells or is declined).
+        let flat: Vec<Point> = cloud(4_000, 5).iter().map(|p| [p[0], p[1], 2.0]).collect();
+        let line: Vec<Point> = cloud(4_000, 6).iter().map(|p| [1.0, 1.0, p[0]]).collect();
+        let mut far = cloud(4_000, 7);
+        for p in far.iter_mut().skip(2_000) {
+            p[0] += 5_000.0;
+        }
+        for points in [flat, line, far] {
+            let tree = KdTree::new(&points).map_k_nearest_distances(11, bits);
+            if let Some(grid) = Grid::for_k_nearest(&points, 11) {
+                assert_eq!(grid.map_k_nearest_distances(11, bits), tree);
+            }
+        }
+    }
+}
