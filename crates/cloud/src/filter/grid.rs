@@ -210,13 +210,13 @@ impl Grid {
                 // ... but a point far from the rest (an outlier above the
                 // scan) would sweep a wide box of points much nearer to
                 // each other than to it: the tree prunes those.
-                return self.from_tree(q, k, scratch);
+                return self.by_tree(q, k, scratch);
             }
         }
     }
 
     /// The k nearest squared distances of `q` from the tree, as `k_nearest`.
-    fn from_tree(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
+    fn by_tree(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
         let tree = self.tree.get_or_init(|| {
             let points: Vec<Point> = (0..self.ids.len())
                 .map(|p| [self.x[p], self.y[p], self.z[p]])
