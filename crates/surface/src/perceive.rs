@@ -817,19 +817,30 @@ pub fn perceive_after(
     let t = Instant::now();
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
-    let (cloud, roll, pitch) = match (prior, p.level.mode) {
+    // The floor found while estimating the tilt is the levelled cloud's
+    // floor too: levelling turns its normal onto the z axis and keeps its
+    // offset, so it is the plane z = d with the same inliers ([RS eq. 11]–12).
+    let (cloud, roll, pitch, found) = match (prior, p.level.mode) {
         (Some(prior), _) => (
             level(cloud, prior.roll_rad, prior.pitch_rad),
             prior.roll_rad,
             prior.pitch_rad,
+            Some(prior.floor),
         ),
         (None, LevelMode::Estimate) => {
             let est = estimate_tilt(cloud, &tilt_params)
                 .map_err(in_stage("estimating roll and pitch from the floor"))?;
+            let floor = TiltEstimate {
+                roll_rad: 0.0,
+                pitch_rad: 0.0,
+                normal: [0.0, 0.0, 1.0],
+                ..est
+            };
             (
                 level(cloud, est.roll_rad, est.pitch_rad),
                 est.roll_rad,
                 est.pitch_rad,
+                Some(floor),
             )
         }
         (None, LevelMode::Given) => {
@@ -844,13 +855,13 @@ pub fn perceive_after(
                     expected: "finite angles",
                 });
             }
-            (level(cloud, r, q), r, q)
+            (level(cloud, r, q), r, q, None)
         }
-        (None, LevelMode::None) => (cloud.clone(), 0.0, 0.0),
+        (None, LevelMode::None) => (cloud.clone(), 0.0, 0.0, None),
     };
-    // The floor after levelling (for the pass-through threshold).
-    let floor = match prior {
-        Some(prior) => prior.floor,
+    // Otherwise the floor after levelling (for the pass-through threshold).
+    let floor = match found {
+        Some(floor) => floor,
         None => estimate_tilt(&cloud, &tilt_params)
             .map_err(in_stage("finding the floor after levelling"))?,
     };

@@ -290,12 +290,16 @@ pub fn least_squares_plane(points: &[[f64; 3]], indices: &[usize]) -> Option<Pla
 
 /// Indices of the points within `threshold` of `plane`, ascending.
 pub(crate) fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> Vec<usize> {
-    points
-        .iter()
-        .enumerate()
-        .filter(|(_, p)| plane.signed_distance(**p).abs() <= threshold)
-        .map(|(i, _)| i)
-        .collect()
+    use rayon::prelude::*;
+    let inlier = |i: usize| plane.signed_distance(points[i]).abs() <= threshold;
+    if points.len() < 1 << 16 {
+        (0..points.len()).filter(|&i| inlier(i)).collect()
+    } else {
+        (0..points.len())
+            .into_par_iter()
+            .filter(|&i| inlier(i))
+            .collect()
+    }
 }
 
 fn distinct_triple(rng: &mut ChaCha8Rng, n: usize) -> (usize, usize, usize) {

@@ -91,6 +91,16 @@ impl Grid {
         Self::new(points, lo, hi, side)
     }
 
+    /// Files `points` (finite) on columns as wide as `radius`, for
+    /// searches within it, or `None` when the cloud is too sparse for a grid.
+    pub(crate) fn for_radius(points: &[Point], radius: f64) -> Option<Self> {
+        if points.is_empty() || u32::try_from(points.len()).is_err() {
+            return None;
+        }
+        let (lo, hi) = bounds(points);
+        Self::new(points, lo, hi, radius)
+    }
+
     /// Files the points on columns of side about `wanted`.
     fn new(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<Self> {
         let n = points.len();
@@ -142,13 +152,11 @@ impl Grid {
         })
     }
 
-    /// The squared distances (as ordered bits) from `q` to every point
-    /// within `r` of it, into `bits`; `dist` is scratch.
-    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>, dist: &mut Vec<u32>) {
-        bits.clear();
+    /// Calls `visit` with each run of sorted positions that may hold points
+    /// within `r` of `q` (all such points are in some run), until it
+    /// returns `false`.
+    fn runs(&self, q: [f32; 3], r: f64, mut visit: impl FnMut(usize, usize) -> bool) {
         let wide = r * (1.0 + SLACK);
-        let cap = (r * r) as f32;
-        let cap = cap.to_bits();
         let column = |c: f64, a: usize, last: usize| {
             (((c - self.origin[a]) / self.h).max(0.0) as usize).min(last)
         };
@@ -170,46 +178,116 @@ impl Grid {
         if f64::from(hi32) < z_hi {
             hi32 = hi32.next_up();
         }
-        let [qx, qy, qz] = q;
-        for cy in y0..=y1 {
-            for cx in x0..=x1 {
-                let c = cy * self.nx + cx;
-                if self.start[c] == self.start[c + 1] {
-                    continue;
-                }
-                // The slabs that hold heights lo32..=hi32 (a slab's
-                // number grows with height, so none between is missed).
-                let slabs = &self.slabs[c];
-                let (a, b) = (slabs.of(lo32), slabs.of(hi32));
-                let first = slabs.first as usize;
-                let (s, e) = (
-                    self.slab_start[first + a] as usize,
-                    self.slab_start[first + b + 1] as usize,
-                );
-                if s >= e {
-                    continue;
-                }
-                // One pass of arithmetic alone, which the compiler
-                // vectorises (FLANN's order, as `squared_distance`) ...
-                dist.clear();
-                let coords = self.x[s..e].iter().zip(&self.y[s..e]).zip(&self.z[s..e]);
-                dist.extend(coords.map(|((x, y), z)| {
-                    let (dx, dy, dz) = (qx - x, qy - y, qz - z);
-                    (dx * dx + dy * dy + dz * dz).to_bits()
-                }));
-                // ... then those within r kept (squared distances are
-                // ≥ +0, whose bits order as the numbers).
-                let base = bits.len();
-                bits.resize(base + dist.len(), 0);
-                let out = &mut bits[base..];
-                let mut kept = 0;
-                for &b in dist.iter() {
-                    out[kept] = b;
-                    kept += usize::from(b <= cap);
-                }
-                bits.truncate(base + kept);
+        // The query's own column first (a count may stop there), then the rest.
+        let own = (column(qx, 0, self.nx - 1), column(qy, 1, self.ny - 1));
+        let cells = std::iter::once(own).chain(
+            (y0..=y1)
+                .flat_map(|cy| (x0..=x1).map(move |cx| (cx, cy)))
+                .filter(|&c| c != own),
+        );
+        for (cx, cy) in cells {
+            let c = cy * self.nx + cx;
+            if self.start[c] == self.start[c + 1] {
+                continue;
+            }
+            // The slabs that hold heights lo32..=hi32 (a slab's number
+            // grows with height, so none between is missed).
+            let slabs = &self.slabs[c];
+            let (a, b) = (slabs.of(lo32), slabs.of(hi32));
+            let first = slabs.first as usize;
+            let (s, e) = (
+                self.slab_start[first + a] as usize,
+                self.slab_start[first + b + 1] as usize,
+            );
+            if s < e && !visit(s, e) {
+                return;
             }
         }
+    }
+
+    /// The squared distances of positions `s..e` from `q` as ordered bits
+    /// (squared distances are ≥ +0, whose bits order as the numbers), in
+    /// one pass of arithmetic alone, which the compiler vectorises
+    /// (FLANN's order, as `squared_distance`).
+    fn distances(&self, q: [f32; 3], s: usize, e: usize, out: &mut Vec<u32>) {
+        let [qx, qy, qz] = q;
+        out.clear();
+        let coords = self.x[s..e].iter().zip(&self.y[s..e]).zip(&self.z[s..e]);
+        out.extend(coords.map(|((x, y), z)| {
+            let (dx, dy, dz) = (qx - x, qy - y, qz - z);
+            (dx * dx + dy * dy + dz * dz).to_bits()
+        }));
+    }
+
+    /// The squared distances (as ordered bits) from `q` to every point
+    /// within `r` of it, into `bits`; `dist` is scratch.
+    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>, dist: &mut Vec<u32>) {
+        bits.clear();
+        let cap = ((r * r) as f32).to_bits();
+        self.runs(q, r, |s, e| {
+            self.distances(q, s, e, dist);
+            // Those within r kept.
+            let base = bits.len();
+            bits.resize(base + dist.len(), 0);
+            let out = &mut bits[base..];
+            let mut kept = 0;
+            for &b in dist.iter() {
+                out[kept] = b;
+                kept += usize::from(b <= cap);
+            }
+            bits.truncate(base + kept);
+            true
+        });
+    }
+
+    /// Whether at least `wanted` points (`q` itself counted) lie within
+    /// squared distance `r2` of `q`, inclusive; stops at a run that
+    /// brings the count there.
+    fn has_within(&self, q: [f32; 3], r2: f32, wanted: usize, dist: &mut Vec<u32>) -> bool {
+        let cap = r2.to_bits();
+        let mut count = 0;
+        self.runs(q, f64::from(r2).sqrt(), |s, e| {
+            self.distances(q, s, e, dist);
+            count += dist.iter().filter(|&&b| b <= cap).count();
+            count < wanted
+        });
+        count >= wanted
+    }
+
+    /// Whether each point has at least `wanted` points (itself counted)
+    /// within squared distance `r2`, in input order (radius outlier
+    /// removal, [RS eq. 13]).
+    pub(crate) fn map_has_within(&self, r2: f32, wanted: usize) -> Vec<bool> {
+        self.map_sorted(Vec::new, |dist, p| {
+            self.has_within([self.x[p], self.y[p], self.z[p]], r2, wanted, dist)
+        })
+    }
+
+    /// `f(scratch, sorted position)` for every point, runs of positions in
+    /// parallel (`init` makes each task's scratch), in input order.
+    fn map_sorted<T, S, I, F>(&self, init: I, f: F) -> Vec<T>
+    where
+        T: Send + Sync + Clone + Default,
+        I: Fn() -> S + Sync + Send,
+        F: Fn(&mut S, usize) -> T + Sync + Send,
+    {
+        let n = self.ids.len();
+        let runs: Vec<(usize, usize)> = (0..n.div_ceil(RUN))
+            .map(|i| (i * RUN, ((i + 1) * RUN).min(n)))
+            .collect();
+        let parts: Vec<Vec<T>> = runs
+            .par_iter()
+            .map_init(init, |scratch, &(s, e)| {
+                (s..e).map(|p| f(scratch, p)).collect()
+            })
+            .collect();
+        let mut result = vec![T::default(); n];
+        for (part, &(s, _)) in parts.into_iter().zip(&runs) {
+            for (j, value) in part.into_iter().enumerate() {
+                result[self.ids[s + j] as usize] = value;
+            }
+        }
+        result
     }
 
     /// The k nearest squared distances of `q`, in any order but the k-th
@@ -263,39 +341,23 @@ impl Grid {
         T: Send + Sync + Clone + Default,
         F: Fn(&[f32]) -> T + Sync + Send,
     {
-        let n = self.ids.len();
-        let runs: Vec<(usize, usize)> = (0..n.div_ceil(RUN))
-            .map(|i| (i * RUN, ((i + 1) * RUN).min(n)))
-            .collect();
-        let parts: Vec<Vec<T>> = runs
-            .par_iter()
-            .map_init(Scratch::default, |scratch, &(s, e)| {
-                let mut out = Vec::with_capacity(e - s);
-                let mut guess = self.h;
-                for p in s..e {
-                    let q = [self.x[p], self.y[p], self.z[p]];
-                    let kth = self.k_nearest(q, guess, k, scratch);
-                    // The next point is near (same column, a little
-                    // higher, mostly): its k-th distance is likely within
-                    // a little more, and rarely far more than a column.
-                    guess = (f64::from(kth).sqrt() * GUESS)
-                        .min(2.0 * self.h)
-                        .max(self.h * 1e-3);
-                    let dist = &mut scratch.nearest;
-                    dist.clear();
-                    dist.extend(scratch.bits[..k].iter().map(|&b| f32::from_bits(b)));
-                    out.push(f(dist));
-                }
-                out
-            })
-            .collect();
-        let mut result = vec![T::default(); n];
-        for (part, &(s, _)) in parts.into_iter().zip(&runs) {
-            for (j, value) in part.into_iter().enumerate() {
-                result[self.ids[s + j] as usize] = value;
-            }
-        }
-        result
+        self.map_sorted(
+            || (Scratch::default(), self.h),
+            |(scratch, guess), p| {
+                let q = [self.x[p], self.y[p], self.z[p]];
+                let kth = self.k_nearest(q, *guess, k, scratch);
+                // The next point is near (same column, a little higher,
+                // mostly): its k-th distance is likely within a little
+                // more, and rarely far more than a column.
+                *guess = (f64::from(kth).sqrt() * GUESS)
+                    .min(2.0 * self.h)
+                    .max(self.h * 1e-3);
+                let dist = &mut scratch.nearest;
+                dist.clear();
+                dist.extend(scratch.bits[..k].iter().map(|&b| f32::from_bits(b)));
+                f(dist)
+            },
+        )
     }
 }
 
@@ -535,6 +597,24 @@ mod tests {
             if let Some(grid) = Grid::for_k_nearest(&points, 11) {
                 assert_eq!(grid.map_k_nearest_distances(11, bits), tree);
             }
+        }
+    }
+
+    #[test]
+    fn radius_counts_are_the_trees() {
+        for (n, r, wanted, seed) in [
+            (20_000, 0.05f32, 6, 8),
+            (3_000, 0.3, 12, 9),
+            (500, 2.0, 40, 10),
+        ] {
+            let points = cloud(n, seed);
+            let r2 = r * r;
+            let tree = KdTree::new(&points);
+            let by_tree = tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted));
+            let grid = Grid::for_radius(&points, f64::from(r)).expect("a grid");
+            let by_grid = grid.map_has_within(r2, wanted);
+            assert_eq!(by_grid, by_tree, "n {n}, r {r}");
+            assert!(by_grid.iter().any(|&k| k) && by_grid.iter().any(|&k| !k));
         }
     }
 }

@@ -39,6 +39,7 @@ use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_points};
+use super::grid::Grid;
 use super::kdtree::KdTree;
 use crate::{PointCloud, Result};
 
@@ -134,11 +135,18 @@ fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<us
     if wanted > points.len() {
         return Vec::new();
     }
-    let tree = KdTree::new(points);
     let r2 = f32_at_most(params.radius_m * params.radius_m);
     // The wanted-th nearest is within the radius exactly when at least
-    // `wanted` points are: count them, stopping at `wanted`.
-    let keep: Vec<bool> = tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted));
+    // `wanted` points are: count them, stopping at `wanted` (on a grid of
+    // columns as wide as the radius when the cloud suits one, `grid.rs`;
+    // else on the k-d tree: the same counts).
+    let keep: Vec<bool> = match Grid::for_radius(points, f64::from(r2).sqrt()) {
+        Some(grid) => grid.map_has_within(r2, wanted),
+        None => {
+            let tree = KdTree::new(points);
+            tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted))
+        }
+    };
     keep.par_iter()
         .enumerate()
         .filter(|(_, &k)| k)
