@@ -27,6 +27,7 @@
 //! its plane, noise on a plane shrinks).
 
 use super::common::{bad, empty_input, f32_at_most, is_finite};
+use super::grid::Grid;
 use super::kdtree::KdTree;
 use super::normals::pca_normal;
 use crate::{Point, PointCloud, Result};
@@ -118,21 +119,21 @@ pub fn bilateral_normal_smoothing(
         1.0 / (2.0 * params.sigma_d_m * params.sigma_d_m),
         1.0 / (2.0 * params.sigma_n_m * params.sigma_n_m),
     );
+    let radius = f64::from(r2).sqrt();
     for _ in 0..params.iterations {
-        let tree = KdTree::new(&points);
-        let current = tree.points();
-        points = tree.map_points(Vec::new, |found, pos, p| {
-            tree.within(p, r2, found);
-            // In input order, so that the sums' rounding does not depend on
-            // the tree (the same points give the same result in any cloud
-            // that holds their neighbourhood: a tile with its margin).
-            found.sort_unstable_by_key(|&q| tree.id(q as usize));
+        let current = &points;
+        // [RS eq. 19]–[RS eq. 20] for point `i` from its neighbours within
+        // the radius, in input order, so that the sums' rounding does not
+        // depend on the search (the same points give the same result in any
+        // cloud that holds their neighbourhood: a tile with its margin).
+        let smooth = |i: usize, found: &[u32]| -> Point {
+            let p = &current[i];
             let Some(n) = pca_normal(found.iter().map(|&q| current[q as usize])) else {
                 return *p;
             };
             let pf = p.map(f64::from);
             let (mut num, mut den) = (0.0_f64, 0.0_f64);
-            for &q in found.iter().filter(|&&q| q as usize != pos) {
+            for &q in found.iter().filter(|&&q| q as usize != i) {
                 let d = [0, 1, 2].map(|a| f64::from(current[q as usize][a]) - pf[a]);
                 let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
@@ -148,7 +149,24 @@ pub fn bilateral_normal_smoothing(
             } else {
                 *p
             }
-        });
+        };
+        // On a grid of columns as wide as the radius when the cloud suits
+        // one (`grid.rs`), else on the k-d tree: the same neighbours.
+        points = match Grid::for_radius(current, radius) {
+            Some(grid) => grid.map_within(r2, || (), |_, i, found| smooth(i, found)),
+            None => {
+                let tree = KdTree::new(current);
+                tree.map_points(Vec::new, |found, pos, p| {
+                    tree.within(p, r2, found);
+                    for q in found.iter_mut() {
+                        *q = tree.id(*q as usize) as u32;
+                    }
+                    found.sort_unstable();
+                    let _ = p;
+                    smooth(tree.id(pos), found)
+                })
+            }
+        };
     }
     Ok(PointCloud::new(points))
 }

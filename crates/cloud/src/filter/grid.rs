@@ -2,7 +2,7 @@
 //!
 //! Why beside the k-d tree: on a LiDAR scan the k nearest of a point lie in
 //! a ball whose radius changes slowly over the cloud. Points are filed in
-//! vertical columns of side `h` (about the k-th distance), each column
+//! vertical columns of side `h` (about twice the k-th distance), each column
 //! sorted by height and cut in slabs of `h / 2` whose first positions are
 //! stored, and queried in that order. A query takes the k-th distance of
 //! the point before it, a little more, as a radius r; the columns that
@@ -88,7 +88,7 @@ impl Grid {
             }
             None => first,
         };
-        Self::new(points, lo, hi, side)
+        Self::new(points, lo, hi, side * SIDE)
     }
 
     /// Files `points` (finite) on columns as wide as `radius`, for
@@ -263,6 +263,39 @@ impl Grid {
         })
     }
 
+    /// `f(scratch, i, found)` for every point `i` of the input, `found` the
+    /// input indices of the points within squared distance `r2` of it
+    /// (inclusive, itself counted), ascending; in input order.
+    pub(crate) fn map_within<T, S, I, F>(&self, r2: f32, init: I, f: F) -> Vec<T>
+    where
+        T: Send + Sync + Clone + Default,
+        I: Fn() -> S + Sync + Send,
+        F: Fn(&mut S, usize, &[u32]) -> T + Sync + Send,
+    {
+        let cap = r2.to_bits();
+        let r = f64::from(r2).sqrt();
+        self.map_sorted(
+            || (init(), Vec::new(), Vec::new()),
+            |(scratch, dist, found), p| {
+                let q = [self.x[p], self.y[p], self.z[p]];
+                found.clear();
+                self.runs(q, r, |s, e| {
+                    self.distances(q, s, e, dist);
+                    let ids = &self.ids[s..e];
+                    found.extend(
+                        dist.iter()
+                            .zip(ids)
+                            .filter(|(&b, _)| b <= cap)
+                            .map(|(_, &id)| id),
+                    );
+                    true
+                });
+                found.sort_unstable();
+                f(scratch, self.ids[p] as usize, found)
+            },
+        )
+    }
+
     /// `f(scratch, sorted position)` for every point, runs of positions in
     /// parallel (`init` makes each task's scratch), in input order.
     fn map_sorted<T, S, I, F>(&self, init: I, f: F) -> Vec<T>
@@ -366,6 +399,12 @@ const RUN: usize = 4096;
 
 /// The next query's radius: this times the k-th distance of the last.
 const GUESS: f64 = 1.1;
+
+/// Columns this many times as wide as the typical k-th distance: runs
+/// long enough to vectorise, few columns a query (1.3–1.5× faster than
+/// columns as wide as the distance on the bench piles).
+const SIDE: f64 = 2.0;
+const TUNE_R: f64 = 2.0;
 
 /// A query whose radius grows past this many columns goes to the tree.
 const FAR: f64 = 3.0;
@@ -616,5 +655,29 @@ mod tests {
             assert_eq!(by_grid, by_tree, "n {n}, r {r}");
             assert!(by_grid.iter().any(|&k| k) && by_grid.iter().any(|&k| !k));
         }
+    }
+
+    #[test]
+    fn neighbours_within_a_radius_are_the_trees() {
+        let points = cloud(8_000, 11);
+        let r2 = 0.25f32 * 0.25;
+        let tree = KdTree::new(&points);
+        let by_tree: Vec<Vec<u32>> = tree.map_points(Vec::new, |found, _, p| {
+            tree.within(p, r2, found);
+            let mut ids: Vec<u32> = found.iter().map(|&q| tree.id(q as usize) as u32).collect();
+            ids.sort_unstable();
+            ids
+        });
+        let grid = Grid::for_radius(&points, 0.25).expect("a grid");
+        let by_grid = grid.map_within(
+            r2,
+            || (),
+            |_, i, found| {
+                assert!(found.contains(&(i as u32)));
+                found.to_vec()
+            },
+        );
+        assert_eq!(by_grid, by_tree);
+        assert!(by_grid.iter().map(Vec::len).max() > Some(5));
     }
 }
