@@ -404,7 +404,6 @@ const GUESS: f64 = 1.1;
 /// long enough to vectorise, few columns a query (1.3–1.5× faster than
 /// columns as wide as the distance on the bench piles).
 const SIDE: f64 = 2.0;
-const TUNE_R: f64 = 2.0;
 
 /// A query whose radius grows past this many columns goes to the tree.
 const FAR: f64 = 3.0;
