@@ -137,8 +137,9 @@ pub fn bilateral_normal_smoothing(
                 let d = [0, 1, 2].map(|a| f64::from(current[q as usize][a]) - pf[a]);
                 let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
-                // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩).
-                let w = (-dist2 * inv_2sd2).exp() * (-h * h * inv_2sn2).exp();
+                // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩), two
+                // Gaussians taken as one exponential of their exponents' sum.
+                let w = (-(dist2 * inv_2sd2 + h * h * inv_2sn2)).exp();
                 num += w * h;
                 den += w;
             }
