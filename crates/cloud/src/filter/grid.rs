@@ -25,8 +25,6 @@
 //! relative 1e-4, far above the f32 rounding of a squared distance, so no
 //! point within r is left out of it.
 
-use std::sync::OnceLock;
-
 use rayon::prelude::*;
 
 use super::kdtree::{KdTree, Nearest};
@@ -47,9 +45,10 @@ pub(crate) struct Grid {
     /// Columns along x and y.
     nx: usize,
     ny: usize,
-    /// First sorted position of each column; `nx·ny + 1` entries.
+    /// First sorted position of each column (numbered by [`block_index`]),
+    /// and one past the last.
     start: Vec<u32>,
-    /// Each column's height index; `nx·ny` entries.
+    /// Each column's height index.
     slabs: Vec<Slabs>,
     /// The first sorted position of each slab, per column (from
     /// `Slabs::first`), and one past the column's last point.
@@ -60,9 +59,6 @@ pub(crate) struct Grid {
     z: Vec<f32>,
     /// Input index of each sorted position.
     ids: Vec<u32>,
-    /// A k-d tree over the points in sorted order, built at the first
-    /// query far from the rest (an outlier), which it answers better.
-    tree: OnceLock<KdTree>,
 }
 
 impl Grid {
@@ -88,7 +84,28 @@ impl Grid {
             }
             None => first,
         };
-        Self::new(points, lo, hi, side * SIDE)
+        let first = Self::new(points, lo, hi, side * SIDE)?;
+        // The density over the columns assumes a surface; where the range
+        // noise makes the scan a layer of some thickness (dense scans) the
+        // k nearest lie much closer. The median k-th distance of evenly
+        // spread points tells, and a grid far off it is made again.
+        let probes = PROBES.min(n);
+        let mut scratch = Scratch::default();
+        let mut kth: Vec<f64> = (0..probes)
+            .map(|i| {
+                let p = i * n / probes;
+                let q = [first.x[p], first.y[p], first.z[p]];
+                let kth = first.k_nearest(q, first.h / SIDE, k, &mut scratch, true);
+                f64::from(kth.unwrap_or(0.0)).sqrt()
+            })
+            .collect();
+        kth.sort_unstable_by(f64::total_cmp);
+        let side = kth[probes / 2] * SIDE;
+        if side > 0.0 && (side < first.h / 1.5 || side > first.h * 1.5) {
+            Self::new(points, lo, hi, side).or(Some(first))
+        } else {
+            Some(first)
+        }
     }
 
     /// Files `points` (finite) on columns as wide as `radius`, for
@@ -106,11 +123,12 @@ impl Grid {
         let n = points.len();
         let columns = Columns::new(points, lo, hi, wanted)?;
         let Columns { h, nx, ny, of, .. } = columns;
-        let mut start = vec![0u32; nx * ny + 1];
+        let count = block_index(nx - 1, ny - 1, nx) + 1;
+        let mut start = vec![0u32; count + 1];
         for &c in &of {
             start[c as usize + 1] += 1;
         }
-        for c in 0..nx * ny {
+        for c in 0..count {
             start[c + 1] += start[c];
         }
         // Counting sort by column, then each column by height.
@@ -132,8 +150,10 @@ impl Grid {
             .par_chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32)
             .for_each(|column| column.sort_unstable());
         let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
-        let coordinate =
-            |a: usize| -> Vec<f32> { ids.par_iter().map(|&i| points[i as usize][a]).collect() };
+        // The points in sorted order in one gather (one random read a
+        // point), then split by axis.
+        let sorted: Vec<Point> = ids.par_iter().map(|&i| points[i as usize]).collect();
+        let coordinate = |a: usize| -> Vec<f32> { sorted.par_iter().map(|p| p[a]).collect() };
         let z = coordinate(2);
         let (slabs, slab_start) = slab_index(&start, &z, h);
         Some(Self {
@@ -148,7 +168,6 @@ impl Grid {
             y: coordinate(1),
             z,
             ids,
-            tree: OnceLock::new(),
         })
     }
 
@@ -186,7 +205,7 @@ impl Grid {
                 .filter(|&c| c != own),
         );
         for (cx, cy) in cells {
-            let c = cy * self.nx + cx;
+            let c = block_index(cx, cy, self.nx);
             if self.start[c] == self.start[c + 1] {
                 continue;
             }
@@ -324,9 +343,18 @@ impl Grid {
     }
 
     /// The k nearest squared distances of `q`, in any order but the k-th
-    /// last, left in `bits[..k]`, starting from the radius `guess` (which may be too
-    /// small or too large); returns the k-th.
-    fn k_nearest(&self, q: [f32; 3], guess: f64, k: usize, scratch: &mut Scratch) -> f32 {
+    /// last, left in `bits[..k]`, starting from the radius `guess` (which
+    /// may be too small or too large); returns the k-th, or `None` for a
+    /// point far from the rest (its radius grew past `FAR` columns) unless
+    /// `unbounded`.
+    fn k_nearest(
+        &self,
+        q: [f32; 3],
+        guess: f64,
+        k: usize,
+        scratch: &mut Scratch,
+        unbounded: bool,
+    ) -> Option<f32> {
         let mut r = guess;
         loop {
             self.within(q, r, &mut scratch.bits, &mut scratch.dist);
@@ -334,29 +362,22 @@ impl Grid {
             if found >= k {
                 let bits = &mut scratch.bits;
                 bits.select_nth_unstable(k - 1);
-                return f32::from_bits(bits[k - 1]);
+                return Some(f32::from_bits(bits[k - 1]));
             }
             // Too few within r: on a surface the count grows as r², so
             // grow r by the shortfall (at least ×1.25, at most ×4) ...
             let grow = (k as f64 / found.max(1) as f64).sqrt() * 1.1;
             r *= grow.clamp(1.25, 4.0);
-            if r > FAR * self.h {
+            if r > FAR * self.h && !unbounded {
                 // ... but a point far from the rest (an outlier above the
-                // scan) would sweep a wide box of points much nearer to
-                // each other than to it: the tree prunes those.
-                return self.by_tree(q, k, scratch);
+                // scan) sweeps a wide box: such points are left for later.
+                return None;
             }
         }
     }
 
     /// The k nearest squared distances of `q` from the tree, as `k_nearest`.
-    fn by_tree(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
-        let tree = self.tree.get_or_init(|| {
-            let points: Vec<Point> = (0..self.ids.len())
-                .map(|p| [self.x[p], self.y[p], self.z[p]])
-                .collect();
-            KdTree::new(&points)
-        });
+    fn by_tree(&self, tree: &KdTree, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
         let knn = scratch.knn.get_or_insert_with(|| Nearest::new(k));
         tree.nearest(&q, knn);
         scratch.bits.clear();
@@ -367,32 +388,88 @@ impl Grid {
     }
 
     /// `f` of the k nearest squared distances (the point itself counted;
-    /// in any order, the k-th last) of every point, in input order; runs of columns in
-    /// parallel.
+    /// in any order, the k-th last) of every point, in input order; runs of
+    /// sorted positions in parallel. Points far from the rest are answered
+    /// after the others: by a k-d tree when they are many (outliers of a
+    /// noisy scan: each would sweep a wide box of the grid), else on the
+    /// grid (a tree over a 20 M-point scan for a few hundred of them would
+    /// cost more than it saves).
     pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
     where
         T: Send + Sync + Clone + Default,
         F: Fn(&[f32]) -> T + Sync + Send,
     {
-        self.map_sorted(
+        let answer = |scratch: &mut Scratch| {
+            let dist = &mut scratch.nearest;
+            dist.clear();
+            dist.extend(scratch.bits[..k].iter().map(|&b| f32::from_bits(b)));
+            f(dist)
+        };
+        let mut out: Vec<Option<T>> = self.map_sorted(
             || (Scratch::default(), self.h),
             |(scratch, guess), p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
-                let kth = self.k_nearest(q, *guess, k, scratch);
+                let kth = self.k_nearest(q, *guess, k, scratch, false)?;
                 // The next point is near (same column, a little higher,
                 // mostly): its k-th distance is likely within a little
                 // more, and rarely far more than a column.
                 *guess = (f64::from(kth).sqrt() * GUESS)
                     .min(2.0 * self.h)
                     .max(self.h * 1e-3);
-                let dist = &mut scratch.nearest;
-                dist.clear();
-                dist.extend(scratch.bits[..k].iter().map(|&b| f32::from_bits(b)));
-                f(dist)
+                Some(answer(scratch))
             },
-        )
+        );
+        let far: Vec<usize> = (0..self.ids.len())
+            .filter(|&p| out[self.ids[p] as usize].is_none())
+            .collect();
+        let tree = (far.len() * TREE_WORTH > self.ids.len()).then(|| {
+            let points: Vec<Point> = (0..self.ids.len())
+                .map(|p| [self.x[p], self.y[p], self.z[p]])
+                .collect();
+            KdTree::new(&points)
+        });
+        let late: Vec<(usize, T)> = far
+            .par_iter()
+            .map_init(Scratch::default, |scratch, &p| {
+                let q = [self.x[p], self.y[p], self.z[p]];
+                match &tree {
+                    Some(tree) => {
+                        self.by_tree(tree, q, k, scratch);
+                    }
+                    None => {
+                        self.k_nearest(q, FAR * self.h, k, scratch, true);
+                    }
+                }
+                (self.ids[p] as usize, answer(scratch))
+            })
+            .collect();
+        for (i, value) in late {
+            out[i] = Some(value);
+        }
+        out.into_iter().map(|v| v.unwrap_or_default()).collect()
     }
 }
+
+/// Far points per point above which they are answered by a k-d tree (a
+/// tree costs about 0.1 µs a point to build, a far point on the grid about
+/// 100 µs).
+const TREE_WORTH: usize = 1000;
+
+/// Columns a side of a block (see [`block_index`]).
+const BLOCK: usize = 8;
+
+/// The index of column (cx, cy) when the columns are numbered in blocks of
+/// 8 × 8, blocks in rows: the columns around a query then lie close
+/// together in memory (in plain rows the row above is a whole row of points
+/// away, which outgrows the caches on a 20 M-point scan).
+#[inline]
+fn block_index(cx: usize, cy: usize, nx: usize) -> usize {
+    let blocks_x = nx.div_ceil(BLOCK);
+    ((cy / BLOCK) * blocks_x + cx / BLOCK) * BLOCK * BLOCK + (cy % BLOCK) * BLOCK + cx % BLOCK
+}
+
+/// Points whose k-th distance checks a grid's side.
+const PROBES: usize = 256;
 
 /// Points per parallel task.
 const RUN: usize = 4096;
@@ -512,7 +589,7 @@ impl Columns {
             .map(|p| {
                 let cx = (((f64::from(p[0]) - lo[0]) / h) as usize).min(nx - 1);
                 let cy = (((f64::from(p[1]) - lo[1]) / h) as usize).min(ny - 1);
-                (cy * nx + cx) as u32
+                block_index(cx, cy, nx) as u32
             })
             .collect();
         Some(Self { h, nx, ny, of })
@@ -520,7 +597,7 @@ impl Columns {
 
     /// Points in each column.
     fn counts(&self) -> impl Iterator<Item = u32> {
-        let mut counts = vec![0u32; self.nx * self.ny];
+        let mut counts = vec![0u32; block_index(self.nx - 1, self.ny - 1, self.nx) + 1];
         for &c in &self.of {
             counts[c as usize] += 1;
         }
