@@ -1,22 +1,27 @@
-//! Exact k nearest distances on a uniform grid of columns, for dense scans.
+//! Exact neighbour searches on a uniform grid of columns, for dense scans:
+//! the k nearest distances (statistical removal), a count within a radius
+//! (radius removal) and all points within a radius (smoothing).
 //!
 //! Why beside the k-d tree: on a LiDAR scan the k nearest of a point lie in
 //! a ball whose radius changes slowly over the cloud. Points are filed in
-//! vertical columns of side `h` (about twice the k-th distance), each column
-//! sorted by height and cut in slabs of `h / 2` whose first positions are
-//! stored, and queried in that order. A query takes the k-th distance of
-//! the point before it, a little more, as a radius r; the columns that
-//! meet the box q ± r give, by two look-ups each, the run of points whose
-//! height may be within r, and one pass of plain arithmetic over those
-//! contiguous runs (which the compiler vectorises) gives their squared
-//! distances. If k of them lie within r, they hold the k nearest;
-//! otherwise r grows (by the count found, as on a surface) and the query is
-//! repeated. A point far from the rest (an outlier above the scan, whose
-//! box would sweep many columns) goes to a k-d tree, built on first need.
-//! In place of the tree's walk with a branch a node, a query costs a few
-//! look-ups and about three times k distances: the statistical filter on
-//! the 1 M-point bench pile fell from 1.19 s (the tree alone) to 0.6 s. A
-//! cloud whose grid would need far more columns than points (two scans
+//! vertical columns of side `h` (about twice the k-th distance, or the
+//! search radius), numbered in 8 × 8 blocks so that neighbouring columns
+//! lie close in memory, each column sorted by height and cut in slabs of
+//! `h / 2` whose first positions are stored; points are queried in that
+//! order. A k-nearest query takes the k-th distance of the point before
+//! it, a little more, as a radius r; the columns that meet the box q ± r
+//! give, by two look-ups each, the run of points whose height may be
+//! within r, and one pass of plain arithmetic over those contiguous runs
+//! (which the compiler vectorises) gives their squared distances. If k of
+//! them lie within r, they hold the k nearest; otherwise r grows (by the
+//! count found, as on a surface) and the query is repeated. A point far
+//! from the rest (an outlier above the scan, whose box would sweep many
+//! columns) is answered after the others: by a k-d tree when such points
+//! are many, else on the grid. In place of the tree's walk with a branch a
+//! node, a query costs a few look-ups and about four times k distances:
+//! the statistical filter on the 1 M-point bench pile fell from 2.15 s
+//! (the tree alone) to 0.64–0.79 s (BENCHMARKS.md, 2026-12-03). A cloud
+//! whose grid would need far more columns than points (two scans
 //! kilometres apart) is declined and the caller uses the k-d tree; both
 //! give the same distances, bit for bit.
 //!
@@ -37,7 +42,7 @@ const COLUMNS_PER_POINT: usize = 8;
 /// Relative widening of the box (see the module docs).
 const SLACK: f64 = 1e-4;
 
-/// Points filed by column (row-major over x, y), each column by height.
+/// Points filed by column (numbered in blocks, see `block_index`), each column by height.
 pub(crate) struct Grid {
     /// Corner of the grid (the cloud's minimum) and cell side.
     origin: [f64; 3],
