@@ -136,24 +136,51 @@ impl Grid {
         for c in 0..count {
             start[c + 1] += start[c];
         }
-        // Counting sort by column, then each column by height.
-        let mut next = start.clone();
-        let mut entries = vec![(0u64, 0u32); n];
+        // Counting sort by column, then each column by height, a row of
+        // blocks at a time in parallel (their columns are numbered in one
+        // run): the points are first dealt to their rows of blocks in one
+        // serial pass that writes a few streams, then each row sorts its
+        // own part of the output.
+        let row_len = nx.div_ceil(BLOCK) * BLOCK * BLOCK;
+        let rows = count.div_ceil(row_len);
+        let first_of = |r: usize| start[(r * row_len).min(count)] as usize;
+        let mut order = vec![0u32; n];
+        let mut fill: Vec<usize> = (0..rows).map(first_of).collect();
         for (i, &c) in of.iter().enumerate() {
-            let slot = &mut next[c as usize];
-            // Heights ordered as integers (finite f32, sign folded).
-            let bits = points[i][2].to_bits();
-            let key = if bits >> 31 == 1 {
-                !bits
-            } else {
-                bits | 1 << 31
-            };
-            entries[*slot as usize] = ((u64::from(c) << 32) | u64::from(key), i as u32);
-            *slot += 1;
+            let r = c as usize / row_len;
+            order[fill[r]] = i as u32;
+            fill[r] += 1;
         }
-        entries
-            .par_chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32)
-            .for_each(|column| column.sort_unstable());
+        let mut entries = vec![(0u64, 0u32); n];
+        let mut parts = Vec::with_capacity(rows);
+        let (mut rest, mut dealt) = (entries.as_mut_slice(), order.as_slice());
+        for r in 0..rows {
+            let len = first_of(r + 1) - first_of(r);
+            let (part, tail) = rest.split_at_mut(len);
+            let (mine, others) = dealt.split_at(len);
+            parts.push((r, part, mine));
+            (rest, dealt) = (tail, others);
+        }
+        parts.into_par_iter().for_each(|(r, part, mine)| {
+            let (c0, base) = (r * row_len, first_of(r));
+            let mut next = start[c0..((r + 1) * row_len).min(count)].to_vec();
+            for &i in mine {
+                let c = of[i as usize] as usize;
+                let slot = &mut next[c - c0];
+                // Heights ordered as integers (finite f32, sign folded).
+                let bits = points[i as usize][2].to_bits();
+                let key = if bits >> 31 == 1 {
+                    !bits
+                } else {
+                    bits | 1 << 31
+                };
+                part[*slot as usize - base] = ((c as u64) << 32 | u64::from(key), i);
+                *slot += 1;
+            }
+            for column in part.chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32) {
+                column.sort_unstable();
+            }
+        });
         let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
         // The points in sorted order in one gather (one random read a
         // point), then split by axis.
