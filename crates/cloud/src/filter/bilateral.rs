@@ -163,7 +163,6 @@ pub fn bilateral_normal_smoothing(
                         *q = tree.id(*q as usize) as u32;
                     }
                     found.sort_unstable();
-                    let _ = p;
                     smooth(tree.id(pos), found)
                 })
             }

@@ -73,6 +73,19 @@ where
     Ok(kept(&finite)?.into_iter().map(|i| index[i]).collect())
 }
 
+/// A seeded uniform generator on [0, 1) (an LCG, 24 bits) for the tests'
+/// clouds: the same seed gives the same cloud on every machine.
+#[cfg(test)]
+pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f32 {
+    let mut s = seed;
+    move || {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 40) as f32 / (1u64 << 24) as f32
+    }
+}
+
 /// The points of `cloud` at `indices`, in that order.
 pub(crate) fn gather(cloud: &PointCloud, indices: &[usize]) -> PointCloud {
     PointCloud::new(indices.iter().map(|&i| cloud.points[i]).collect())

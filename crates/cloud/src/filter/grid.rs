@@ -678,13 +678,7 @@ mod tests {
     use super::*;
 
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
-        let mut s = seed;
-        let mut u = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            ((s >> 40) as f32) / (1u64 << 24) as f32
-        };
+        let mut u = super::super::common::uniform(seed);
         // A rough surface with noise, a few outliers high above it and
         // duplicated points.
         let mut points: Vec<Point> = (0..n)

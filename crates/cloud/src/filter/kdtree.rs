@@ -633,13 +633,7 @@ mod tests {
     use super::*;
 
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
-        let mut s = seed;
-        let mut u = move || {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 40) as f32 / (1u64 << 24) as f32
-        };
+        let mut u = super::super::common::uniform(seed);
         // A thin slab with duplicates, to stress ties and flat cells.
         let mut pts: Vec<Point> = (0..n).map(|_| [u(), u() * 2.0, u() * 0.01]).collect();
         for i in 0..n / 10 {
