@@ -30,6 +30,7 @@ pub mod paper;
 pub mod plan;
 pub mod profile;
 pub mod scan;
+pub mod similar;
 pub mod terrain;
 pub mod trajectory;
 pub mod validate;
@@ -53,5 +54,6 @@ pub use plan::{
 };
 pub use profile::{Geometry, MachineProfile};
 pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
+pub use similar::Similarity;
 pub use terrain::DigSurface;
 pub use trajectory::{Decision, Trajectory};

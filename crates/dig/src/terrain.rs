@@ -38,7 +38,15 @@ pub struct DigSurface {
     heights: Vec<f64>,
     /// Where it came from, for reports.
     pub source: String,
+    /// A cut thicker than this is taken as "everything" (the normal never
+    /// leaves the material) [m]: 4 m, a hundred times the scale model's
+    /// deepest cut; [`DigSurface::with_deepest_cut`] sets it for a larger
+    /// machine.
+    deepest_cut_m: f64,
 }
+
+/// The default of [`DigSurface::with_deepest_cut`] [m].
+pub const DEEPEST_CUT_M: f64 = 4.0;
 
 impl DigSurface {
     /// Tabulate `f(x, y_across)` (dig-frame height) averaged over |y| ≤ b/2,
@@ -63,7 +71,16 @@ impl DigSurface {
             x0,
             heights,
             source: source.to_string(),
+            deepest_cut_m: DEEPEST_CUT_M,
         }
+    }
+
+    /// The same profile with cuts thicker than `m` taken as "everything"
+    /// (by default [`DEEPEST_CUT_M`], for the scale model; λ times that for
+    /// a machine λ times as large).
+    pub fn with_deepest_cut(mut self, m: f64) -> Self {
+        self.deepest_cut_m = m;
+        self
     }
 
     /// The noiseless synthetic pile of [`autoshovel_surface::generate_pile`]
@@ -155,8 +172,8 @@ impl DigSurface {
         let x_toe = raw.x0 + i_up as f64 * DX - back;
         Ok(Self {
             x0: raw.x0 - x_toe,
-            heights: raw.heights,
             source: format!("fitted surface (toe at sensor x = {x_toe:.3} m)"),
+            ..raw
         })
     }
 
@@ -186,6 +203,7 @@ impl DigSurface {
         Ok(Self {
             x0: 0.0,
             heights,
+            deepest_cut_m: raw.deepest_cut_m,
             source: format!(
                 "fitted surface (toe extrapolated {:.3} m before the scan, at sensor x = {x_toe:.3} m)",
                 n as f64 * DX
@@ -237,7 +255,7 @@ impl DigSurface {
         while f_hi > 0.0 {
             (lo, f_lo) = (hi, f_hi);
             hi *= 2.0;
-            if hi > 4.0 {
+            if hi > self.deepest_cut_m {
                 return hi;
             }
             f_hi = below(hi);
