@@ -135,6 +135,19 @@ impl DigSurface {
             x_hi,
             "fitted surface",
         );
+        raw.from_toe(toe_rise_m).map(|(surface, _)| surface)
+    }
+
+    /// This profile (heights above the floor along a line, from `x0`) in
+    /// the dig frame: x measured from the toe, where the profile climbs out
+    /// of the floor — the last sample at most `toe_rise_m` above it before
+    /// the climb to the top, moved back down the face along its slope to
+    /// the floor. When the profile starts on the face already, the face is
+    /// continued down to the floor. Returns the profile and the toe's
+    /// position on the original line.
+    pub fn from_toe(self, toe_rise_m: f64) -> Result<(Self, f64)> {
+        let raw = self;
+        let (x_lo, x_hi) = raw.x_range();
         let top = raw
             .heights
             .iter()
@@ -170,18 +183,22 @@ impl DigSurface {
             0.0
         };
         let x_toe = raw.x0 + i_up as f64 * DX - back;
-        Ok(Self {
-            x0: raw.x0 - x_toe,
-            source: format!("fitted surface (toe at sensor x = {x_toe:.3} m)"),
-            ..raw
-        })
+        let source = format!("{} (toe at x = {x_toe:.3} m)", raw.source);
+        Ok((
+            Self {
+                x0: raw.x0 - x_toe,
+                source,
+                ..raw
+            },
+            x_toe,
+        ))
     }
 
     /// The fit starts on the face (perception removes the floor points, so a
     /// pile that rises steeply from its toe has no floor inside the fitted
     /// extent): continue the face down to the floor along its slope over the
     /// first 20 mm, and put the toe where it meets the floor.
-    fn extrapolate_toe(raw: Self, x_lo: f64, x_hi: f64) -> Result<Self> {
+    fn extrapolate_toe(raw: Self, x_lo: f64, x_hi: f64) -> Result<(Self, f64)> {
         let k = 20.min(raw.heights.len() - 1);
         let h0 = raw.heights[0];
         let slope = (raw.heights[k] - h0) / (k as f64 * DX);
@@ -200,7 +217,7 @@ impl DigSurface {
         let x_toe = x_lo - n as f64 * DX;
         let mut heights: Vec<f64> = (0..n).map(|i| h0 * i as f64 / n as f64).collect();
         heights.extend_from_slice(&raw.heights);
-        Ok(Self {
+        Ok((Self {
             x0: 0.0,
             heights,
             deepest_cut_m: raw.deepest_cut_m,
@@ -208,7 +225,7 @@ impl DigSurface {
                 "fitted surface (toe extrapolated {:.3} m before the scan, at sensor x = {x_toe:.3} m)",
                 n as f64 * DX
             ),
-        })
+        }, x_toe))
     }
 
     /// The x range tabulated [m].

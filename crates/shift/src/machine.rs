@@ -1,0 +1,448 @@
+//! The machine's side of a shift: what it knows comes from its scans (as
+//! perception cleans and levels them) and its RTK pose. From those it keeps
+//! a height model of the pit ([`PileModel`]), cuts dig profiles along its
+//! swing angles ([`dig_options`]), chooses its next stand from the face it
+//! has perceived ([`next_stands`]) and builds its walking map from its
+//! scans ([`walking_map`]). Nothing here reads [`crate::world::World`].
+
+use autoshovel_cloud::PointCloud;
+use autoshovel_core::{Pose2, Vec2};
+use autoshovel_dig::{DigSurface, TOE_RISE_SHARE};
+use autoshovel_propel::{Map, Obstacle, Shape};
+
+/// Height above which a cell of the model is an obstacle to walking [m].
+pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
+
+/// Band width of the walking map's obstacle rectangles (along y) [m].
+pub const MAP_BAND_M: f64 = 2.0;
+
+/// Length of a dig profile from the swing axis [m].
+pub const PROFILE_LENGTH_M: f64 = 40.0;
+
+/// The machine's height model of the pit, from its scans: each cell the
+/// mean height above the floor of the cleaned points of the last scan
+/// that saw it; a cell the last scan saw only as floor is floor; NaN where
+/// no scan has looked.
+#[derive(Debug, Clone, PartialEq)]
+pub struct PileModel {
+    /// Lower-left corner [m].
+    pub origin: [f64; 2],
+    /// Cell edge [m].
+    pub cell_m: f64,
+    /// Cells along x and y.
+    pub size: [usize; 2],
+    /// Heights above the floor [m] (NaN: never seen).
+    pub z: Vec<f64>,
+}
+
+impl PileModel {
+    /// An empty model over the site `min`–`max`.
+    pub fn new(min: [f64; 2], max: [f64; 2], cell_m: f64) -> Self {
+        let size = [0, 1].map(|a| ((max[a] - min[a]) / cell_m).ceil().max(1.0) as usize);
+        Self {
+            origin: min,
+            cell_m,
+            size,
+            z: vec![f64::NAN; size[0] * size[1]],
+        }
+    }
+
+    /// The cell of (x, y), if inside.
+    pub fn cell_of(&self, x: f64, y: f64) -> Option<usize> {
+        let i = ((x - self.origin[0]) / self.cell_m).floor();
+        let j = ((y - self.origin[1]) / self.cell_m).floor();
+        (i >= 0.0 && j >= 0.0 && (i as usize) < self.size[0] && (j as usize) < self.size[1])
+            .then(|| j as usize * self.size[0] + i as usize)
+    }
+
+    /// The centre of cell `k`.
+    pub fn centre(&self, k: usize) -> [f64; 2] {
+        [
+            self.origin[0] + ((k % self.size[0]) as f64 + 0.5) * self.cell_m,
+            self.origin[1] + ((k / self.size[0]) as f64 + 0.5) * self.cell_m,
+        ]
+    }
+
+    /// Folds in one scan: `seen` is the whole scan levelled, `cleaned` what
+    /// perception kept of it (both in the levelled sensor frame, the floor
+    /// at `floor_z`), taken at `pose` (the machine's own estimate; the
+    /// sensor on the swing axis). Returns the cells updated.
+    pub fn update(&mut self, seen: &PointCloud, cleaned: &PointCloud, floor_z: f64, pose: Pose2) -> usize {
+        let (c, s) = (pose.theta.cos(), pose.theta.sin());
+        let world = |p: &[f32; 3]| {
+            let (x, y) = (f64::from(p[0]), f64::from(p[1]));
+            (pose.x + x * c - y * s, pose.y + x * s + y * c)
+        };
+        let mut sum = vec![0.0f64; self.z.len()];
+        let mut count = vec![0u32; self.z.len()];
+        let mut floor = vec![false; self.z.len()];
+        for p in &cleaned.points {
+            let (x, y) = world(p);
+            if let Some(k) = self.cell_of(x, y) {
+                sum[k] += f64::from(p[2]) - floor_z;
+                count[k] += 1;
+            }
+        }
+        for p in &seen.points {
+            let (x, y) = world(p);
+            // Only returns near the floor say "floor here" (dust in the
+            // air says nothing about the ground under it).
+            if (f64::from(p[2]) - floor_z).abs() < OBSTACLE_HEIGHT_M {
+                if let Some(k) = self.cell_of(x, y) {
+                    floor[k] = true;
+                }
+            }
+        }
+        let mut updated = 0;
+        for k in 0..self.z.len() {
+            if count[k] > 0 {
+                self.z[k] = (sum[k] / f64::from(count[k])).max(0.0);
+                updated += 1;
+            } else if floor[k] {
+                self.z[k] = 0.0;
+                updated += 1;
+            }
+        }
+        updated
+    }
+
+    /// The model's height at (x, y): its cell's, 0 outside the site, NaN
+    /// where never seen.
+    pub fn height(&self, x: f64, y: f64) -> f64 {
+        self.cell_of(x, y).map_or(0.0, |k| self.z[k])
+    }
+
+    /// What the model holds above the floor [m³] (unseen cells count nothing).
+    pub fn volume_m3(&self) -> f64 {
+        self.z.iter().filter(|z| z.is_finite()).sum::<f64>() * self.cell_m * self.cell_m
+    }
+
+    /// The width-averaged profile along the line from `origin` at
+    /// `heading`, from the swing axis out to [`PROFILE_LENGTH_M`]
+    /// (x along the line); unseen cells take the last seen height before
+    /// them along the line (floor at the start).
+    pub fn profile(&self, origin: [f64; 2], heading: f64, width_m: f64) -> DigSurface {
+        let (c, s) = (heading.cos(), heading.sin());
+        let step = 0.5 * self.cell_m;
+        let n = (PROFILE_LENGTH_M / step) as usize + 1;
+        // Along the line, each of five lines across the width, holding the
+        // last seen height over unseen cells.
+        let across = [-0.4, -0.2, 0.0, 0.2, 0.4].map(|f| f * width_m);
+        let tracks: Vec<Vec<f64>> = across
+            .iter()
+            .map(|&w| {
+                let mut last = 0.0;
+                (0..n)
+                    .map(|i| {
+                        let t = i as f64 * step;
+                        let z = self.height(origin[0] + t * c - w * s, origin[1] + t * s + w * c);
+                        if z.is_finite() {
+                            last = z;
+                        }
+                        last
+                    })
+                    .collect()
+            })
+            .collect();
+        let at = |track: &[f64], t: f64| {
+            let u = (t / step).clamp(0.0, (n - 1) as f64);
+            let i = (u as usize).min(n - 2);
+            let f = u - i as f64;
+            track[i] * (1.0 - f) + track[i + 1] * f
+        };
+        DigSurface::from_fn(
+            |t, w| {
+                // The nearest of the five tracks across.
+                let j = (((w / width_m) + 0.4) / 0.2).round().clamp(0.0, 4.0) as usize;
+                at(&tracks[j], t)
+            },
+            width_m,
+            0.0,
+            PROFILE_LENGTH_M,
+            "the machine's pile model",
+        )
+    }
+}
+
+/// One way the machine could dig from where it stands.
+#[derive(Debug, Clone)]
+pub struct DigOption {
+    /// Swing angle from the machine's heading [rad].
+    pub swing: f64,
+    /// The dig line's direction in the world [rad].
+    pub heading: f64,
+    /// Distance from the swing axis to the toe along the line [m].
+    pub toe_s_m: f64,
+    /// The profile in the dig frame (x from the toe).
+    pub surface: DigSurface,
+    /// Material within the planner's reach along the line [m³] (model).
+    pub material_m3: f64,
+}
+
+/// The profiles along each swing angle with their toes, most material first;
+/// the angles without a pile (a toe the model cannot place) are returned
+/// with the reason.
+pub fn dig_options(
+    model: &PileModel,
+    pose: Pose2,
+    angles: &[f64],
+    width_m: f64,
+    reach_m: f64,
+    deepest_cut_m: f64,
+) -> (Vec<DigOption>, Vec<(f64, String)>) {
+    let mut options = Vec::new();
+    let mut refused = Vec::new();
+    for &swing in angles {
+        let heading = pose.theta + swing;
+        let raw = model.profile([pose.x, pose.y], heading, width_m);
+        let face = raw.top();
+        if !(face > 2.0 * OBSTACLE_HEIGHT_M) {
+            refused.push((swing, format!("no pile along it (highest {face:.2} m)")));
+            continue;
+        }
+        match raw.from_toe(TOE_RISE_SHARE * face) {
+            Ok((surface, toe_s_m)) => {
+                let surface = surface.with_deepest_cut(deepest_cut_m);
+                let n = 200;
+                let material_m3 = (0..n)
+                    .map(|i| surface.height(reach_m * (i as f64 + 0.5) / n as f64).max(0.0))
+                    .sum::<f64>()
+                    * reach_m
+                    / n as f64
+                    * width_m;
+                options.push(DigOption {
+                    swing,
+                    heading,
+                    toe_s_m,
+                    surface,
+                    material_m3,
+                });
+            }
+            Err(e) => refused.push((swing, e.to_string())),
+        }
+    }
+    options.sort_by(|a, b| b.material_m3.total_cmp(&a.material_m3));
+    (options, refused)
+}
+
+/// A stand the machine could walk to, and what it could dig there.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct StandCandidate {
+    /// Where the swing axis would stand, facing the face.
+    pub pose: Pose2,
+    /// Material within reach over the dig angles [m³] (model).
+    pub material_m3: f64,
+    /// Sideways from the current stand (left positive) [m].
+    pub lateral_m: f64,
+}
+
+/// The stands the machine could dig from next, most material first: at
+/// the current stand's heading, at lateral offsets of 0, ±1, ±2 `step_m`,
+/// each where the perceived toe straight ahead lies `stand_off_m` from the
+/// swing axis; a candidate must have at least `least_m3` within reach, a
+/// footprint on bare floor in the model, and lie inside the site.
+#[allow(clippy::too_many_arguments)]
+pub fn next_stands(
+    model: &PileModel,
+    pose: Pose2,
+    angles: &[f64],
+    width_m: f64,
+    reach_m: f64,
+    stand_off_m: f64,
+    step_m: f64,
+    footprint_m: f64,
+    least_m3: f64,
+) -> Vec<StandCandidate> {
+    let (c, s) = (pose.theta.cos(), pose.theta.sin());
+    let mut out = Vec::new();
+    for k in [0.0, 1.0, -1.0, 2.0, -2.0] {
+        let lateral = k * step_m;
+        // Look for the toe from 10 m behind the current stand.
+        let base = [pose.x - 10.0 * c - lateral * s, pose.y - 10.0 * s + lateral * c];
+        let raw = model.profile(base, pose.theta, width_m);
+        let face = raw.top();
+        if !(face > 2.0 * OBSTACLE_HEIGHT_M) {
+            continue;
+        }
+        let Ok((_, toe_s)) = raw.from_toe(TOE_RISE_SHARE * face) else {
+            continue;
+        };
+        let along = toe_s - stand_off_m;
+        let stand = Pose2::new(base[0] + along * c, base[1] + along * s, pose.theta);
+        if !footprint_clear(model, stand, footprint_m) {
+            continue;
+        }
+        let (options, _) = dig_options(model, stand, angles, width_m, reach_m, f64::INFINITY);
+        // Material of the fan: the lines are a swing step apart, so each
+        // stands for its share of the fan, not a dipper's width.
+        let material_m3: f64 = options.iter().map(|o| o.material_m3).sum();
+        if material_m3 >= least_m3 {
+            out.push(StandCandidate {
+                pose: stand,
+                material_m3,
+                lateral_m: lateral,
+            });
+        }
+    }
+    out.sort_by(|a, b| b.material_m3.total_cmp(&a.material_m3));
+    out
+}
+
+/// Whether the model shows bare floor (or nothing seen) under the
+/// footprint disc at `pose`, inside the site.
+pub fn footprint_clear(model: &PileModel, pose: Pose2, radius_m: f64) -> bool {
+    let c = model.cell_m;
+    let lo = [pose.x - radius_m, pose.y - radius_m];
+    let hi = [pose.x + radius_m, pose.y + radius_m];
+    let site_hi = [
+        model.origin[0] + model.size[0] as f64 * c,
+        model.origin[1] + model.size[1] as f64 * c,
+    ];
+    if lo[0] < model.origin[0] || lo[1] < model.origin[1] || hi[0] > site_hi[0] || hi[1] > site_hi[1] {
+        return false;
+    }
+    let n = (2.0 * radius_m / c).ceil() as i64;
+    (-n..=n).all(|i| {
+        (-n..=n).all(|j| {
+            let (x, y) = (pose.x + i as f64 * c * 0.5, pose.y + j as f64 * c * 0.5);
+            (x - pose.x).hypot(y - pose.y) > radius_m || !(model.height(x, y) > OBSTACLE_HEIGHT_M)
+        })
+    })
+}
+
+/// The walking map from the model: the site, and every run of cells above
+/// [`OBSTACLE_HEIGHT_M`] within a band of [`MAP_BAND_M`] along y as one
+/// rectangle (a convex polygon for the planner; the machine's footprint
+/// radius gives the clearance), so the map follows a face as it has been
+/// dug, concave bays included.
+pub fn walking_map(model: &PileModel) -> Map {
+    let c = model.cell_m;
+    let band = (MAP_BAND_M / c).round().max(1.0) as usize;
+    let (nx, ny) = (model.size[0], model.size[1]);
+    let max = Vec2::new(model.origin[0] + nx as f64 * c, model.origin[1] + ny as f64 * c);
+    let mut map = Map::new(Vec2::new(model.origin[0], model.origin[1]), max);
+    for b0 in (0..ny).step_by(band) {
+        let rows = b0..(b0 + band).min(ny);
+        let high = |i: usize| rows.clone().any(|j| model.z[j * nx + i] > OBSTACLE_HEIGHT_M);
+        let mut i = 0;
+        while i < nx {
+            if !high(i) {
+                i += 1;
+                continue;
+            }
+            let start = i;
+            while i < nx && high(i) {
+                i += 1;
+            }
+            let (x0, x1) = (model.origin[0] + start as f64 * c, model.origin[0] + i as f64 * c);
+            let (y0, y1) = (
+                model.origin[1] + rows.start as f64 * c,
+                model.origin[1] + rows.end as f64 * c,
+            );
+            map.obstacles.push(Obstacle {
+                name: format!("scanned ({:.0}, {:.0})", 0.5 * (x0 + x1), 0.5 * (y0 + y1)),
+                shape: Shape::Polygon {
+                    vertices: vec![
+                        Vec2::new(x0, y0),
+                        Vec2::new(x1, y0),
+                        Vec2::new(x1, y1),
+                        Vec2::new(x0, y1),
+                    ],
+                },
+            });
+        }
+    }
+    map
+}
+
+/// The midpoint of a V-shaped move from `from` to `to` (walking paper
+/// Fig. 1c): back away `back_m` along the heading, a tenth of the way
+/// sideways, turned towards the goal's side by up to 35° (a 1,400 t
+/// machine does not turn on the spot), so that the forward leg arrives
+/// square to the face.
+pub fn v_midpoint(from: Pose2, to: Pose2, back_m: f64) -> Pose2 {
+    let (c, s) = (from.theta.cos(), from.theta.sin());
+    let d = to.position() - from.position();
+    let forward = d.x * c + d.y * s;
+    let lateral = -d.x * s + d.y * c;
+    let turn = lateral.signum() * (0.55 * lateral.abs().atan2(back_m + forward)).min(35f64.to_radians());
+    let (mx, my) = (
+        from.x - back_m * c - 0.1 * lateral * s,
+        from.y - back_m * s + 0.1 * lateral * c,
+    );
+    Pose2::new(mx, my, from.theta + turn)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::scenario::ShiftScenario;
+    use crate::world::{Lidar, World};
+    use autoshovel_surface::perceive::{perceive, PerceptionParams};
+
+    fn scanned(pose: Pose2) -> (World, PileModel) {
+        let s = ShiftScenario::bench();
+        let world = World::new(&s);
+        let lidar = Lidar::on_machine(s.machine.sensor_height_m, 30_000);
+        let scan = world.scan(pose, &lidar, 3);
+        let got = perceive(&scan, &PerceptionParams::default()).unwrap();
+        let seen = autoshovel_surface::level(&scan, got.roll_rad, got.pitch_rad);
+        let mut model = PileModel::new(s.world.min_m, s.world.max_m, 0.5);
+        model.update(&seen, &got.cloud, got.floor_height_m, pose);
+        (world, model)
+    }
+
+    #[test]
+    fn the_model_from_one_scan_agrees_with_the_pit_where_it_looked() {
+        let pose = Pose2::new(24.0, 60.0, 0.0);
+        let (world, model) = scanned(pose);
+        let mut errors: Vec<f64> = (0..model.z.len())
+            .filter(|&k| model.z[k].is_finite() && model.z[k] > 0.0)
+            .map(|k| {
+                let [x, y] = model.centre(k);
+                (model.z[k] - world.height(x, y)).abs()
+            })
+            .collect();
+        assert!(errors.len() > 500, "{}", errors.len());
+        errors.sort_by(f64::total_cmp);
+        let median = errors[errors.len() / 2];
+        assert!(median < 0.1, "median error {median} m");
+        // The toe straight ahead is where the pit's is (x = 30), a little
+        // further in: perception takes the ground band (0.2 m) away with the
+        // floor, and the model's cells are 0.5 m.
+        let (options, _) = dig_options(&model, pose, &[0.0], 3.6, 15.0, 120.0);
+        assert_eq!(options.len(), 1);
+        let toe = options[0].toe_s_m;
+        assert!((6.0..7.0).contains(&toe), "{toe}");
+    }
+
+    #[test]
+    fn the_walking_map_keeps_the_pile_and_the_boulders_out_and_the_floor_free() {
+        let pose = Pose2::new(12.0, 50.0, 0.0);
+        let (_, model) = scanned(pose);
+        let map = walking_map(&model);
+        // The face at x ≥ 31 is inside an obstacle; open floor at x = 20 is not;
+        // the boulder at (21, 46) is.
+        let blocked = |x: f64, y: f64| {
+            map.obstacles.iter().any(|o| match &o.shape {
+                Shape::Polygon { vertices } => {
+                    x >= vertices[0].x && x <= vertices[1].x && y >= vertices[0].y && y <= vertices[2].y
+                }
+                Shape::Circle { .. } => false,
+            })
+        };
+        assert!(blocked(33.0, 50.0));
+        assert!(!blocked(20.0, 52.0));
+        assert!(blocked(21.0, 46.0));
+    }
+
+    #[test]
+    fn a_v_midpoint_backs_away_and_turns_towards_the_goal() {
+        let from = Pose2::new(10.0, 22.0, std::f64::consts::FRAC_PI_2);
+        let to = Pose2::new(26.0, 22.0, std::f64::consts::FRAC_PI_2);
+        let m = v_midpoint(from, to, 11.0);
+        assert!((m.y - 11.0).abs() < 1e-9);
+        assert!(m.theta < from.theta, "turns right, towards the goal");
+        assert!(from.theta - m.theta <= 35f64.to_radians() + 1e-12);
+    }
+}
