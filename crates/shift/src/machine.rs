@@ -7,7 +7,7 @@
 
 use autoshovel_cloud::PointCloud;
 use autoshovel_core::{Pose2, Vec2};
-use autoshovel_dig::{DigSurface, TOE_RISE_SHARE};
+use autoshovel_dig::DigSurface;
 use autoshovel_propel::{Map, Obstacle, Shape};
 
 /// Height above which a cell of the model is an obstacle to walking [m].
@@ -15,6 +15,14 @@ pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
 
 /// Band width of the walking map's obstacle rectangles (along y) [m].
 pub const MAP_BAND_M: f64 = 2.0;
+
+/// Share of the face's height at which the machine reads the face's
+/// slope, continued down to the floor to place the toe (the dig frame's
+/// origin, [`DigSurface::from_toe`]). The planner's own rule for a fresh
+/// scan takes 3 % ([`autoshovel_dig::TOE_RISE_SHARE`]); on a face that has
+/// been dug, a low wedge is left at the foot, and the toe that matters is
+/// the one of the face above it.
+pub const FACE_RISE_SHARE: f64 = 0.25;
 
 /// Length of a dig profile from the swing axis [m].
 pub const PROFILE_LENGTH_M: f64 = 40.0;
@@ -75,7 +83,7 @@ impl PileModel {
         };
         let mut sum = vec![0.0f64; self.z.len()];
         let mut count = vec![0u32; self.z.len()];
-        let mut floor = vec![false; self.z.len()];
+        let (mut low_sum, mut low_count) = (vec![0.0f64; self.z.len()], vec![0u32; self.z.len()]);
         for p in &cleaned.points {
             let (x, y) = world(p);
             if let Some(k) = self.cell_of(x, y) {
@@ -85,11 +93,33 @@ impl PileModel {
         }
         for p in &seen.points {
             let (x, y) = world(p);
-            // Only returns near the floor say "floor here" (dust in the
-            // air says nothing about the ground under it).
-            if (f64::from(p[2]) - floor_z).abs() < OBSTACLE_HEIGHT_M {
+            // Returns near the floor that perception set aside with the
+            // ground say "floor, or the foot of the face, here" (dust in
+            // the air says nothing about the ground under it).
+            let h = f64::from(p[2]) - floor_z;
+            if h.abs() < OBSTACLE_HEIGHT_M {
                 if let Some(k) = self.cell_of(x, y) {
-                    floor[k] = true;
+                    low_sum[k] += h;
+                    low_count[k] += 1;
+                }
+            }
+        }
+        // What the last scan covered and did not hit (occluded, or thinned
+        // out by perception's voxel grid) is unknown now, not as it was:
+        // the dipper may have been there since.
+        let hit: Vec<usize> = (0..self.z.len()).filter(|&k| count[k] > 0).collect();
+        if let (Some(&lo), Some(&hi)) = (hit.iter().min_by_key(|&&k| k % self.size[0]), hit.iter().max_by_key(|&&k| k % self.size[0])) {
+            let (i0, i1) = (lo % self.size[0], hi % self.size[0]);
+            let (j0, j1) = (
+                hit.iter().map(|&k| k / self.size[0]).min().unwrap_or(0),
+                hit.iter().map(|&k| k / self.size[0]).max().unwrap_or(0),
+            );
+            for j in j0..=j1 {
+                for i in i0..=i1 {
+                    let k = j * self.size[0] + i;
+                    if count[k] == 0 && low_count[k] == 0 && self.z[k] > 0.0 {
+                        self.z[k] = f64::NAN;
+                    }
                 }
             }
         }
@@ -98,8 +128,8 @@ impl PileModel {
             if count[k] > 0 {
                 self.z[k] = (sum[k] / f64::from(count[k])).max(0.0);
                 updated += 1;
-            } else if floor[k] {
-                self.z[k] = 0.0;
+            } else if low_count[k] > 0 {
+                self.z[k] = (low_sum[k] / f64::from(low_count[k])).max(0.0);
                 updated += 1;
             }
         }
@@ -119,8 +149,9 @@ impl PileModel {
 
     /// The width-averaged profile along the line from `origin` at
     /// `heading`, from the swing axis out to [`PROFILE_LENGTH_M`]
-    /// (x along the line); unseen cells take the last seen height before
-    /// them along the line (floor at the start).
+    /// (x along the line); cells no scan point fell in (perception thins
+    /// the cloud to a voxel grid) are bridged linearly between the seen
+    /// cells either side along the line, held past the last.
     pub fn profile(&self, origin: [f64; 2], heading: f64, width_m: f64) -> DigSurface {
         let (c, s) = (heading.cos(), heading.sin());
         let step = 0.5 * self.cell_m;
@@ -131,17 +162,14 @@ impl PileModel {
         let tracks: Vec<Vec<f64>> = across
             .iter()
             .map(|&w| {
-                let mut last = 0.0;
-                (0..n)
+                let mut track: Vec<f64> = (0..n)
                     .map(|i| {
                         let t = i as f64 * step;
-                        let z = self.height(origin[0] + t * c - w * s, origin[1] + t * s + w * c);
-                        if z.is_finite() {
-                            last = z;
-                        }
-                        last
+                        self.height(origin[0] + t * c - w * s, origin[1] + t * s + w * c)
                     })
-                    .collect()
+                    .collect();
+                fill_gaps(&mut track);
+                track
             })
             .collect();
         let at = |track: &[f64], t: f64| {
@@ -161,6 +189,27 @@ impl PileModel {
             PROFILE_LENGTH_M,
             "the machine's pile model",
         )
+    }
+}
+
+/// Replaces the NaN runs of `track` by the straight line between the
+/// finite values either side; floor before the first (the ground the
+/// machine stands on, under the sensor's view) and the last held after.
+fn fill_gaps(track: &mut [f64]) {
+    let seen: Vec<usize> = (0..track.len()).filter(|&i| track[i].is_finite()).collect();
+    let Some((&first, &last)) = seen.first().zip(seen.last()) else {
+        track.fill(0.0);
+        return;
+    };
+    let tail = track[last];
+    track[..first].fill(0.0);
+    track[last + 1..].fill(tail);
+    for w in seen.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        for i in a + 1..b {
+            let f = (i - a) as f64 / (b - a) as f64;
+            track[i] = track[a] * (1.0 - f) + track[b] * f;
+        }
     }
 }
 
@@ -200,7 +249,7 @@ pub fn dig_options(
             refused.push((swing, format!("no pile along it (highest {face:.2} m)")));
             continue;
         }
-        match raw.from_toe(TOE_RISE_SHARE * face) {
+        match raw.from_toe(FACE_RISE_SHARE * face) {
             Ok((surface, toe_s_m)) => {
                 let surface = surface.with_deepest_cut(deepest_cut_m);
                 let n = 200;
@@ -236,14 +285,17 @@ pub struct StandCandidate {
     pub lateral_m: f64,
 }
 
-/// The stands the machine could dig from next, most material first: at
-/// the current stand's heading, at lateral offsets of 0, ±1, ±2 `step_m`,
-/// each where the perceived toe straight ahead lies `stand_off_m` from the
-/// swing axis; a candidate must have at least `least_m3` within reach, a
-/// footprint on bare floor in the model, and lie inside the site.
+/// The stands the machine could dig from next, best first: at the current
+/// stand's heading, at lateral offsets of 0, ±1, … ±8 `step_m`, each where
+/// the perceived toe straight ahead lies `stand_off_m` from the swing
+/// axis; a candidate must have at least `least_m3` within reach, a
+/// footprint clear of the walking map and lie inside the site. Best: most
+/// material within reach, discounted by e^(−d / 60 m) for the distance d
+/// to walk there.
 #[allow(clippy::too_many_arguments)]
 pub fn next_stands(
     model: &PileModel,
+    map: &Map,
     pose: Pose2,
     angles: &[f64],
     width_m: f64,
@@ -252,26 +304,34 @@ pub fn next_stands(
     step_m: f64,
     footprint_m: f64,
     least_m3: f64,
-) -> Vec<StandCandidate> {
+) -> (Vec<StandCandidate>, Vec<String>) {
     let (c, s) = (pose.theta.cos(), pose.theta.sin());
     let mut out = Vec::new();
-    for k in [0.0, 1.0, -1.0, 2.0, -2.0] {
-        let lateral = k * step_m;
+    let mut refused = Vec::new();
+    for k in -8..=8 {
+        let lateral = f64::from(k) * step_m;
         // Look for the toe from 10 m behind the current stand.
         let base = [pose.x - 10.0 * c - lateral * s, pose.y - 10.0 * s + lateral * c];
         let raw = model.profile(base, pose.theta, width_m);
         let face = raw.top();
         if !(face > 2.0 * OBSTACLE_HEIGHT_M) {
+            refused.push(format!("{lateral:+.0} m: no pile ahead"));
             continue;
         }
-        let Ok((_, toe_s)) = raw.from_toe(TOE_RISE_SHARE * face) else {
+        let Ok((_, toe_s)) = raw.from_toe(FACE_RISE_SHARE * face) else {
+            refused.push(format!("{lateral:+.0} m: no toe ahead"));
             continue;
         };
-        let along = toe_s - stand_off_m;
-        let stand = Pose2::new(base[0] + along * c, base[1] + along * s, pose.theta);
-        if !footprint_clear(model, stand, footprint_m) {
+        // Back off from there until the footprint is clear of everything
+        // the scans show above the floor (the toe line need not be straight).
+        let Some(stand) = (0..12).find_map(|k| {
+            let along = toe_s - stand_off_m - 0.5 * k as f64;
+            let stand = Pose2::new(base[0] + along * c, base[1] + along * s, pose.theta);
+            footprint_clear(map, stand, footprint_m).then_some(stand)
+        }) else {
+            refused.push(format!("{lateral:+.0} m: no clear footprint within 6 m of the toe's stand-off"));
             continue;
-        }
+        };
         let (options, _) = dig_options(model, stand, angles, width_m, reach_m, f64::INFINITY);
         // Material of the fan: the lines are a swing step apart, so each
         // stands for its share of the fan, not a dipper's width.
@@ -282,33 +342,33 @@ pub fn next_stands(
                 material_m3,
                 lateral_m: lateral,
             });
+        } else {
+            refused.push(format!("{lateral:+.0} m: {material_m3:.0} m³ within reach"));
         }
     }
-    out.sort_by(|a, b| b.material_m3.total_cmp(&a.material_m3));
-    out
+    let score = |c: &StandCandidate| {
+        c.material_m3 * (-(c.pose.position() - pose.position()).norm() / 60.0).exp()
+    };
+    out.sort_by(|a, b| score(b).total_cmp(&score(a)));
+    (out, refused)
 }
 
-/// Whether the model shows bare floor (or nothing seen) under the
-/// footprint disc at `pose`, inside the site.
-pub fn footprint_clear(model: &PileModel, pose: Pose2, radius_m: f64) -> bool {
-    let c = model.cell_m;
-    let lo = [pose.x - radius_m, pose.y - radius_m];
-    let hi = [pose.x + radius_m, pose.y + radius_m];
-    let site_hi = [
-        model.origin[0] + model.size[0] as f64 * c,
-        model.origin[1] + model.size[1] as f64 * c,
-    ];
-    if lo[0] < model.origin[0] || lo[1] < model.origin[1] || hi[0] > site_hi[0] || hi[1] > site_hi[1] {
-        return false;
-    }
-    let n = (2.0 * radius_m / c).ceil() as i64;
-    (-n..=n).all(|i| {
-        (-n..=n).all(|j| {
-            let (x, y) = (pose.x + i as f64 * c * 0.5, pose.y + j as f64 * c * 0.5);
-            (x - pose.x).hypot(y - pose.y) > radius_m || !(model.height(x, y) > OBSTACLE_HEIGHT_M)
-        })
-    })
+/// Whether the footprint disc at `pose` keeps [`FOOTPRINT_MARGIN_M`]
+/// from everything on the walking map `map` (made by [`walking_map`] from
+/// what the scans show), inside the site.
+pub fn footprint_clear(map: &Map, pose: Pose2, radius_m: f64) -> bool {
+    let p = Vec2::new(pose.x, pose.y);
+    let inside = pose.x - radius_m >= map.min.x
+        && pose.y - radius_m >= map.min.y
+        && pose.x + radius_m <= map.max.x
+        && pose.y + radius_m <= map.max.y;
+    inside && map.clearance(p, radius_m) >= FOOTPRINT_MARGIN_M
 }
+
+/// Clearance a stand keeps from everything on the walking map [m]: more
+/// than the metre the walk planner wants free ahead of a machine that
+/// starts to move (so the next walk may start forward).
+pub const FOOTPRINT_MARGIN_M: f64 = 1.2;
 
 /// The walking map from the model: the site, and every run of cells above
 /// [`OBSTACLE_HEIGHT_M`] within a band of [`MAP_BAND_M`] along y as one

@@ -26,7 +26,7 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 
-use autoshovel_core::Pose2;
+use autoshovel_core::{Pose2, Vec2};
 use autoshovel_dig::{plan_dig, DigModel, DigSearch, DigSurface, MachineProfile, Similarity};
 use autoshovel_propel::{plan_path, Direction, FieldKind, PlanOptions, Scenario as Travel};
 use autoshovel_surface::perceive::{perceive, PerceptionParams};
@@ -37,7 +37,7 @@ use autoshovel_track::{
 
 use crate::cycle::{propel_energy_j, SwingDrive};
 use crate::error::{Result, ShiftError};
-use crate::machine::{dig_options, next_stands, v_midpoint, walking_map, PileModel};
+use crate::machine::{dig_options, next_stands, v_midpoint, walking_map, PileModel, FOOTPRINT_MARGIN_M};
 use crate::scenario::ShiftScenario;
 use crate::world::{Cut, Lidar, World};
 
@@ -52,6 +52,10 @@ pub struct ShiftOptions {
     pub search: DigSearch,
     /// Most snapshots of the pit kept for the animation.
     pub frames: usize,
+    /// Share of each drive rating (c11–c14) the planner keeps in reserve:
+    /// a plan sits on its limits, and the true pile differs from the
+    /// scanned one.
+    pub rating_margin: f64,
 }
 
 impl Default for ShiftOptions {
@@ -71,6 +75,7 @@ impl Default for ShiftOptions {
                 polish_step: 0.05,
             },
             frames: 160,
+            rating_margin: 0.1,
         }
     }
 }
@@ -409,7 +414,11 @@ pub fn run_shift(
     };
     let mut pose_seen = measured(pose, &mut rng);
     let lidar = Lidar::on_machine(m.sensor_height_m, scenario.shift.scan_points);
-    let perception = PerceptionParams::default();
+    // The machine's pile model is the cleaned cloud on a grid; the paper's
+    // polynomial surface ([RS eq. 21]) is still fitted, but a face dug
+    // into bays is no polynomial, so its R² bar is not required.
+    let mut perception = PerceptionParams::default();
+    perception.fit.r2_threshold = 0.0;
     let mut model = PileModel::new(scenario.world.min_m, scenario.world.max_m, scenario.world.cell_m);
     let swing = SwingDrive {
         speed_rad_s: m.swing_speed_deg_s.to_radians(),
@@ -464,6 +473,7 @@ pub fn run_shift(
     let mut warm: Vec<Vec<f64>> = Vec::new();
     let (mut truck, mut truck_load_t, mut trucks_t) = (1usize, 0.0f64, 0.0f64);
     let mut failed_scans = 0;
+    let mut exhausted: Vec<(f64, String)> = Vec::new();
     let mut completed = false;
     let mut scans = 0u64;
     let mut propel_j = 0.0;
@@ -520,11 +530,23 @@ pub fn run_shift(
             }
             for option in options_here {
                 let label = format!("{:+.0}°", option.swing.to_degrees());
+                // An angle the planner could not dig at this stand stays
+                // undiggable while the machine stands here (nothing but
+                // the dipper changes the pile, and it only takes away).
+                if let Some(why) = exhausted.iter().find(|(a, _)| *a == option.swing).map(|(_, w)| w) {
+                    reasons.push(format!("{label}: {why}"));
+                    continue;
+                }
                 if option.material_m3 < profile.limits.fill_min * capacity {
                     reasons.push(format!("{label}: {:.1} m³ within reach", option.material_m3));
                     continue;
                 }
                 let mut p = profile.clone();
+                let keep = 1.0 - options.rating_margin;
+                p.limits.hoist_force_max_n *= keep;
+                p.limits.crowd_force_max_n *= keep;
+                p.limits.hoist_power_max_w *= keep;
+                p.limits.crowd_power_max_w *= keep;
                 let toe_distance = option.toe_s_m - m.saddle_ahead_m;
                 p.geometry.toe_distance_m = Some(toe_distance);
                 let dig = match DigModel::new(&p, option.surface.clone()) {
@@ -541,7 +563,10 @@ pub fn run_shift(
                         chosen = Some((option, p, dig, plan, toe_distance));
                         break;
                     }
-                    Err(e) => reasons.push(format!("{label}: {e}")),
+                    Err(e) => {
+                        reasons.push(format!("{label}: {e}"));
+                        exhausted.push((option.swing, e.to_string()));
+                    }
                 }
             }
             if chosen.is_none() || stands[stand_no - 1].passes >= MAX_PASSES_PER_STAND {
@@ -575,7 +600,9 @@ pub fn run_shift(
                 "the pit along the dig line",
             )
             .with_deepest_cut(deepest);
-            let executed = DigModel::new(&p, truth).ok().map(|true_dig| true_dig.evaluate(&d));
+            let mut rated = p.clone();
+            rated.limits = profile.limits.clone();
+            let executed = DigModel::new(&rated, truth).ok().map(|true_dig| true_dig.evaluate(&d));
             let dug_m3 = world.cut(&cut);
             let dug_t = dug_m3 * density_t;
             let path_world: Vec<[f64; 3]> = cut
@@ -587,7 +614,7 @@ pub fn run_shift(
                 })
                 .collect();
             let fill = dug_m3 / capacity;
-            if fill > p.limits.fill_max {
+            if fill > profile.limits.fill_max {
                 note(
                     &mut events,
                     t + d.td_s,
@@ -598,7 +625,7 @@ pub fn run_shift(
                         passes.len() + 1,
                         dug_m3,
                         100.0 * fill,
-                        100.0 * p.limits.fill_max
+                        100.0 * profile.limits.fill_max
                     ),
                 );
             }
@@ -708,8 +735,10 @@ pub fn run_shift(
             stand.left_because = why;
             stand.after = world.z.clone();
         }
-        let candidates = next_stands(
+        let map = walking_map(&model);
+        let (candidates, refused) = next_stands(
             &model,
+            &map,
             pose_seen,
             &angles,
             width,
@@ -719,17 +748,82 @@ pub fn run_shift(
             m.footprint_radius_m,
             3.0 * capacity,
         );
+        // A stand already stood on is no new stand.
+        let candidates: Vec<_> = candidates
+            .into_iter()
+            .filter(|c| {
+                stands
+                    .iter()
+                    .all(|s| (s.x_m - c.pose.x).hypot(s.y_m - c.pose.y) > 0.75)
+            })
+            .collect();
         if candidates.is_empty() {
             note(
                 &mut events,
                 t,
                 "no-stand",
                 stand_no,
-                "no stand with material within reach remains in the perceived pit".into(),
+                format!(
+                    "no stand with material within reach remains in the perceived pit ({})",
+                    refused.join("; ")
+                ),
             );
             break 'shift;
         }
-        let map = walking_map(&model);
+        note(
+            &mut events,
+            t,
+            "next-stand",
+            stand_no,
+            candidates
+                .iter()
+                .take(3)
+                .map(|c| {
+                    format!(
+                        "({:.1}, {:.1}) {:+.0} m aside, {:.0} m³ within reach",
+                        c.pose.x, c.pose.y, c.lateral_m, c.material_m3
+                    )
+                })
+                .collect::<Vec<_>>()
+                .join("; "),
+        );
+        // Standing closer to the face than a walk may start from (the new
+        // scan showed it nearer than the last): back straight out first,
+        // over ground the machine has just stood or walked on.
+        let here = map.clearance(pose_seen.position(), m.footprint_radius_m);
+        if here < FOOTPRINT_MARGIN_M {
+            let back = FOOTPRINT_MARGIN_M + 1.0 - here;
+            let (c, sn) = (pose_seen.theta.cos(), pose_seen.theta.sin());
+            let to = Vec2::new(pose_seen.x - back * c, pose_seen.y - back * sn);
+            if let Ok(leg) = RefLeg::new(Direction::Reverse, vec![pose_seen.position(), to], Some(pose_seen.theta)) {
+                let d = drive(vec![leg], pose, m.walk_speed_mps, seed.wrapping_add(7919 + walks.len() as u64));
+                let energy = propel_energy_j(m.mass_t * 1000.0, m.rolling_resistance, d.travelled_m);
+                propel_j += energy;
+                t += d.time_s;
+                note(
+                    &mut events,
+                    t,
+                    "back-off",
+                    stand_no,
+                    format!("{:.1} m straight back from the face ({:.2} m clearance on the new scan)", d.travelled_m, here),
+                );
+                walks.push(WalkRecord {
+                    from_stand: stand_no,
+                    to_stand: stand_no,
+                    v_move: false,
+                    planned_m: back,
+                    travelled_m: d.travelled_m,
+                    time_s: d.time_s,
+                    energy_j: energy,
+                    final_error_m: (d.end.position() - to).norm(),
+                    max_deviation_m: d.run.metrics.max_centroid_dev_overall_m,
+                    planned: vec![[pose_seen.x, pose_seen.y], [to.x, to.y]],
+                    driven: d.run.samples.iter().step_by(10).map(|s| [s.truth.x, s.truth.y]).collect(),
+                });
+                pose = d.end;
+                pose_seen = d.run.samples.last().map_or(pose, |s| s.measured);
+            }
+        }
         let mut arrived = false;
         for candidate in candidates.iter().take(3) {
             let goal = candidate.pose;
@@ -741,33 +835,43 @@ pub fn run_shift(
             let mut start = pose_seen;
             while attempt < 2 {
                 attempt += 1;
-                let travel = Travel {
-                    name: format!("stand {} to {}", stand_no, stand_no + 1),
-                    map: map.clone(),
-                    footprint_radius_m: m.footprint_radius_m,
-                    start,
-                    midpoint: v_move.then(|| {
-                        v_midpoint(start, goal, (0.7 * candidate.lateral_m.abs()).max(10.0))
-                    }),
-                    goal,
-                    direction: if ahead >= 0.0 || v_move {
-                        Direction::Forward
-                    } else {
-                        Direction::Reverse
-                    },
-                };
-                let planned = match plan_path(&travel, &PlanOptions::new(FieldKind::Improved)) {
-                    Ok(p) => p,
-                    Err(e) => {
-                        note(
-                            &mut events,
-                            t,
-                            "stand-unreachable",
-                            stand_no,
-                            format!("({:.1}, {:.1}): {e}", goal.x, goal.y),
-                        );
-                        break;
+                // A V-move backs out 10-15 m (more for a longer move
+                // sideways); where that midpoint is blocked, less.
+                let full = (0.7 * candidate.lateral_m.abs()).clamp(10.0, 15.0);
+                let backs: &[f64] = if v_move { &[1.0, 0.6, 0.35] } else { &[0.0] };
+                let mut tried = Vec::new();
+                let mut found = None;
+                for &share in backs {
+                    let travel = Travel {
+                        name: format!("stand {} to {}", stand_no, stand_no + 1),
+                        map: map.clone(),
+                        footprint_radius_m: m.footprint_radius_m,
+                        start,
+                        midpoint: v_move.then(|| v_midpoint(start, goal, share * full)),
+                        goal,
+                        direction: if ahead >= 0.0 || v_move {
+                            Direction::Forward
+                        } else {
+                            Direction::Reverse
+                        },
+                    };
+                    match plan_path(&travel, &PlanOptions::new(FieldKind::Improved)) {
+                        Ok(p) => {
+                            found = Some((travel, p));
+                            break;
+                        }
+                        Err(e) => tried.push(e.to_string()),
                     }
+                }
+                let Some((travel, planned)) = found else {
+                    note(
+                        &mut events,
+                        t,
+                        "stand-unreachable",
+                        stand_no,
+                        format!("({:.1}, {:.1}): {}", goal.x, goal.y, tried.join("; ")),
+                    );
+                    break;
                 };
                 let legs_spec = travel.legs();
                 let mut legs = Vec::new();
@@ -781,23 +885,9 @@ pub fn run_shift(
                     note(&mut events, t, "stand-unreachable", stand_no, "a planned leg the tracker cannot follow".into());
                     break;
                 }
-                let setup = Setup {
-                    legs,
-                    start: pose,
-                    crawler: CrawlerParams::default(),
-                    slip: SlipParams::loose_bench(),
-                    rtk: RtkParams::rtk(seed.wrapping_add(walks.len() as u64)),
-                    sim: SimParams {
-                        speed_mps: m.walk_speed_mps,
-                        ..SimParams::default()
-                    },
-                };
-                let mut controller = ControllerKind::Fuzzy.build(&ControllerParams::default());
-                let run = simulate(&setup, controller.as_mut());
+                let drive = drive(legs, pose, m.walk_speed_mps, seed.wrapping_add(walks.len() as u64));
+                let (run, end, time_s, travelled) = (&drive.run, drive.end, drive.time_s, drive.travelled_m);
                 let last = run.samples.last();
-                let end = last.map_or(pose, |s| s.truth);
-                let time_s = last.map_or(0.0, |s| s.t_s);
-                let travelled = run.metrics.travelled_m;
                 let energy = propel_energy_j(m.mass_t * 1000.0, m.rolling_resistance, travelled);
                 propel_j += energy;
                 let error = (end.position() - goal.position()).norm();
@@ -876,6 +966,7 @@ pub fn run_shift(
         });
         frames.push(snapshot(&world, t, pose));
         failed_scans = 0;
+        exhausted.clear();
     }
     if let Some(last) = stands.last_mut() {
         if last.after.is_empty() {
@@ -960,8 +1051,8 @@ pub fn run_shift(
         tonnes,
         tonnes_per_hour: if hours_run > 0.0 { tonnes / hours_run } else { 0.0 },
         cycle_time_s: cycle,
-        walk_time_s: walks.iter().map(|w| w.time_s).sum(),
-        walked_m: walks.iter().map(|w| w.travelled_m).sum(),
+        walk_time_s: walks.iter().fold(0.0, |a, w| a + w.time_s),
+        walked_m: walks.iter().fold(0.0, |a, w| a + w.travelled_m),
         energy_kwh_per_t: energy,
         fill_factor,
         volume_left_m3: world.volume_m3(),
@@ -989,6 +1080,38 @@ pub fn run_shift(
         frame_size,
         frame_cell_m: FRAME_CELL_M,
     })
+}
+
+/// A drive along planned legs in the crawler simulator: loose-bench
+/// slip, Table 2-like RTK, the fuzzy tracker.
+struct Drive {
+    run: autoshovel_track::Run,
+    end: Pose2,
+    time_s: f64,
+    travelled_m: f64,
+}
+
+fn drive(legs: Vec<RefLeg>, start: Pose2, speed_mps: f64, seed: u64) -> Drive {
+    let setup = Setup {
+        legs,
+        start,
+        crawler: CrawlerParams::default(),
+        slip: SlipParams::loose_bench(),
+        rtk: RtkParams::rtk(seed),
+        sim: SimParams {
+            speed_mps,
+            ..SimParams::default()
+        },
+    };
+    let mut controller = ControllerKind::Fuzzy.build(&ControllerParams::default());
+    let run = simulate(&setup, controller.as_mut());
+    let last = run.samples.last();
+    Drive {
+        end: last.map_or(start, |s| s.truth),
+        time_s: last.map_or(0.0, |s| s.t_s),
+        travelled_m: run.metrics.travelled_m,
+        run,
+    }
 }
 
 /// The models behind the figures of merit, in words.

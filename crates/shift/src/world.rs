@@ -47,7 +47,7 @@ pub struct Lidar {
 }
 
 impl Lidar {
-    /// An 80-line sensor's worth of rays over 110° × 57° below the horizon
+    /// An 80-line sensor's worth of rays over 110° × 72° below the horizon
     /// (walking paper Table 2's class), mounted 0.8° and −1.5° off level,
     /// 2 cm range noise, 0.3 % dust.
     pub fn on_machine(height_m: f64, points: usize) -> Self {
@@ -292,7 +292,7 @@ impl World {
 
     /// A scan from the LiDAR on the machine at `pose` (the swing axis on
     /// the floor, heading θ), in the sensor's own frame (x ahead, tilted by
-    /// its mounting): rays in 80 lines from 8° to 65° below the horizon
+    /// its mounting): rays in 80 lines from 8° to 80° below the horizon
     /// over ±55° of azimuth, each marched over the grid to its first hit;
     /// a ray that leaves the world is lost. Same seed, same scan.
     pub fn scan(&self, pose: Pose2, lidar: &Lidar, seed: u64) -> PointCloud {
@@ -307,7 +307,7 @@ impl World {
             .map(|ray| {
                 let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (ray as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
                 let (line, k) = (ray / per_line, ray % per_line);
-                let el = (-8.0 - 57.0 * line as f64 / (LINES - 1) as f64).to_radians();
+                let el = (-8.0 - 72.0 * line as f64 / (LINES - 1) as f64).to_radians();
                 let az = (-55.0 + 110.0 * (k as f64 + 0.5) / per_line as f64).to_radians();
                 // The ray in the machine's level frame, then the world's.
                 let d = [el.cos() * az.cos(), el.cos() * az.sin(), el.sin()];
