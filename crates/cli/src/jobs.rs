@@ -459,3 +459,24 @@ pub fn plan_excavate(setup: &Setup, out: Option<&OutDir>) -> Result<Job<Excavate
         Ok(figures::excavate::write(dir, setup, &ex, written)?)
     })
 }
+
+/// `shift`: a whole shift of `scenario` with the dig planner's `profile`
+/// (1:30, scaled by the scenario's λ), with a progress bar when `show`.
+pub fn shift(
+    scenario: &autoshovel_shift::ShiftScenario,
+    profile: &autoshovel_dig::MachineProfile,
+    options: &autoshovel_shift::ShiftOptions,
+    out: Option<&OutDir>,
+    show: bool,
+) -> Result<Job<autoshovel_shift::ShiftSummary>> {
+    let bar = crate::output::progress_bar(show, "shift {bar:40} {percent:>3}% of the shift {elapsed}");
+    bar.set_length(1000);
+    let run = autoshovel_shift::run_shift(scenario, profile, options, &mut |share| {
+        bar.set_position((share * 1000.0) as u64)
+    })
+    .with_context(|| format!("shift {}", scenario.name))?;
+    bar.finish_and_clear();
+    Job::finish(run.summary.clone(), out, |dir, written| {
+        Ok(figures::shift::write(dir, &run, written)?)
+    })
+}

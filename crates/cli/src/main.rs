@@ -24,6 +24,7 @@ mod pile;
 mod plan_dig;
 mod plan_excavate;
 mod plan_path;
+mod shift;
 mod study;
 mod study_boulders;
 mod track;
@@ -61,6 +62,8 @@ enum Command {
     ValidateDig(validate_dig::Args),
     /// Plan a hydraulic excavator's dig round buried boulders: two-level planning (SPEC §5).
     PlanExcavate(plan_excavate::Args),
+    /// The whole machine: a shift of scan, dig, swing, dump and walk against a changing pit (SPEC §9).
+    Shift(shift::Args),
     /// Seeded random haul-road study: classic APF, improved APF and the Theta* reference.
     StudyPaths(study::Args),
     /// Seeded boulder study of the excavator planner that knows only what it touches.
@@ -175,6 +178,7 @@ fn main() -> ExitCode {
         Command::PlanDig(args) => plan_dig::run(&args),
         Command::ValidateDig(args) => validate_dig::run(&args),
         Command::PlanExcavate(args) => plan_excavate::run(&args),
+        Command::Shift(args) => shift::run(&args),
         Command::Scenario { name } => print_scenario(&name),
         Command::PlcSim(args) => link::plc_sim(&args),
         Command::Drive(args) => link::drive(&args),

@@ -16,6 +16,7 @@ pub mod filter;
 pub mod frames;
 pub mod map;
 pub mod perceive;
+pub mod shift;
 pub mod shovel;
 pub mod study;
 pub mod tiles;

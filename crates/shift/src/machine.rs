@@ -81,27 +81,45 @@ impl PileModel {
             let (x, y) = (f64::from(p[0]), f64::from(p[1]));
             (pose.x + x * c - y * s, pose.y + x * s + y * c)
         };
-        let mut sum = vec![0.0f64; self.z.len()];
+        // Cells with cleaned points (perception's surface) take the median
+        // height of the whole scan's points in them: the cleaned cloud is
+        // thinned and smoothed, which rounds off the edges the dipper
+        // leaves; the median of the raw returns keeps them and ignores dust.
         let mut count = vec![0u32; self.z.len()];
-        let (mut low_sum, mut low_count) = (vec![0.0f64; self.z.len()], vec![0u32; self.z.len()]);
         for p in &cleaned.points {
             let (x, y) = world(p);
             if let Some(k) = self.cell_of(x, y) {
-                sum[k] += f64::from(p[2]) - floor_z;
                 count[k] += 1;
             }
         }
+        let mut raw: Vec<Vec<f32>> = vec![Vec::new(); self.z.len()];
+        let (mut low_sum, mut low_count) = (vec![0.0f64; self.z.len()], vec![0u32; self.z.len()]);
         for p in &seen.points {
             let (x, y) = world(p);
-            // Returns near the floor that perception set aside with the
-            // ground say "floor, or the foot of the face, here" (dust in
-            // the air says nothing about the ground under it).
+            let Some(k) = self.cell_of(x, y) else { continue };
             let h = f64::from(p[2]) - floor_z;
-            if h.abs() < OBSTACLE_HEIGHT_M {
-                if let Some(k) = self.cell_of(x, y) {
-                    low_sum[k] += h;
-                    low_count[k] += 1;
+            if count[k] > 0 {
+                raw[k].push(h as f32);
+            } else if h.abs() < OBSTACLE_HEIGHT_M {
+                // Returns near the floor that perception set aside with the
+                // ground say "floor, or the foot of the face, here" (dust
+                // in the air says nothing about the ground under it).
+                low_sum[k] += h;
+                low_count[k] += 1;
+            }
+        }
+        let mut sum = vec![0.0f64; self.z.len()];
+        for k in 0..self.z.len() {
+            if count[k] > 0 {
+                let v = &mut raw[k];
+                if v.is_empty() {
+                    count[k] = 0;
+                    continue;
                 }
+                let mid = v.len() / 2;
+                v.select_nth_unstable_by(mid, f32::total_cmp);
+                sum[k] = f64::from(v[mid]);
+                count[k] = 1;
             }
         }
         // What the last scan covered and did not hit (occluded, or thinned
