@@ -469,7 +469,8 @@ pub fn shift(
     out: Option<&OutDir>,
     show: bool,
 ) -> Result<Job<autoshovel_shift::ShiftSummary>> {
-    let bar = crate::output::progress_bar(show, "shift {bar:40} {percent:>3}% of the shift {elapsed}");
+    let bar =
+        crate::output::progress_bar(show, "shift {bar:40} {percent:>3}% of the shift {elapsed}");
     bar.set_length(1000);
     let run = autoshovel_shift::run_shift(scenario, profile, options, &mut |share| {
         bar.set_position((share * 1000.0) as u64)

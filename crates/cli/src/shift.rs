@@ -36,7 +36,10 @@ pub struct Args {
 pub fn run(args: &Args) -> Result<()> {
     if args.print_scenario {
         use std::io::Write as _;
-        let text = match autoshovel_shift::scenario::BUILTINS.iter().find(|(n, _)| *n == args.scenario) {
+        let text = match autoshovel_shift::scenario::BUILTINS
+            .iter()
+            .find(|(n, _)| *n == args.scenario)
+        {
             Some((_, text)) => text.to_string(),
             None => ShiftScenario::resolve(&args.scenario)?.to_toml(),
         };
@@ -58,8 +61,14 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
         args.output.force,
     )?;
-    crate::jobs::shift(&scenario, &profile, &options, out.as_ref(), !args.output.json)?
-        .report(args.output.json, print_human)
+    crate::jobs::shift(
+        &scenario,
+        &profile,
+        &options,
+        out.as_ref(),
+        !args.output.json,
+    )?
+    .report(args.output.json, print_human)
 }
 
 fn print_human(s: &ShiftSummary) {
@@ -67,7 +76,11 @@ fn print_human(s: &ShiftSummary) {
         "shift on {}: {:.2} h simulated{}, {} passes from {} stands, {} walks ({:.0} m)",
         s.scenario,
         s.hours,
-        if s.completed { "" } else { " (ended early: no stand left)" },
+        if s.completed {
+            ""
+        } else {
+            " (ended early: no stand left)"
+        },
         s.passes,
         s.stands,
         s.walks,

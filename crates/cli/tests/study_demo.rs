@@ -140,8 +140,8 @@ fn study_refuses_zero_maps_and_bad_obstacle_ranges() {
     );
 }
 
-// `demo` plans six scenarios, a 100-map study, five rope-shovel digs and
-// three excavator digs: about 4 s in release, roughly 10–15 s in the test
+// `demo` plans six scenarios, a 100-map study, five rope-shovel digs,
+// three excavator digs and a 45-minute shift: about 4 s in release, roughly 10–15 s in the test
 // profile (opt-level 1, dependencies at 2).
 #[test]
 fn demo_writes_index_and_summary() {
@@ -194,6 +194,7 @@ fn demo_writes_index_and_summary() {
             "plan-path straight improved-apf",
             "plan-path v-shape apf",
             "plan-path v-shape improved-apf",
+            "shift",
             "study-paths",
             "track curve --compare",
             "track curve fuzzy",
@@ -233,6 +234,13 @@ fn demo_writes_index_and_summary() {
     assert_eq!(jobs["plan-path curve apf"]["success"], false);
     assert_eq!(jobs["plan-path curve apf"]["local_minimum"], true);
     assert_eq!(jobs["study-paths"]["maps"], 100);
+    // The short shift digs from more than one stand, walks, and its mass
+    // balance closes.
+    let shift = &jobs["shift"];
+    assert!(shift["stands"].as_u64().unwrap() >= 2, "{shift}");
+    assert!(shift["walks"].as_u64().unwrap() >= 1, "{shift}");
+    assert_eq!(shift["mass_balance"]["closes"], true);
+    assert!(out.join("shift").join("animation.html").is_file());
     assert_eq!(jobs["plan-dig typical"]["feasible"], true);
     let piles: Vec<&str> = jobs["plan-dig --all-surfaces"]["surfaces"]
         .as_array()

@@ -175,7 +175,10 @@ mod tests {
             let small = DigModel::new(&model_profile, surface).unwrap();
             let big = DigModel::new(&big_profile, image).unwrap();
             let search = crate::plan::search_preset();
-            let d = crate::plan::plan_dig(&small, &search, &[]).unwrap().outcome.decision;
+            let d = crate::plan::plan_dig(&small, &search, &[])
+                .unwrap()
+                .outcome
+                .decision;
             let x = [d.ax6, d.ay6, d.td_s, d.gx_m, d.gy_m];
             let a = small.evaluate(&Decision::from_slice(&x));
             let b = big.evaluate(&Decision::from_slice(&s.decision(&x)));
@@ -211,7 +214,11 @@ mod tests {
     #[test]
     fn the_full_size_dipper_is_wk_class() {
         let p = Similarity::PAPER.machine(&MachineProfile::scale_model());
-        assert_relative_eq!(p.dipper.capacity_m3, 8.107e-4 * 27_000.0, max_relative = 1e-12);
+        assert_relative_eq!(
+            p.dipper.capacity_m3,
+            8.107e-4 * 27_000.0,
+            max_relative = 1e-12
+        );
         assert!((20.0..25.0).contains(&p.dipper.capacity_m3));
         assert_relative_eq!(p.limits.hoist_power_max_w, 15.0 * 30f64.powf(3.5));
         assert_relative_eq!(p.search.td_s[0], 9.0 * 30f64.sqrt());

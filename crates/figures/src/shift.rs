@@ -28,8 +28,27 @@ pub const STAND_MAPS: usize = 12;
 /// Writes the job's tables and plots of `run` into `dir`.
 pub fn write(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), ReportError> {
     tables(dir, run, written)?;
-    written.plot(dir, write_heatmap(&pit_map(run, &run.before, "The pit at the start", false), dir, "pit_before")?);
-    written.plot(dir, write_heatmap(&pit_map(run, &run.after, "The pit at the end: stands, dig paths and walks", true), dir, "pit_after")?);
+    written.plot(
+        dir,
+        write_heatmap(
+            &pit_map(run, &run.before, "The pit at the start", false),
+            dir,
+            "pit_before",
+        )?,
+    );
+    written.plot(
+        dir,
+        write_heatmap(
+            &pit_map(
+                run,
+                &run.after,
+                "The pit at the end: stands, dig paths and walks",
+                true,
+            ),
+            dir,
+            "pit_after",
+        )?,
+    );
     let n = run.stands.len();
     for (i, stand) in run.stands.iter().enumerate() {
         if i + 1 >= STAND_MAPS && i + 1 != n {
@@ -87,9 +106,28 @@ fn tables(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), Repor
     write_csv_cells(
         &passes,
         &[
-            "pass", "stand", "truck", "t_start_s", "swing_deg", "toe_distance_m", "dig_s", "swing_s",
-            "dump_s", "return_s", "wait_s", "planned_m3", "executed_m3", "dug_m3", "dug_t",
-            "fill_factor", "hoist_j", "crowd_j", "swing_j", "perceive_ms", "plan_ms", "wall_ms",
+            "pass",
+            "stand",
+            "truck",
+            "t_start_s",
+            "swing_deg",
+            "toe_distance_m",
+            "dig_s",
+            "swing_s",
+            "dump_s",
+            "return_s",
+            "wait_s",
+            "planned_m3",
+            "executed_m3",
+            "dug_m3",
+            "dug_t",
+            "fill_factor",
+            "hoist_j",
+            "crowd_j",
+            "swing_j",
+            "perceive_ms",
+            "plan_ms",
+            "wall_ms",
         ],
         &rows,
     )?;
@@ -113,7 +151,16 @@ fn tables(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), Repor
         .collect();
     write_csv_cells(
         &stands,
-        &["stand", "x_m", "y_m", "heading_deg", "t_arrive_s", "passes", "dug_t", "left_because"],
+        &[
+            "stand",
+            "x_m",
+            "y_m",
+            "heading_deg",
+            "t_arrive_s",
+            "passes",
+            "dug_t",
+            "left_because",
+        ],
         &rows,
     )?;
     written.file(dir, &stands);
@@ -138,16 +185,29 @@ fn tables(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), Repor
     write_csv_cells(
         &walks,
         &[
-            "from_stand", "to_stand", "v_move", "planned_m", "travelled_m", "time_s", "energy_j",
-            "final_error_m", "max_deviation_m",
+            "from_stand",
+            "to_stand",
+            "v_move",
+            "planned_m",
+            "travelled_m",
+            "time_s",
+            "energy_j",
+            "final_error_m",
+            "max_deviation_m",
         ],
         &rows,
     )?;
     written.file(dir, &walks);
     let paths = dir.join("walk_paths.csv");
     let rows = run.walks.iter().enumerate().flat_map(|(i, w)| {
-        let planned = w.planned.iter().map(move |p| vec![i as f64 + 1.0, 0.0, p[0], p[1]]);
-        let driven = w.driven.iter().map(move |p| vec![i as f64 + 1.0, 1.0, p[0], p[1]]);
+        let planned = w
+            .planned
+            .iter()
+            .map(move |p| vec![i as f64 + 1.0, 0.0, p[0], p[1]]);
+        let driven = w
+            .driven
+            .iter()
+            .map(move |p| vec![i as f64 + 1.0, 1.0, p[0], p[1]]);
         planned.chain(driven)
     });
     write_csv(&paths, &["walk", "driven", "x_m", "y_m"], rows)?;
@@ -156,29 +216,72 @@ fn tables(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), Repor
     let rows: Vec<Vec<String>> = run
         .events
         .iter()
-        .map(|e| vec![format_f64(e.t_s), e.kind.to_string(), e.stand.to_string(), e.message.clone()])
+        .map(|e| {
+            vec![
+                format_f64(e.t_s),
+                e.kind.to_string(),
+                e.stand.to_string(),
+                e.message.clone(),
+            ]
+        })
         .collect();
     write_csv_cells(&events, &["t_s", "kind", "stand", "message"], &rows)?;
     written.file(dir, &events);
     Ok(())
 }
 
-/// Sample coordinates of the world's cells, and its heights by row.
-fn grid(world: &World, z: &[f64], window: Option<([f64; 2], [f64; 2])>) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
+/// Cells at most in a drawn height map (an SVG draws each as a rectangle).
+const MAP_CELLS: usize = 25_000;
+
+/// Sample coordinates and heights by row of `z` (the world's grid) over
+/// `window` (default: all), every `k`-th cell each way so that at most
+/// [`MAP_CELLS`] are drawn (each the mean of the k × k it stands for).
+fn grid(
+    world: &World,
+    z: &[f64],
+    window: Option<([f64; 2], [f64; 2])>,
+) -> (Vec<f64>, Vec<f64>, Vec<Vec<f64>>) {
     let c = world.cell_m;
     let [nx, ny] = world.size;
     let (lo, hi) = window.unwrap_or((
         world.origin,
-        [world.origin[0] + nx as f64 * c, world.origin[1] + ny as f64 * c],
+        [
+            world.origin[0] + nx as f64 * c,
+            world.origin[1] + ny as f64 * c,
+        ],
     ));
     let i0 = (((lo[0] - world.origin[0]) / c).floor().max(0.0)) as usize;
     let i1 = ((((hi[0] - world.origin[0]) / c).ceil()) as usize).min(nx);
     let j0 = (((lo[1] - world.origin[1]) / c).floor().max(0.0)) as usize;
     let j1 = ((((hi[1] - world.origin[1]) / c).ceil()) as usize).min(ny);
-    let xs = (i0..i1).map(|i| world.origin[0] + (i as f64 + 0.5) * c).collect();
-    let ys = (j0..j1).map(|j| world.origin[1] + (j as f64 + 0.5) * c).collect();
-    let rows = (j0..j1).map(|j| (i0..i1).map(|i| z[j * nx + i]).collect()).collect();
-    (xs, ys, rows)
+    let cells = (i1 - i0) * (j1 - j0);
+    let k = ((cells as f64 / MAP_CELLS as f64).sqrt().ceil() as usize).max(1);
+    let centre = |first: usize, last: usize, o: f64| o + 0.5 * (first + last) as f64 * c + 0.5 * c;
+    let cols: Vec<(usize, usize)> = (i0..i1).step_by(k).map(|i| (i, (i + k).min(i1))).collect();
+    let rows: Vec<(usize, usize)> = (j0..j1).step_by(k).map(|j| (j, (j + k).min(j1))).collect();
+    let xs = cols
+        .iter()
+        .map(|&(a, b)| centre(a, b - 1, world.origin[0]))
+        .collect();
+    let ys = rows
+        .iter()
+        .map(|&(a, b)| centre(a, b - 1, world.origin[1]))
+        .collect();
+    let heights = rows
+        .iter()
+        .map(|&(ja, jb)| {
+            cols.iter()
+                .map(|&(ia, ib)| {
+                    let n = ((jb - ja) * (ib - ia)) as f64;
+                    (ja..jb)
+                        .flat_map(|j| (ia..ib).map(move |i| z[j * nx + i]))
+                        .sum::<f64>()
+                        / n
+                })
+                .collect()
+        })
+        .collect();
+    (xs, ys, heights)
 }
 
 fn pit_map(run: &ShiftRun, world: &World, title: &str, overlays: bool) -> Heatmap {
@@ -188,10 +291,16 @@ fn pit_map(run: &ShiftRun, world: &World, title: &str, overlays: bool) -> Heatma
         .equal_aspect();
     if overlays {
         for p in &run.passes {
-            map = map.layer(Layer::line(p.path.iter().map(|q| (q[0], q[1])), Stroke::solid(Rgb::WHITE, 1)));
+            map = map.layer(Layer::line(
+                p.path.iter().map(|q| (q[0], q[1])),
+                Stroke::solid(Rgb::WHITE, 1),
+            ));
         }
         for w in &run.walks {
-            map = map.layer(Layer::line(w.driven.iter().map(|q| (q[0], q[1])), Stroke::solid(Rgb::RED, 2)));
+            map = map.layer(Layer::line(
+                w.driven.iter().map(|q| (q[0], q[1])),
+                Stroke::solid(Rgb::RED, 2),
+            ));
         }
     }
     map.layer(
@@ -207,7 +316,10 @@ fn stand_maps(run: &ShiftRun, i: usize) -> (Heatmap, Heatmap) {
     let make = |z: &[f64], when: &str| {
         let (xs, ys, rows) = grid(world, z, Some(window));
         Heatmap::new(
-            format!("Stand {} {when}: {} passes, {:.0} t", s.stand, s.passes, s.dug_t),
+            format!(
+                "Stand {} {when}: {} passes, {:.0} t",
+                s.stand, s.passes, s.dug_t
+            ),
             "x (east) [m]",
             "y (north) [m]",
             xs,
@@ -220,16 +332,33 @@ fn stand_maps(run: &ShiftRun, i: usize) -> (Heatmap, Heatmap) {
         .layer(Layer::points([(s.x_m, s.y_m)], Rgb::BLACK, 4).with_label("swing axis"))
     };
     let before = make(&s.before, "on arrival");
-    let mut after = make(if s.after.is_empty() { &run.after.z } else { &s.after }, "on leaving");
+    let mut after = make(
+        if s.after.is_empty() {
+            &run.after.z
+        } else {
+            &s.after
+        },
+        "on leaving",
+    );
     for p in run.passes.iter().filter(|p| p.stand == s.stand) {
-        after = after.layer(Layer::line(p.path.iter().map(|q| (q[0], q[1])), Stroke::solid(Rgb::WHITE, 2)));
+        after = after.layer(Layer::line(
+            p.path.iter().map(|q| (q[0], q[1])),
+            Stroke::solid(Rgb::WHITE, 2),
+        ));
     }
     (before, after)
 }
 
+/// One stage's time of a pass.
+type Stage = fn(&autoshovel_shift::PassRecord) -> f64;
+
 fn timeline(run: &ShiftRun) -> Vec<Figure> {
     let hours = |t: f64| t / 3600.0;
-    let mut tonnes = Figure::new("Shift timeline: mass dug, walks (grey) and safety events", "time [h]", "mass dug [t]");
+    let mut tonnes = Figure::new(
+        "Shift timeline: mass dug, walks (grey) and safety events",
+        "time [h]",
+        "mass dug [t]",
+    );
     let mut total = 0.0;
     let mut line = vec![(0.0, 0.0)];
     for p in &run.passes {
@@ -238,28 +367,45 @@ fn timeline(run: &ShiftRun) -> Vec<Figure> {
     }
     let top = total.max(1.0);
     let mut t_walk = Vec::new();
-    for e in run.events.iter().filter(|e| matches!(e.kind, "walk" | "back-off")) {
+    for e in run
+        .events
+        .iter()
+        .filter(|e| matches!(e.kind, "walk" | "back-off"))
+    {
         t_walk.push(e.t_s);
     }
     for (w, t_end) in run.walks.iter().zip(&t_walk) {
         let (a, b) = (hours(t_end - w.time_s), hours(*t_end));
-        tonnes.layers.push(Layer::polygon([(a, 0.0), (b, 0.0), (b, top), (a, top)], Some(Rgb(220, 220, 220)), Stroke::solid(Rgb(220, 220, 220), 1)));
+        tonnes.layers.push(Layer::polygon(
+            [(a, 0.0), (b, 0.0), (b, top), (a, top)],
+            Some(Rgb(220, 220, 220)),
+            Stroke::solid(Rgb(220, 220, 220), 1),
+        ));
     }
-    tonnes.layers.push(Layer::line(line, Stroke::solid(Rgb::BLUE, 2)).with_label("cumulative mass dug"));
+    tonnes
+        .layers
+        .push(Layer::line(line, Stroke::solid(Rgb::BLUE, 2)).with_label("cumulative mass dug"));
     let safety: Vec<(f64, f64)> = run
         .events
         .iter()
         .filter(|e| matches!(e.kind, "overfill" | "over-rating" | "walk-stalled"))
         .map(|e| {
-            let done = run.passes.iter().filter(|p| p.t_start_s <= e.t_s).map(|p| p.dug_t).sum::<f64>();
+            let done = run
+                .passes
+                .iter()
+                .filter(|p| p.t_start_s <= e.t_s)
+                .map(|p| p.dug_t)
+                .sum::<f64>();
             (hours(e.t_s), done)
         })
         .collect();
     if !safety.is_empty() {
-        tonnes.layers.push(Layer::points(safety, Rgb::RED, 3).with_label("safety event"));
+        tonnes
+            .layers
+            .push(Layer::points(safety, Rgb::RED, 3).with_label("safety event"));
     }
     let mut stages = Figure::new("Each pass's stages", "pass", "time [s]");
-    let series: [(&str, fn(&autoshovel_shift::PassRecord) -> f64, Rgb); 5] = [
+    let series: [(&str, Stage, Rgb); 5] = [
         ("dig", |p| p.dig_s, Rgb::BROWN),
         ("swing", |p| p.swing_s, Rgb::BLUE),
         ("dump", |p| p.dump_s, Rgb::GREEN),
@@ -268,7 +414,11 @@ fn timeline(run: &ShiftRun) -> Vec<Figure> {
     ];
     for (name, f, color) in series {
         stages.layers.push(
-            Layer::line(run.passes.iter().map(|p| (p.pass as f64, f(p))), Stroke::solid(color, 1)).with_label(name),
+            Layer::line(
+                run.passes.iter().map(|p| (p.pass as f64, f(p))),
+                Stroke::solid(color, 1),
+            )
+            .with_label(name),
         );
     }
     vec![tonnes, stages]
@@ -286,7 +436,10 @@ fn animation_html(run: &ShiftRun) -> String {
         .max(1e-3);
     let mut frames = String::from("[");
     for (k, f) in run.frames.iter().enumerate() {
-        let bytes: Vec<u8> = f.z.iter().map(|&z| ((z / top).clamp(0.0, 1.0) * 255.0).round() as u8).collect();
+        let bytes: Vec<u8> =
+            f.z.iter()
+                .map(|&z| ((z / top).clamp(0.0, 1.0) * 255.0).round() as u8)
+                .collect();
         if k > 0 {
             frames.push(',');
         }

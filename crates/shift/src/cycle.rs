@@ -111,20 +111,31 @@ mod tests {
             assert_relative_eq!(d.time_s(angle), t, max_relative = 2e-3);
         }
         // 90° at 20°/s and 12°/s²: 4.5 s + 1.67 s.
-        assert_relative_eq!(d.time_s(90f64.to_radians()), 90.0 / 20.0 + 20.0 / 12.0, max_relative = 1e-12);
+        assert_relative_eq!(
+            d.time_s(90f64.to_radians()),
+            90.0 / 20.0 + 20.0 / 12.0,
+            max_relative = 1e-12
+        );
     }
 
     #[test]
     fn swing_energy_is_the_kinetic_energy_at_the_top_speed() {
         let d = drive();
         let w = 20f64.to_radians();
-        assert_relative_eq!(d.energy_j(1.5, 0.0), 0.5 * 3e7 * w * w, max_relative = 1e-12);
+        assert_relative_eq!(
+            d.energy_j(1.5, 0.0),
+            0.5 * 3e7 * w * w,
+            max_relative = 1e-12
+        );
         let load = 50_000.0;
         assert_relative_eq!(
             d.energy_j(1.5, load),
             0.5 * (3e7 + load * 196.0) * w * w,
             max_relative = 1e-12
         );
-        assert_relative_eq!(propel_energy_j(1.4e6, 0.08, 10.0), 0.08 * 1.4e6 * 9.81 * 10.0);
+        assert_relative_eq!(
+            propel_energy_j(1.4e6, 0.08, 10.0),
+            0.08 * 1.4e6 * 9.81 * 10.0
+        );
     }
 }

@@ -10,6 +10,17 @@ use autoshovel_core::{Pose2, Vec2};
 use autoshovel_dig::DigSurface;
 use autoshovel_propel::{Map, Obstacle, Shape};
 
+/// Perception as the machine runs it on every scan: the rope-shovel
+/// paper's pipeline with its defaults, except that the polynomial surface
+/// ([RS eq. 21]) need not pass its R² bar — the machine's pile model is the
+/// cleaned cloud on a grid ([`PileModel`]), and a face dug into bays is no
+/// polynomial.
+pub fn perception() -> autoshovel_surface::perceive::PerceptionParams {
+    let mut p = autoshovel_surface::perceive::PerceptionParams::default();
+    p.fit.r2_threshold = 0.0;
+    p
+}
+
 /// Height above which a cell of the model is an obstacle to walking [m].
 pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
 
@@ -26,6 +37,9 @@ pub const FACE_RISE_SHARE: f64 = 0.25;
 
 /// Length of a dig profile from the swing axis [m].
 pub const PROFILE_LENGTH_M: f64 = 40.0;
+
+/// How far ahead the machine looks for a face when choosing a stand [m].
+pub const LOOK_AHEAD_M: f64 = 90.0;
 
 /// The machine's height model of the pit, from its scans: each cell the
 /// mean height above the floor of the cleaned points of the last scan
@@ -75,7 +89,13 @@ impl PileModel {
     /// perception kept of it (both in the levelled sensor frame, the floor
     /// at `floor_z`), taken at `pose` (the machine's own estimate; the
     /// sensor on the swing axis). Returns the cells updated.
-    pub fn update(&mut self, seen: &PointCloud, cleaned: &PointCloud, floor_z: f64, pose: Pose2) -> usize {
+    pub fn update(
+        &mut self,
+        seen: &PointCloud,
+        cleaned: &PointCloud,
+        floor_z: f64,
+        pose: Pose2,
+    ) -> usize {
         let (c, s) = (pose.theta.cos(), pose.theta.sin());
         let world = |p: &[f32; 3]| {
             let (x, y) = (f64::from(p[0]), f64::from(p[1]));
@@ -96,7 +116,9 @@ impl PileModel {
         let (mut low_sum, mut low_count) = (vec![0.0f64; self.z.len()], vec![0u32; self.z.len()]);
         for p in &seen.points {
             let (x, y) = world(p);
-            let Some(k) = self.cell_of(x, y) else { continue };
+            let Some(k) = self.cell_of(x, y) else {
+                continue;
+            };
             let h = f64::from(p[2]) - floor_z;
             if count[k] > 0 {
                 raw[k].push(h as f32);
@@ -126,7 +148,10 @@ impl PileModel {
         // out by perception's voxel grid) is unknown now, not as it was:
         // the dipper may have been there since.
         let hit: Vec<usize> = (0..self.z.len()).filter(|&k| count[k] > 0).collect();
-        if let (Some(&lo), Some(&hi)) = (hit.iter().min_by_key(|&&k| k % self.size[0]), hit.iter().max_by_key(|&&k| k % self.size[0])) {
+        if let (Some(&lo), Some(&hi)) = (
+            hit.iter().min_by_key(|&&k| k % self.size[0]),
+            hit.iter().max_by_key(|&&k| k % self.size[0]),
+        ) {
             let (i0, i1) = (lo % self.size[0], hi % self.size[0]);
             let (j0, j1) = (
                 hit.iter().map(|&k| k / self.size[0]).min().unwrap_or(0),
@@ -166,14 +191,20 @@ impl PileModel {
     }
 
     /// The width-averaged profile along the line from `origin` at
-    /// `heading`, from the swing axis out to [`PROFILE_LENGTH_M`]
+    /// `heading`, from `origin` out to `length_m`
     /// (x along the line); cells no scan point fell in (perception thins
     /// the cloud to a voxel grid) are bridged linearly between the seen
     /// cells either side along the line, held past the last.
-    pub fn profile(&self, origin: [f64; 2], heading: f64, width_m: f64) -> DigSurface {
+    pub fn profile(
+        &self,
+        origin: [f64; 2],
+        heading: f64,
+        width_m: f64,
+        length_m: f64,
+    ) -> DigSurface {
         let (c, s) = (heading.cos(), heading.sin());
         let step = 0.5 * self.cell_m;
-        let n = (PROFILE_LENGTH_M / step) as usize + 1;
+        let n = (length_m / step) as usize + 1;
         // Along the line, each of five lines across the width, holding the
         // last seen height over unseen cells.
         let across = [-0.4, -0.2, 0.0, 0.2, 0.4].map(|f| f * width_m);
@@ -204,7 +235,7 @@ impl PileModel {
             },
             width_m,
             0.0,
-            PROFILE_LENGTH_M,
+            length_m,
             "the machine's pile model",
         )
     }
@@ -261,9 +292,9 @@ pub fn dig_options(
     let mut refused = Vec::new();
     for &swing in angles {
         let heading = pose.theta + swing;
-        let raw = model.profile([pose.x, pose.y], heading, width_m);
+        let raw = model.profile([pose.x, pose.y], heading, width_m, PROFILE_LENGTH_M);
         let face = raw.top();
-        if !(face > 2.0 * OBSTACLE_HEIGHT_M) {
+        if face.is_nan() || face <= 2.0 * OBSTACLE_HEIGHT_M {
             refused.push((swing, format!("no pile along it (highest {face:.2} m)")));
             continue;
         }
@@ -272,7 +303,11 @@ pub fn dig_options(
                 let surface = surface.with_deepest_cut(deepest_cut_m);
                 let n = 200;
                 let material_m3 = (0..n)
-                    .map(|i| surface.height(reach_m * (i as f64 + 0.5) / n as f64).max(0.0))
+                    .map(|i| {
+                        surface
+                            .height(reach_m * (i as f64 + 0.5) / n as f64)
+                            .max(0.0)
+                    })
                     .sum::<f64>()
                     * reach_m
                     / n as f64
@@ -329,10 +364,13 @@ pub fn next_stands(
     for k in -8..=8 {
         let lateral = f64::from(k) * step_m;
         // Look for the toe from 10 m behind the current stand.
-        let base = [pose.x - 10.0 * c - lateral * s, pose.y - 10.0 * s + lateral * c];
-        let raw = model.profile(base, pose.theta, width_m);
+        let base = [
+            pose.x - 10.0 * c - lateral * s,
+            pose.y - 10.0 * s + lateral * c,
+        ];
+        let raw = model.profile(base, pose.theta, width_m, LOOK_AHEAD_M);
         let face = raw.top();
-        if !(face > 2.0 * OBSTACLE_HEIGHT_M) {
+        if face.is_nan() || face <= 2.0 * OBSTACLE_HEIGHT_M {
             refused.push(format!("{lateral:+.0} m: no pile ahead"));
             continue;
         }
@@ -347,13 +385,18 @@ pub fn next_stands(
             let stand = Pose2::new(base[0] + along * c, base[1] + along * s, pose.theta);
             footprint_clear(map, stand, footprint_m).then_some(stand)
         }) else {
-            refused.push(format!("{lateral:+.0} m: no clear footprint within 6 m of the toe's stand-off"));
+            refused.push(format!(
+                "{lateral:+.0} m: no clear footprint within 6 m of the toe's stand-off"
+            ));
             continue;
         };
-        let (options, _) = dig_options(model, stand, angles, width_m, reach_m, f64::INFINITY);
-        // Material of the fan: the lines are a swing step apart, so each
-        // stands for its share of the fan, not a dipper's width.
-        let material_m3: f64 = options.iter().map(|o| o.material_m3).sum();
+        let material_m3 = fan_material(
+            model,
+            stand,
+            angles,
+            toe_s - along_of(base, stand, pose.theta),
+            reach_m,
+        );
         if material_m3 >= least_m3 {
             out.push(StandCandidate {
                 pose: stand,
@@ -369,6 +412,57 @@ pub fn next_stands(
     };
     out.sort_by(|a, b| score(b).total_cmp(&score(a)));
     (out, refused)
+}
+
+/// Distance along `heading` from `base` to `stand`.
+fn along_of(base: [f64; 2], stand: Pose2, heading: f64) -> f64 {
+    (stand.x - base[0]) * heading.cos() + (stand.y - base[1]) * heading.sin()
+}
+
+/// What the model holds above the floor [m³] in the fan a stand can dig:
+/// within the swing angles (and half a dig line's spread more either
+/// side), from `toe_m` out to `toe_m + reach_m` from the swing axis.
+pub fn fan_material(
+    model: &PileModel,
+    stand: Pose2,
+    angles: &[f64],
+    toe_m: f64,
+    reach_m: f64,
+) -> f64 {
+    let spread = 5f64.to_radians();
+    let (lo, hi) = angles
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &x| {
+            (a.min(x), b.max(x))
+        });
+    let (r0, r1) = (toe_m.max(0.0), toe_m.max(0.0) + reach_m);
+    let c = model.cell_m;
+    let cell = |v: f64, o: f64, n: usize| (((v - o) / c).floor().max(0.0) as usize).min(n);
+    let (i0, i1) = (
+        cell(stand.x - r1, model.origin[0], model.size[0]),
+        cell(stand.x + r1, model.origin[0], model.size[0]) + 1,
+    );
+    let (j0, j1) = (
+        cell(stand.y - r1, model.origin[1], model.size[1]),
+        cell(stand.y + r1, model.origin[1], model.size[1]) + 1,
+    );
+    let mut sum = 0.0;
+    for j in j0..j1.min(model.size[1]) {
+        for i in i0..i1.min(model.size[0]) {
+            let k = j * model.size[0] + i;
+            let z = model.z[k];
+            if z.is_nan() || z <= 0.0 {
+                continue;
+            }
+            let [x, y] = model.centre(k);
+            let r = (x - stand.x).hypot(y - stand.y);
+            let a = autoshovel_core::wrap_angle((y - stand.y).atan2(x - stand.x) - stand.theta);
+            if (r0..=r1).contains(&r) && a >= lo - spread && a <= hi + spread {
+                sum += z;
+            }
+        }
+    }
+    sum * c * c
 }
 
 /// Whether the footprint disc at `pose` keeps [`FOOTPRINT_MARGIN_M`]
@@ -397,11 +491,17 @@ pub fn walking_map(model: &PileModel) -> Map {
     let c = model.cell_m;
     let band = (MAP_BAND_M / c).round().max(1.0) as usize;
     let (nx, ny) = (model.size[0], model.size[1]);
-    let max = Vec2::new(model.origin[0] + nx as f64 * c, model.origin[1] + ny as f64 * c);
+    let max = Vec2::new(
+        model.origin[0] + nx as f64 * c,
+        model.origin[1] + ny as f64 * c,
+    );
     let mut map = Map::new(Vec2::new(model.origin[0], model.origin[1]), max);
     for b0 in (0..ny).step_by(band) {
         let rows = b0..(b0 + band).min(ny);
-        let high = |i: usize| rows.clone().any(|j| model.z[j * nx + i] > OBSTACLE_HEIGHT_M);
+        let high = |i: usize| {
+            rows.clone()
+                .any(|j| model.z[j * nx + i] > OBSTACLE_HEIGHT_M)
+        };
         let mut i = 0;
         while i < nx {
             if !high(i) {
@@ -412,7 +512,10 @@ pub fn walking_map(model: &PileModel) -> Map {
             while i < nx && high(i) {
                 i += 1;
             }
-            let (x0, x1) = (model.origin[0] + start as f64 * c, model.origin[0] + i as f64 * c);
+            let (x0, x1) = (
+                model.origin[0] + start as f64 * c,
+                model.origin[0] + i as f64 * c,
+            );
             let (y0, y1) = (
                 model.origin[1] + rows.start as f64 * c,
                 model.origin[1] + rows.end as f64 * c,
@@ -443,7 +546,8 @@ pub fn v_midpoint(from: Pose2, to: Pose2, back_m: f64) -> Pose2 {
     let d = to.position() - from.position();
     let forward = d.x * c + d.y * s;
     let lateral = -d.x * s + d.y * c;
-    let turn = lateral.signum() * (0.55 * lateral.abs().atan2(back_m + forward)).min(35f64.to_radians());
+    let turn =
+        lateral.signum() * (0.55 * lateral.abs().atan2(back_m + forward)).min(35f64.to_radians());
     let (mx, my) = (
         from.x - back_m * c - 0.1 * lateral * s,
         from.y - back_m * s + 0.1 * lateral * c,
@@ -456,14 +560,14 @@ mod tests {
     use super::*;
     use crate::scenario::ShiftScenario;
     use crate::world::{Lidar, World};
-    use autoshovel_surface::perceive::{perceive, PerceptionParams};
+    use autoshovel_surface::perceive::perceive;
 
     fn scanned(pose: Pose2) -> (World, PileModel) {
         let s = ShiftScenario::bench();
         let world = World::new(&s);
         let lidar = Lidar::on_machine(s.machine.sensor_height_m, 30_000);
         let scan = world.scan(pose, &lidar, 3);
-        let got = perceive(&scan, &PerceptionParams::default()).unwrap();
+        let got = perceive(&scan, &perception()).unwrap();
         let seen = autoshovel_surface::level(&scan, got.roll_rad, got.pitch_rad);
         let mut model = PileModel::new(s.world.min_m, s.world.max_m, 0.5);
         model.update(&seen, &got.cloud, got.floor_height_m, pose);
@@ -504,7 +608,10 @@ mod tests {
         let blocked = |x: f64, y: f64| {
             map.obstacles.iter().any(|o| match &o.shape {
                 Shape::Polygon { vertices } => {
-                    x >= vertices[0].x && x <= vertices[1].x && y >= vertices[0].y && y <= vertices[2].y
+                    x >= vertices[0].x
+                        && x <= vertices[1].x
+                        && y >= vertices[0].y
+                        && y <= vertices[2].y
                 }
                 Shape::Circle { .. } => false,
             })

@@ -29,15 +29,17 @@ use serde::Serialize;
 use autoshovel_core::{Pose2, Vec2};
 use autoshovel_dig::{plan_dig, DigModel, DigSearch, DigSurface, MachineProfile, Similarity};
 use autoshovel_propel::{plan_path, Direction, FieldKind, PlanOptions, Scenario as Travel};
-use autoshovel_surface::perceive::{perceive, PerceptionParams};
+use autoshovel_surface::perceive::perceive;
 use autoshovel_track::{
-    simulate, ControllerKind, ControllerParams, CrawlerParams, RefLeg, RtkParams, Setup,
-    SimParams, SlipParams,
+    simulate, ControllerKind, ControllerParams, CrawlerParams, RefLeg, RtkParams, Setup, SimParams,
+    SlipParams,
 };
 
 use crate::cycle::{propel_energy_j, SwingDrive};
 use crate::error::{Result, ShiftError};
-use crate::machine::{dig_options, next_stands, v_midpoint, walking_map, PileModel, FOOTPRINT_MARGIN_M};
+use crate::machine::{
+    dig_options, next_stands, v_midpoint, walking_map, PileModel, FOOTPRINT_MARGIN_M,
+};
 use crate::scenario::ShiftScenario;
 use crate::world::{Cut, Lidar, World};
 
@@ -392,7 +394,12 @@ pub fn run_shift(
     let mut world = World::new(scenario);
     let before = world.clone();
     let mut pose = Pose2::new(m.start_m[0], m.start_m[1], m.heading_deg.to_radians());
-    if !world.is_clear(pose.x, pose.y, m.footprint_radius_m, crate::machine::OBSTACLE_HEIGHT_M) {
+    if !world.is_clear(
+        pose.x,
+        pose.y,
+        m.footprint_radius_m,
+        crate::machine::OBSTACLE_HEIGHT_M,
+    ) {
         return Err(ShiftError::BadStart {
             x_m: pose.x,
             y_m: pose.y,
@@ -414,25 +421,33 @@ pub fn run_shift(
     };
     let mut pose_seen = measured(pose, &mut rng);
     let lidar = Lidar::on_machine(m.sensor_height_m, scenario.shift.scan_points);
-    // The machine's pile model is the cleaned cloud on a grid; the paper's
-    // polynomial surface ([RS eq. 21]) is still fitted, but a face dug
-    // into bays is no polynomial, so its R² bar is not required.
-    let mut perception = PerceptionParams::default();
-    perception.fit.r2_threshold = 0.0;
-    let mut model = PileModel::new(scenario.world.min_m, scenario.world.max_m, scenario.world.cell_m);
+    let perception = crate::machine::perception();
+    let mut model = PileModel::new(
+        scenario.world.min_m,
+        scenario.world.max_m,
+        scenario.world.cell_m,
+    );
     let swing = SwingDrive {
         speed_rad_s: m.swing_speed_deg_s.to_radians(),
         accel_rad_s2: m.swing_accel_deg_s2.to_radians(),
         inertia_kg_m2: m.upper_inertia_kg_m2,
         radius_m: m.dipper_radius_m,
     };
-    let angles: Vec<f64> = scenario.shift.dig_angles_deg.iter().map(|a| a.to_radians()).collect();
+    let angles: Vec<f64> = scenario
+        .shift
+        .dig_angles_deg
+        .iter()
+        .map(|a| a.to_radians())
+        .collect();
     let width = profile.dipper.width_m;
     let reach = profile.search.gx_m[1];
     let deepest = similarity.length(autoshovel_dig::terrain::DEEPEST_CUT_M);
     let density_t = profile.material.density_kg_m3 / 1000.0;
     let capacity = profile.dipper.capacity_m3;
-    let nominal_toe = profile.geometry.toe_distance_m.unwrap_or(similarity.length(0.0875));
+    let nominal_toe = profile
+        .geometry
+        .toe_distance_m
+        .unwrap_or(similarity.length(0.0875));
     let stand_off = m.saddle_ahead_m + nominal_toe;
     let truck_swing = scenario.truck.swing_deg.to_radians();
 
@@ -477,14 +492,15 @@ pub fn run_shift(
     let mut completed = false;
     let mut scans = 0u64;
     let mut propel_j = 0.0;
-    let note = |events: &mut Vec<Event>, t: f64, kind: &'static str, stand: usize, message: String| {
-        events.push(Event {
-            t_s: t,
-            kind,
-            stand,
-            message,
-        })
-    };
+    let note =
+        |events: &mut Vec<Event>, t: f64, kind: &'static str, stand: usize, message: String| {
+            events.push(Event {
+                t_s: t,
+                kind,
+                stand,
+                message,
+            })
+        };
 
     'shift: loop {
         let stand_no = stands.len();
@@ -497,7 +513,11 @@ pub fn run_shift(
         // Scan and perceive.
         let pass_wall = Instant::now();
         scans += 1;
-        let scan = world.scan(pose, &lidar, seed.wrapping_mul(1_000_003).wrapping_add(scans));
+        let scan = world.scan(
+            pose,
+            &lidar,
+            seed.wrapping_mul(1_000_003).wrapping_add(scans),
+        );
         let t_perceive = Instant::now();
         let perceived = perceive(&scan, &perception);
         let perceive_ms = t_perceive.elapsed().as_secs_f64() * 1e3;
@@ -533,12 +553,19 @@ pub fn run_shift(
                 // An angle the planner could not dig at this stand stays
                 // undiggable while the machine stands here (nothing but
                 // the dipper changes the pile, and it only takes away).
-                if let Some(why) = exhausted.iter().find(|(a, _)| *a == option.swing).map(|(_, w)| w) {
+                if let Some(why) = exhausted
+                    .iter()
+                    .find(|(a, _)| *a == option.swing)
+                    .map(|(_, w)| w)
+                {
                     reasons.push(format!("{label}: {why}"));
                     continue;
                 }
                 if option.material_m3 < profile.limits.fill_min * capacity {
-                    reasons.push(format!("{label}: {:.1} m³ within reach", option.material_m3));
+                    reasons.push(format!(
+                        "{label}: {:.1} m³ within reach",
+                        option.material_m3
+                    ));
                     continue;
                 }
                 let mut p = profile.clone();
@@ -602,7 +629,9 @@ pub fn run_shift(
             .with_deepest_cut(deepest);
             let mut rated = p.clone();
             rated.limits = profile.limits.clone();
-            let executed = DigModel::new(&rated, truth).ok().map(|true_dig| true_dig.evaluate(&d));
+            let executed = DigModel::new(&rated, truth)
+                .ok()
+                .map(|true_dig| true_dig.evaluate(&d));
             let dug_m3 = world.cut(&cut);
             let dug_t = dug_m3 * density_t;
             let path_world: Vec<[f64; 3]> = cut
@@ -634,7 +663,11 @@ pub fn run_shift(
                     let broken: Vec<String> = e
                         .violated()
                         .into_iter()
-                        .filter(|v| ["c11", "c12", "c13", "c14"].iter().any(|c| v.starts_with(c)))
+                        .filter(|v| {
+                            ["c11", "c12", "c13", "c14"]
+                                .iter()
+                                .any(|c| v.starts_with(c))
+                        })
                         .collect();
                     if !broken.is_empty() {
                         note(
@@ -642,7 +675,11 @@ pub fn run_shift(
                             t + d.td_s,
                             "over-rating",
                             stand_no,
-                            format!("pass {}: on the true pile {}", passes.len() + 1, broken.join(", ")),
+                            format!(
+                                "pass {}: on the true pile {}",
+                                passes.len() + 1,
+                                broken.join(", ")
+                            ),
                         );
                     }
                     (e.hoist_energy_j, e.crowd_energy_j, e.volume_m3)
@@ -795,9 +832,19 @@ pub fn run_shift(
             let back = FOOTPRINT_MARGIN_M + 1.0 - here;
             let (c, sn) = (pose_seen.theta.cos(), pose_seen.theta.sin());
             let to = Vec2::new(pose_seen.x - back * c, pose_seen.y - back * sn);
-            if let Ok(leg) = RefLeg::new(Direction::Reverse, vec![pose_seen.position(), to], Some(pose_seen.theta)) {
-                let d = drive(vec![leg], pose, m.walk_speed_mps, seed.wrapping_add(7919 + walks.len() as u64));
-                let energy = propel_energy_j(m.mass_t * 1000.0, m.rolling_resistance, d.travelled_m);
+            if let Ok(leg) = RefLeg::new(
+                Direction::Reverse,
+                vec![pose_seen.position(), to],
+                Some(pose_seen.theta),
+            ) {
+                let d = drive(
+                    vec![leg],
+                    pose,
+                    m.walk_speed_mps,
+                    seed.wrapping_add(7919 + walks.len() as u64),
+                );
+                let energy =
+                    propel_energy_j(m.mass_t * 1000.0, m.rolling_resistance, d.travelled_m);
                 propel_j += energy;
                 t += d.time_s;
                 note(
@@ -805,7 +852,10 @@ pub fn run_shift(
                     t,
                     "back-off",
                     stand_no,
-                    format!("{:.1} m straight back from the face ({:.2} m clearance on the new scan)", d.travelled_m, here),
+                    format!(
+                        "{:.1} m straight back from the face ({:.2} m clearance on the new scan)",
+                        d.travelled_m, here
+                    ),
                 );
                 walks.push(WalkRecord {
                     from_stand: stand_no,
@@ -818,7 +868,13 @@ pub fn run_shift(
                     final_error_m: (d.end.position() - to).norm(),
                     max_deviation_m: d.run.metrics.max_centroid_dev_overall_m,
                     planned: vec![[pose_seen.x, pose_seen.y], [to.x, to.y]],
-                    driven: d.run.samples.iter().step_by(10).map(|s| [s.truth.x, s.truth.y]).collect(),
+                    driven: d
+                        .run
+                        .samples
+                        .iter()
+                        .step_by(10)
+                        .map(|s| [s.truth.x, s.truth.y])
+                        .collect(),
                 });
                 pose = d.end;
                 pose_seen = d.run.samples.last().map_or(pose, |s| s.measured);
@@ -882,11 +938,23 @@ pub fn run_shift(
                     }
                 }
                 if legs.len() != legs_spec.len() {
-                    note(&mut events, t, "stand-unreachable", stand_no, "a planned leg the tracker cannot follow".into());
+                    note(
+                        &mut events,
+                        t,
+                        "stand-unreachable",
+                        stand_no,
+                        "a planned leg the tracker cannot follow".into(),
+                    );
                     break;
                 }
-                let drive = drive(legs, pose, m.walk_speed_mps, seed.wrapping_add(walks.len() as u64));
-                let (run, end, time_s, travelled) = (&drive.run, drive.end, drive.time_s, drive.travelled_m);
+                let drive = drive(
+                    legs,
+                    pose,
+                    m.walk_speed_mps,
+                    seed.wrapping_add(walks.len() as u64),
+                );
+                let (run, end, time_s, travelled) =
+                    (&drive.run, drive.end, drive.time_s, drive.travelled_m);
                 let last = run.samples.last();
                 let energy = propel_energy_j(m.mass_t * 1000.0, m.rolling_resistance, travelled);
                 propel_j += energy;
@@ -907,7 +975,12 @@ pub fn run_shift(
                         .iter()
                         .flat_map(|l| l.points.iter().map(|p| [p.pose.x, p.pose.y]))
                         .collect(),
-                    driven: run.samples.iter().step_by(10).map(|s| [s.truth.x, s.truth.y]).collect(),
+                    driven: run
+                        .samples
+                        .iter()
+                        .step_by(10)
+                        .map(|s| [s.truth.x, s.truth.y])
+                        .collect(),
                 });
                 t += time_s;
                 pose = end;
@@ -939,7 +1012,11 @@ pub fn run_shift(
                         "stopped {error:.2} m from ({:.1}, {:.1}); track speeds zero; {}",
                         goal.x,
                         goal.y,
-                        if attempt < 2 { "planning again from here" } else { "giving up this stand" }
+                        if attempt < 2 {
+                            "planning again from here"
+                        } else {
+                            "giving up this stand"
+                        }
                     ),
                 );
                 start = pose_seen;
@@ -949,7 +1026,13 @@ pub fn run_shift(
             }
         }
         if !arrived {
-            note(&mut events, t, "no-stand", stand_no, "no stand could be reached".into());
+            note(
+                &mut events,
+                t,
+                "no-stand",
+                stand_no,
+                "no stand could be reached".into(),
+            );
             break 'shift;
         }
         stands.push(StandRecord {
@@ -1025,7 +1108,8 @@ pub fn run_shift(
             * density_t,
         error_t: (pit_lost_t - trucks_t).abs(),
         tolerance_t,
-        closes: (pit_lost_t - trucks_t).abs() <= tolerance_t && (tonnes - trucks_t).abs() <= tolerance_t,
+        closes: (pit_lost_t - trucks_t).abs() <= tolerance_t
+            && (tonnes - trucks_t).abs() <= tolerance_t,
     };
     let mut by_kind = std::collections::BTreeMap::new();
     for e in &events {
@@ -1036,9 +1120,8 @@ pub fn run_shift(
         .filter(|e| matches!(e.kind, "overfill" | "over-rating" | "walk-stalled"))
         .count();
     let quarter = (passes.len() / 4).max(1);
-    let wall_mean = |ps: &[PassRecord]| {
-        ps.iter().map(|p| p.wall_ms).sum::<f64>() / ps.len().max(1) as f64
-    };
+    let wall_mean =
+        |ps: &[PassRecord]| ps.iter().map(|p| p.wall_ms).sum::<f64>() / ps.len().max(1) as f64;
     let hours_run = t / 3600.0;
     let summary = ShiftSummary {
         job: "shift",
@@ -1049,7 +1132,11 @@ pub fn run_shift(
         stands: stands.len(),
         walks: walks.len(),
         tonnes,
-        tonnes_per_hour: if hours_run > 0.0 { tonnes / hours_run } else { 0.0 },
+        tonnes_per_hour: if hours_run > 0.0 {
+            tonnes / hours_run
+        } else {
+            0.0
+        },
         cycle_time_s: cycle,
         walk_time_s: walks.iter().fold(0.0, |a, w| a + w.time_s),
         walked_m: walks.iter().fold(0.0, |a, w| a + w.travelled_m),

@@ -160,7 +160,11 @@ impl ShiftScenario {
         if !path.exists() {
             return Err(ShiftError::UnknownScenario {
                 name: name_or_path.to_string(),
-                known: BUILTINS.iter().map(|(n, _)| *n).collect::<Vec<_>>().join(", "),
+                known: BUILTINS
+                    .iter()
+                    .map(|(n, _)| *n)
+                    .collect::<Vec<_>>()
+                    .join(", "),
             });
         }
         Self::load(path)
@@ -239,17 +243,32 @@ impl TomlFile for ShiftScenario {
                 "a cell coarse enough for at most 40 million cells",
             ));
         }
-        if !(p.repose_deg < 80.0) {
-            return Err(bad("pile", "repose_deg", config::short(p.repose_deg), "below 80°"));
+        if p.repose_deg >= 80.0 {
+            return Err(bad(
+                "pile",
+                "repose_deg",
+                config::short(p.repose_deg),
+                "below 80°",
+            ));
         }
-        if !(p.y_m[1] > p.y_m[0]) {
-            return Err(bad("pile", "y_m", format!("{:?}", p.y_m), "[south end, north end]"));
+        if !p.y_m.iter().all(|v| v.is_finite()) || p.y_m[1] <= p.y_m[0] {
+            return Err(bad(
+                "pile",
+                "y_m",
+                format!("{:?}", p.y_m),
+                "[south end, north end]",
+            ));
         }
         let inside = |x: f64, y: f64| {
             (w.min_m[0]..=w.max_m[0]).contains(&x) && (w.min_m[1]..=w.max_m[1]).contains(&y)
         };
         if !inside(p.toe_x_m, p.y_m[0]) || !inside(p.toe_x_m, p.y_m[1]) {
-            return Err(bad("pile", "toe_x_m", config::short(p.toe_x_m), "inside the world"));
+            return Err(bad(
+                "pile",
+                "toe_x_m",
+                config::short(p.toe_x_m),
+                "inside the world",
+            ));
         }
         if !inside(m.start_m[0], m.start_m[1]) {
             return Err(bad(
@@ -287,7 +306,9 @@ impl TomlFile for ShiftScenario {
             ));
         }
         if s.dig_angles_deg.is_empty()
-            || s.dig_angles_deg.iter().any(|a| !(a.is_finite() && a.abs() <= 90.0))
+            || s.dig_angles_deg
+                .iter()
+                .any(|a| !(a.is_finite() && a.abs() <= 90.0))
         {
             return Err(bad(
                 "shift",
@@ -318,7 +339,9 @@ mod tests {
         assert_eq!(s.name, "bench");
         assert_eq!(s.boulder.len(), 2);
         let text = BENCH_TOML.replace("face_height_m = 4.5", "face_height_m = -1.0");
-        let e = ShiftScenario::from_toml(&text, "f.toml").unwrap_err().to_string();
+        let e = ShiftScenario::from_toml(&text, "f.toml")
+            .unwrap_err()
+            .to_string();
         let line = BENCH_TOML
             .lines()
             .position(|l| l.starts_with("face_height_m"))

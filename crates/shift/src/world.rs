@@ -210,7 +210,9 @@ impl World {
             && x + radius <= self.origin[0] + self.size[0] as f64 * self.cell_m
             && y + radius <= self.origin[1] + self.size[1] as f64 * self.cell_m;
         inside
-            && self.cells_within(x, y, radius).all(|i| self.z[i] <= clear_m)
+            && self
+                .cells_within(x, y, radius)
+                .all(|i| self.z[i] <= clear_m)
     }
 
     /// The cells whose centres lie within `radius` of (x, y).
@@ -219,8 +221,12 @@ impl World {
         let lo = |v: f64, o: f64| (((v - radius - o) / c).floor().max(0.0)) as usize;
         let (i0, j0) = (lo(x, self.origin[0]), lo(y, self.origin[1]));
         let hi = |v: f64, o: f64, n: usize| ((((v + radius - o) / c).ceil()) as usize).min(n);
-        let (i1, j1) = (hi(x, self.origin[0], self.size[0]), hi(y, self.origin[1], self.size[1]));
-        (j0..j1.max(j0)).flat_map(move |j| (i0..i1.max(i0)).map(move |i| j * self.size[0] + i))
+        let (i1, j1) = (
+            hi(x, self.origin[0], self.size[0]),
+            hi(y, self.origin[1], self.size[1]),
+        );
+        (j0..j1.max(j0))
+            .flat_map(move |j| (i0..i1.max(i0)).map(move |i| j * self.size[0] + i))
             .filter(move |&k| {
                 let [cx, cy] = self.centre(k);
                 (cx - x).hypot(cy - y) <= radius
@@ -305,7 +311,9 @@ impl World {
         let hits: Vec<Option<[f32; 3]>> = (0..LINES * per_line)
             .into_par_iter()
             .map(|ray| {
-                let mut rng = ChaCha8Rng::seed_from_u64(seed ^ (ray as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15));
+                let mut rng = ChaCha8Rng::seed_from_u64(
+                    seed ^ (ray as u64).wrapping_mul(0x9E37_79B9_7F4A_7C15),
+                );
                 let (line, k) = (ray / per_line, ray % per_line);
                 let el = (-8.0 - 72.0 * line as f64 / (LINES - 1) as f64).to_radians();
                 let az = (-55.0 + 110.0 * (k as f64 + 0.5) / per_line as f64).to_radians();
@@ -349,7 +357,11 @@ impl World {
                 && x <= self.origin[0] + self.size[0] as f64 * self.cell_m
                 && y <= self.origin[1] + self.size[1] as f64 * self.cell_m
         };
-        let t_floor = if d[2] < 0.0 { eye[2] / -d[2] } else { return None };
+        let t_floor = if d[2] < 0.0 {
+            eye[2] / -d[2]
+        } else {
+            return None;
+        };
         let (mut lo, mut t) = (0.0, 0.0);
         loop {
             let gap = above(t);
@@ -448,7 +460,9 @@ mod tests {
         let expected: f64 = {
             let n = 10_000;
             (0..n)
-                .map(|i| (before.height(30.0 + 10.0 * (i as f64 + 0.5) / n as f64, 60.0) - 1.0).max(0.0))
+                .map(|i| {
+                    (before.height(30.0 + 10.0 * (i as f64 + 0.5) / n as f64, 60.0) - 1.0).max(0.0)
+                })
                 .sum::<f64>()
                 * 10.0
                 / n as f64
