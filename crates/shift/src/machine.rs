@@ -28,11 +28,11 @@ pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
 pub const MAP_BAND_M: f64 = 2.0;
 
 /// Share of the face's height at which the machine reads the face's
-/// slope, continued down to the floor to place the toe (the dig frame's
-/// origin, [`DigSurface::from_toe`]). The planner's own rule for a fresh
-/// scan takes 3 % ([`autoshovel_dig::TOE_RISE_SHARE`]); on a face that has
-/// been dug, a low wedge is left at the foot, and the toe that matters is
-/// the one of the face above it.
+/// slope, continued down to the floor, to place its next stand
+/// ([`next_stands`]). A dig starts where the profile first rises (the
+/// planner's rule for a scan, 3 % of the face: [`autoshovel_dig::TOE_RISE_SHARE`]),
+/// so it takes the low wedge a dug face leaves at its foot; the stand
+/// follows the face above it.
 pub const FACE_RISE_SHARE: f64 = 0.25;
 
 /// Length of a dig profile from the swing axis [m].
@@ -144,28 +144,6 @@ impl PileModel {
                 count[k] = 1;
             }
         }
-        // What the last scan covered and did not hit (occluded, or thinned
-        // out by perception's voxel grid) is unknown now, not as it was:
-        // the dipper may have been there since.
-        let hit: Vec<usize> = (0..self.z.len()).filter(|&k| count[k] > 0).collect();
-        if let (Some(&lo), Some(&hi)) = (
-            hit.iter().min_by_key(|&&k| k % self.size[0]),
-            hit.iter().max_by_key(|&&k| k % self.size[0]),
-        ) {
-            let (i0, i1) = (lo % self.size[0], hi % self.size[0]);
-            let (j0, j1) = (
-                hit.iter().map(|&k| k / self.size[0]).min().unwrap_or(0),
-                hit.iter().map(|&k| k / self.size[0]).max().unwrap_or(0),
-            );
-            for j in j0..=j1 {
-                for i in i0..=i1 {
-                    let k = j * self.size[0] + i;
-                    if count[k] == 0 && low_count[k] == 0 && self.z[k] > 0.0 {
-                        self.z[k] = f64::NAN;
-                    }
-                }
-            }
-        }
         let mut updated = 0;
         for k in 0..self.z.len() {
             if count[k] > 0 {
@@ -177,6 +155,14 @@ impl PileModel {
             }
         }
         updated
+    }
+
+    /// Lowers the model along a dig the machine made (`cut` in its own
+    /// belief of where it stood: its RTK pose, the swing angle and the toe
+    /// it planned from), as the dipper lowered the pit: until the next
+    /// scan sees the result, the machine expects what it planned.
+    pub fn dug(&mut self, cut: &crate::world::Cut) {
+        crate::world::cut_grid(self.origin, self.cell_m, self.size, &mut self.z, cut);
     }
 
     /// The model's height at (x, y): its cell's, 0 outside the site, NaN
@@ -298,7 +284,7 @@ pub fn dig_options(
             refused.push((swing, format!("no pile along it (highest {face:.2} m)")));
             continue;
         }
-        match raw.from_toe(FACE_RISE_SHARE * face) {
+        match raw.from_toe(autoshovel_dig::TOE_RISE_SHARE * face) {
             Ok((surface, toe_s_m)) => {
                 let surface = surface.with_deepest_cut(deepest_cut_m);
                 let n = 200;
@@ -338,8 +324,10 @@ pub struct StandCandidate {
     pub lateral_m: f64,
 }
 
-/// The stands the machine could dig from next, best first: at the current
-/// stand's heading, at lateral offsets of 0, ±1, … ±8 `step_m`, each where
+/// The stands the machine could dig from next, best first: facing the
+/// face at `face_heading` (the mine plan's digging direction, so that
+/// the small heading errors of each walk do not add up), at lateral
+/// offsets of 0, ±1, … ±8 `step_m` from the machine, each where
 /// the perceived toe straight ahead lies `stand_off_m` from the swing
 /// axis; a candidate must have at least `least_m3` within reach, a
 /// footprint clear of the walking map and lie inside the site. Best: most
@@ -350,6 +338,7 @@ pub fn next_stands(
     model: &PileModel,
     map: &Map,
     pose: Pose2,
+    face_heading: f64,
     angles: &[f64],
     width_m: f64,
     reach_m: f64,
@@ -358,6 +347,7 @@ pub fn next_stands(
     footprint_m: f64,
     least_m3: f64,
 ) -> (Vec<StandCandidate>, Vec<String>) {
+    let pose = Pose2::new(pose.x, pose.y, face_heading);
     let (c, s) = (pose.theta.cos(), pose.theta.sin());
     let mut out = Vec::new();
     let mut refused = Vec::new();

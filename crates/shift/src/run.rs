@@ -633,6 +633,13 @@ pub fn run_shift(
                 .ok()
                 .map(|true_dig| true_dig.evaluate(&d));
             let dug_m3 = world.cut(&cut);
+            // The machine's own account of the same dig, where it believes
+            // it stands.
+            model.dug(&Cut {
+                origin: [pose_seen.x, pose_seen.y],
+                heading: pose_seen.theta + option.swing,
+                ..cut.clone()
+            });
             let dug_t = dug_m3 * density_t;
             let path_world: Vec<[f64; 3]> = cut
                 .path
@@ -777,6 +784,7 @@ pub fn run_shift(
             &model,
             &map,
             pose_seen,
+            m.heading_deg.to_radians(),
             &angles,
             width,
             reach,

@@ -238,62 +238,7 @@ impl World {
     /// cell the swept strip covers is lowered to the path, one it covers in
     /// part by that share of its height above the path.
     pub fn cut(&mut self, cut: &Cut) -> f64 {
-        let xs = cut.path.iter().map(|p| p[0]);
-        let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-            (a.min(x), b.max(x))
-        });
-        if !(x_lo.is_finite() && x_hi > x_lo) {
-            return 0.0;
-        }
-        let (c, s) = (cut.heading.cos(), cut.heading.sin());
-        let corners = [
-            cut.world(x_lo, -cut.half_width_m),
-            cut.world(x_lo, cut.half_width_m),
-            cut.world(x_hi, -cut.half_width_m),
-            cut.world(x_hi, cut.half_width_m),
-        ];
-        let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-        for p in corners {
-            for a in 0..2 {
-                lo[a] = lo[a].min(p[a]);
-                hi[a] = hi[a].max(p[a]);
-            }
-        }
-        let cell = self.cell_m;
-        let index = |v: f64, a: usize| ((v - self.origin[a]) / cell).floor();
-        let range = |a: usize| {
-            let i0 = index(lo[a], a).max(0.0) as usize;
-            let i1 = (index(hi[a], a) + 1.0).clamp(0.0, self.size[a] as f64) as usize;
-            i0..i1
-        };
-        let mut removed = 0.0;
-        for j in range(1) {
-            for i in range(0) {
-                let k = j * self.size[0] + i;
-                let [x, y] = self.centre(k);
-                let (dx, dy) = (x - cut.origin[0], y - cut.origin[1]);
-                let along = dx * c + dy * s - cut.toe_s_m;
-                let across = -dx * s + dy * c;
-                // The share of the cell's width the strip covers (the cell
-                // taken square to the strip): a cell half inside gives up
-                // half of what lies above the path, so the volume taken is
-                // the strip's, not the cells' whose centres it holds.
-                let share = ((cut.half_width_m - (across.abs() - 0.5 * cell)).min(cell) / cell)
-                    .clamp(0.0, 1.0);
-                if share == 0.0 {
-                    continue;
-                }
-                if let Some(floor) = cut.floor_at(along) {
-                    let floor = floor.max(0.0);
-                    if self.z[k] > floor {
-                        let taken = share * (self.z[k] - floor);
-                        removed += taken;
-                        self.z[k] -= taken;
-                    }
-                }
-            }
-        }
-        removed * cell * cell
+        cut_grid(self.origin, self.cell_m, self.size, &mut self.z, cut)
     }
 
     /// A scan from the LiDAR on the machine at `pose` (the swing axis on
@@ -385,6 +330,70 @@ impl World {
         }
         Some(hi)
     }
+}
+
+/// [`World::cut`] on any height grid laid out as the world's (origin,
+/// cell edge, cells along x and y, heights x fastest); a NaN cell (never
+/// seen, in the machine's model) is left as it is.
+pub fn cut_grid(origin: [f64; 2], cell: f64, size: [usize; 2], z: &mut [f64], cut: &Cut) -> f64 {
+    let xs = cut.path.iter().map(|p| p[0]);
+    let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
+        (a.min(x), b.max(x))
+    });
+    if !(x_lo.is_finite() && x_hi > x_lo) {
+        return 0.0;
+    }
+    let (c, s) = (cut.heading.cos(), cut.heading.sin());
+    let corners = [
+        cut.world(x_lo, -cut.half_width_m),
+        cut.world(x_lo, cut.half_width_m),
+        cut.world(x_hi, -cut.half_width_m),
+        cut.world(x_hi, cut.half_width_m),
+    ];
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in corners {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let index = |v: f64, a: usize| ((v - origin[a]) / cell).floor();
+    let range = |a: usize| {
+        let i0 = index(lo[a], a).max(0.0) as usize;
+        let i1 = (index(hi[a], a) + 1.0).clamp(0.0, size[a] as f64) as usize;
+        i0..i1
+    };
+    let mut removed = 0.0;
+    for j in range(1) {
+        for i in range(0) {
+            let k = j * size[0] + i;
+            let [x, y] = [
+                origin[0] + ((k % size[0]) as f64 + 0.5) * cell,
+                origin[1] + ((k / size[0]) as f64 + 0.5) * cell,
+            ];
+            let (dx, dy) = (x - cut.origin[0], y - cut.origin[1]);
+            let along = dx * c + dy * s - cut.toe_s_m;
+            let across = -dx * s + dy * c;
+            // The share of the cell's width the strip covers (the cell
+            // taken square to the strip): a cell half inside gives up
+            // half of what lies above the path, so the volume taken is
+            // the strip's, not the cells' whose centres it holds.
+            let share =
+                ((cut.half_width_m - (across.abs() - 0.5 * cell)).min(cell) / cell).clamp(0.0, 1.0);
+            if share == 0.0 {
+                continue;
+            }
+            if let Some(floor) = cut.floor_at(along) {
+                let floor = floor.max(0.0);
+                if z[k] > floor {
+                    let taken = share * (z[k] - floor);
+                    removed += taken;
+                    z[k] -= taken;
+                }
+            }
+        }
+    }
+    removed * cell * cell
 }
 
 #[cfg(test)]
