@@ -579,13 +579,14 @@ mod tests {
         errors.sort_by(f64::total_cmp);
         let median = errors[errors.len() / 2];
         assert!(median < 0.1, "median error {median} m");
-        // The toe straight ahead is where the pit's is (x = 30), a little
-        // further in: perception takes the ground band (0.2 m) away with the
-        // floor, and the model's cells are 0.5 m.
+        // The toe straight ahead is where the pit's is (x = 30, 6 m from
+        // the axis) within a metre: the first 3 % rise on cells of 0.5 m,
+        // whose foot cells hold the mean of the returns there, then the
+        // face's slope followed down to the floor.
         let (options, _) = dig_options(&model, pose, &[0.0], 3.6, 15.0, 120.0);
         assert_eq!(options.len(), 1);
         let toe = options[0].toe_s_m;
-        assert!((6.0..7.0).contains(&toe), "{toe}");
+        assert!((toe - 6.0).abs() < 1.0, "{toe}");
     }
 
     #[test]
