@@ -465,7 +465,7 @@ fn animation_html(run: &ShiftRun) -> String {
 <canvas id="c" width="{w}" height="{h}"></canvas><br>
 <input type="range" id="bar" min="0" max="{last}" value="0"> <button id="play">play</button> <span id="when"></span>
 <script>
-const F={frames};const NX={nx},NY={ny},S=Math.max(1,Math.floor(640/NX));
+const F={frames};const NX={nx},NY={ny},S=Math.max(1,Math.floor(Math.min(900/NX,640/NY)));
 const c=document.getElementById('c');c.width=NX*S;c.height=NY*S;const g=c.getContext('2d');
 const bar=document.getElementById('bar'),when=document.getElementById('when');
 function col(v){{const t=v/255;return [Math.round(68+t*185),Math.round(1+t*230),Math.round(84+t*(36-84+255*0.0))];}}
