@@ -478,6 +478,74 @@ pub fn shift(
     .with_context(|| format!("shift {}", scenario.name))?;
     bar.finish_and_clear();
     Job::finish(run.summary.clone(), out, |dir, written| {
-        Ok(figures::shift::write(dir, &run, written)?)
+        figures::shift::write(dir, &run, written)?;
+        let log = shift_log(&dir.join("shift.mcap"), &run)?;
+        written.file(dir, &log);
+        Ok(())
     })
+}
+
+/// The shift as an MCAP run log (the machine link's format and topics,
+/// docs/link.md; Foxglove replays it): the machine's true pose at each
+/// pass and along every walk, every event, every pass's record, the
+/// summary at the end. Times are the shift's.
+fn shift_log(
+    path: &std::path::Path,
+    run: &autoshovel_shift::ShiftRun,
+) -> Result<std::path::PathBuf> {
+    use autoshovel_link::log::{topic, EventMsg, PoseMsg};
+    let mut log = autoshovel_link::RunLog::create(
+        path,
+        &[
+            ("job", "shift".to_string()),
+            ("scenario", run.summary.scenario.clone()),
+        ],
+        true,
+    )?;
+    // Messages in time order, as MCAP readers expect them.
+    enum Msg<'a> {
+        Pose(PoseMsg),
+        Event(&'a autoshovel_shift::Event),
+        Pass(&'a autoshovel_shift::PassRecord),
+    }
+    let mut msgs: Vec<(f64, Msg)> = Vec::new();
+    for p in &run.passes {
+        let s = &run.stands[p.stand - 1];
+        let pose = autoshovel_core::Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians());
+        msgs.push((p.t_start_s, Msg::Pose(pose.into())));
+        msgs.push((p.t_start_s, Msg::Pass(p)));
+    }
+    for w in &run.walks {
+        for (&[t, theta], q) in w.driven_at.iter().zip(&w.driven) {
+            msgs.push((
+                t,
+                Msg::Pose(PoseMsg {
+                    x: q[0],
+                    y: q[1],
+                    theta,
+                }),
+            ));
+        }
+    }
+    msgs.extend(run.events.iter().map(|e| (e.t_s, Msg::Event(e))));
+    msgs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (t, msg) in msgs {
+        match msg {
+            Msg::Pose(pose) => log.write(topic::TRUTH, t, &pose)?,
+            Msg::Pass(p) => log.write("/shift/pass", t, p)?,
+            Msg::Event(e) => log.write(
+                topic::EVENT,
+                t,
+                &EventMsg {
+                    t_s: e.t_s,
+                    source: "shift".into(),
+                    kind: e.kind.into(),
+                    message: e.message.clone(),
+                },
+            )?,
+        }
+    }
+    let end = run.summary.hours * 3600.0;
+    log.write(topic::SUMMARY, end, &run.summary)?;
+    Ok(log.finish()?)
 }

@@ -55,6 +55,26 @@ fn a_short_shift_writes_its_tables_maps_and_animation_and_balances() {
     }
     let page = std::fs::read_to_string(out.join("animation.html")).unwrap();
     assert!(page.contains("<canvas") && page.contains("type=\"range\""));
+    // The MCAP log reads back: a message per pass and per event, in time
+    // order, the summary last.
+    let bytes = std::fs::read(out.join("shift.mcap")).unwrap();
+    let mut topics = std::collections::BTreeMap::<String, usize>::new();
+    let mut last = 0;
+    for m in mcap::MessageStream::new(&bytes).unwrap() {
+        let m = m.unwrap();
+        assert!(m.log_time >= last, "out of order");
+        last = m.log_time;
+        *topics.entry(m.channel.topic.clone()).or_default() += 1;
+    }
+    let events = std::fs::read_to_string(out.join("events.csv"))
+        .unwrap()
+        .lines()
+        .count()
+        - 1;
+    assert_eq!(topics["/shift/pass"], 4, "{topics:?}");
+    assert_eq!(topics["/autoshovel/event"], events, "{topics:?}");
+    assert_eq!(topics["/autoshovel/summary"], 1);
+    assert!(topics["/sim/truth"] >= 4);
 }
 
 #[test]

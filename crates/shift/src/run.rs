@@ -175,6 +175,9 @@ pub struct WalkRecord {
     /// The path driven (x, y), true [m].
     #[serde(skip)]
     pub driven: Vec<[f64; 2]>,
+    /// The shift's time [s] and the true heading [rad] at each point of `driven`.
+    #[serde(skip)]
+    pub driven_at: Vec<[f64; 2]>,
 }
 
 /// One stand.
@@ -883,6 +886,13 @@ pub fn run_shift(
                         .step_by(10)
                         .map(|s| [s.truth.x, s.truth.y])
                         .collect(),
+                    driven_at: d
+                        .run
+                        .samples
+                        .iter()
+                        .step_by(10)
+                        .map(|s| [t - d.time_s + s.t_s, s.truth.theta])
+                        .collect(),
                 });
                 pose = d.end;
                 pose_seen = d.run.samples.last().map_or(pose, |s| s.measured);
@@ -988,6 +998,12 @@ pub fn run_shift(
                         .iter()
                         .step_by(10)
                         .map(|s| [s.truth.x, s.truth.y])
+                        .collect(),
+                    driven_at: run
+                        .samples
+                        .iter()
+                        .step_by(10)
+                        .map(|s| [t + s.t_s, s.truth.theta])
                         .collect(),
                 });
                 t += time_s;
