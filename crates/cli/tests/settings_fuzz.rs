@@ -1,6 +1,7 @@
 //! Issue 11: property "fuzzers" for every settings file the program reads —
 //! plan-path and track scenarios, excavator scenarios and machine profiles,
-//! rope-shovel profiles, perception settings and warm-start packs. Each case
+//! rope-shovel profiles, perception settings, warm-start packs and shift
+//! scenarios. Each case
 //! starts from a built-in file, puts hostile values in one to three of its
 //! settings (zero, negatives, 1e308, NaN, infinities, huge integers, wrong
 //! types, extra coordinates), drops lines or cuts the text, then reads it
@@ -242,6 +243,22 @@ proptest! {
             if let Ok(ex) = excavate(&s, &p) {
                 // The simulator's stated ceiling holds.
                 assert!(ex.samples.len() as f64 <= autoshovel_excavate::scenario::MAX_SIM_STEPS + 1.0);
+            }
+            Ok(())
+        });
+    }
+
+    #[test]
+    fn shift_scenarios(e in edits()) {
+        use autoshovel_shift::{run_shift, ShiftOptions, ShiftScenario};
+        let text = damage(autoshovel_shift::scenario::BENCH_TOML, &e);
+        holds("shift scenario", &text, || {
+            let s = ShiftScenario::from_toml(&text, "s.toml").map_err(|e| e.to_string())?;
+            let options = ShiftOptions { cycles: Some(1), ..ShiftOptions::default() };
+            if let Ok(run) = run_shift(&s, &autoshovel_dig::MachineProfile::scale_model(), &options, &mut |_| {}) {
+                // One pass at most, and the pit's loss is what the trucks got.
+                assert!(run.summary.passes <= 1);
+                assert!(run.summary.mass_balance.closes, "{:?}", run.summary.mass_balance);
             }
             Ok(())
         });

@@ -61,6 +61,10 @@ pub struct SearchPath {
     pub expanded: usize,
 }
 
+/// Most points of a forward-search grid (four arrays of them: about
+/// 150 MB).
+pub const MAX_GRID_POINTS: usize = 8_000_000;
+
 /// Why no way round was found.
 #[derive(Debug, Clone, PartialEq)]
 pub struct SearchFailure {
@@ -125,6 +129,22 @@ pub fn forward_search(
     let hi_x = ((c.x + reach).max(back_off.x + 2.0 * s) - back_off.x) / s;
     let lo_y = ((c.y - reach).min(back_off.y - 2.0 * s) - back_off.y) / s;
     let hi_y = ((c.y + reach).max(back_off.y + 2.0 * s) - back_off.y) / s;
+    // A grid past MAX_GRID_POINTS (a rock estimated far larger than the
+    // step, or a step far finer than the rock) is refused before it is
+    // allocated: four arrays of that many points would not fit.
+    let span = (hi_x - lo_x + 1.0) * (hi_y - lo_y + 1.0);
+    if !(span.is_finite() && span <= MAX_GRID_POINTS as f64) {
+        return Err(SearchFailure {
+            why: format!(
+                "the search grid round the rock (radius {:.3} m + window {:.3} m at steps of {:.4} m) would have {} points, more than {}",
+                met.radius_m,
+                params.window_m,
+                s,
+                autoshovel_core::config::approx(span),
+                autoshovel_core::config::approx(MAX_GRID_POINTS as f64)
+            ),
+        });
+    }
     let (i0, i1) = (lo_x.floor() as i64, hi_x.ceil() as i64);
     let (j0, j1) = (lo_y.floor() as i64, hi_y.ceil() as i64);
     let nx = (i1 - i0 + 1) as usize;
@@ -274,4 +294,42 @@ pub fn forward_search(
         ),
     };
     Err(SearchFailure { why })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::profile::MachineProfile;
+
+    #[test]
+    fn a_grid_too_large_to_allocate_is_refused_by_name() {
+        // The paper's contact with the rock estimated a thousand times too
+        // large (a fuzzed profile made one): 10¹¹ points at 5 cm.
+        let m = Backhoe::new(&MachineProfile::default());
+        let rock = Envelope::new(Vec2::new(6.64, -0.60), 2.5e3);
+        let contact = Vec2::new(6.6812, -0.3534);
+        let normal = Vec2::new(0.0, 1.0);
+        let params = SearchParams {
+            step_m: 0.05,
+            clearance_m: 0.1,
+            window_m: 1.0,
+        };
+        let e = forward_search(
+            &m,
+            -1.73,
+            contact,
+            normal,
+            &rock,
+            AvoidSide::Over,
+            &[rock],
+            6.24,
+            &params,
+        )
+        .unwrap_err();
+        assert!(
+            e.why.contains("search grid") && e.why.contains("points"),
+            "{}",
+            e.why
+        );
+    }
 }

@@ -22,6 +22,7 @@
 
 pub mod cycle;
 mod error;
+pub mod grid;
 pub mod machine;
 pub mod run;
 pub mod scenario;

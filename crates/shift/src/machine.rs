@@ -10,6 +10,8 @@ use autoshovel_core::{Pose2, Vec2};
 use autoshovel_dig::DigSurface;
 use autoshovel_propel::{Map, Obstacle, Shape};
 
+use crate::grid::Layout;
+
 /// Perception as the machine runs it on every scan: the rope-shovel
 /// paper's pipeline with its defaults, except that the polynomial surface
 /// ([RS eq. 21]) need not pass its R² bar — the machine's pile model is the
@@ -60,29 +62,32 @@ pub struct PileModel {
 impl PileModel {
     /// An empty model over the site `min`–`max`.
     pub fn new(min: [f64; 2], max: [f64; 2], cell_m: f64) -> Self {
-        let size = [0, 1].map(|a| ((max[a] - min[a]) / cell_m).ceil().max(1.0) as usize);
+        let layout = Layout::over(min, max, cell_m);
         Self {
             origin: min,
             cell_m,
-            size,
-            z: vec![f64::NAN; size[0] * size[1]],
+            size: layout.size,
+            z: vec![f64::NAN; layout.len()],
         }
     }
 
     /// The cell of (x, y), if inside.
     pub fn cell_of(&self, x: f64, y: f64) -> Option<usize> {
-        let i = ((x - self.origin[0]) / self.cell_m).floor();
-        let j = ((y - self.origin[1]) / self.cell_m).floor();
-        (i >= 0.0 && j >= 0.0 && (i as usize) < self.size[0] && (j as usize) < self.size[1])
-            .then(|| j as usize * self.size[0] + i as usize)
+        self.layout().cell_of(x, y)
     }
 
     /// The centre of cell `k`.
     pub fn centre(&self, k: usize) -> [f64; 2] {
-        [
-            self.origin[0] + ((k % self.size[0]) as f64 + 0.5) * self.cell_m,
-            self.origin[1] + ((k / self.size[0]) as f64 + 0.5) * self.cell_m,
-        ]
+        self.layout().centre(k)
+    }
+
+    /// The grid's layout.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            origin: self.origin,
+            cell_m: self.cell_m,
+            size: self.size,
+        }
     }
 
     /// Folds in one scan: `seen` is the whole scan levelled, `cleaned` what
@@ -162,7 +167,7 @@ impl PileModel {
     /// it planned from), as the dipper lowered the pit: until the next
     /// scan sees the result, the machine expects what it planned.
     pub fn dug(&mut self, cut: &crate::world::Cut) {
-        crate::world::cut_grid(self.origin, self.cell_m, self.size, &mut self.z, cut);
+        self.layout().cut(&mut self.z, cut);
     }
 
     /// The model's height at (x, y): its cell's, 0 outside the site, NaN
@@ -173,7 +178,7 @@ impl PileModel {
 
     /// What the model holds above the floor [m³] (unseen cells count nothing).
     pub fn volume_m3(&self) -> f64 {
-        self.z.iter().filter(|z| z.is_finite()).sum::<f64>() * self.cell_m * self.cell_m
+        self.layout().volume_m3(&self.z)
     }
 
     /// The width-averaged profile along the line from `origin` at
@@ -190,7 +195,8 @@ impl PileModel {
     ) -> DigSurface {
         let (c, s) = (heading.cos(), heading.sin());
         let step = 0.5 * self.cell_m;
-        let n = (length_m / step) as usize + 1;
+        // At least two samples (a cell as long as the profile).
+        let n = ((length_m / step) as usize + 1).max(2);
         // Along the line, each of five lines across the width, holding the
         // last seen height over unseen cells.
         let across = [-0.4, -0.2, 0.0, 0.2, 0.4].map(|f| f * width_m);

@@ -370,6 +370,8 @@ pub struct ShiftRun {
 const ARRIVED_M: f64 = 1.5;
 /// Passes at one stand at most (a guard: the planner ends a stand long before).
 const MAX_PASSES_PER_STAND: usize = 200;
+/// Stands in a row without a pass after which the shift ends.
+const MAX_BARREN_STANDS: usize = 12;
 /// Cell of an animation frame [m].
 const FRAME_CELL_M: f64 = 1.0;
 
@@ -815,6 +817,17 @@ pub fn run_shift(
                     "no stand with material within reach remains in the perceived pit ({})",
                     refused.join("; ")
                 ),
+            );
+            break 'shift;
+        }
+        let barren = stands.iter().rev().take_while(|s| s.passes == 0).count();
+        if barren >= MAX_BARREN_STANDS {
+            note(
+                &mut events,
+                t,
+                "no-stand",
+                stand_no,
+                format!("{barren} stands in a row without a feasible dig: the pile as scanned cannot be dug by this machine"),
             );
             break 'shift;
         }

@@ -10,6 +10,13 @@ use autoshovel_surface::PileShape;
 
 use crate::error::{Result, ShiftError};
 
+/// Most cells of the pit's height grid (two grids of 80 MB: the pit and
+/// the machine's model; a 1.5 km square pit at 0.5 m).
+pub const MAX_CELLS: f64 = 1e7;
+
+/// Highest pile, heap or vehicle [m].
+pub const MAX_HEIGHT_M: f64 = 1000.0;
+
 /// The built-in scenario's text.
 pub const BENCH_TOML: &str = include_str!("../scenarios/bench.toml");
 
@@ -58,6 +65,24 @@ pub struct HeapSpec {
     pub center_m: [f64; 2],
     /// Radius at the floor [m].
     pub radius_m: f64,
+    /// Height [m].
+    pub height_m: f64,
+}
+
+/// A parked vehicle (a haul truck waiting, a water truck, a dozer): a box
+/// on the floor, in the pit's height grid, so scans see it and walks go
+/// round it.
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct ParkedSpec {
+    /// Centre (x, y) [m].
+    #[serde(deserialize_with = "config::xy")]
+    pub center_m: [f64; 2],
+    /// Length and width [m].
+    #[serde(deserialize_with = "config::xy")]
+    pub size_m: [f64; 2],
+    /// Heading of its length [deg from +x].
+    pub heading_deg: f64,
     /// Height [m].
     pub height_m: f64,
 }
@@ -142,6 +167,9 @@ pub struct ShiftScenario {
     /// Stockpiles on the floor.
     #[serde(default)]
     pub stockpile: Vec<HeapSpec>,
+    /// Parked vehicles.
+    #[serde(default)]
+    pub parked: Vec<ParkedSpec>,
     /// The machine.
     pub machine: MachineSpec,
     /// The trucks.
@@ -235,12 +263,24 @@ impl TomlFile for ShiftScenario {
             }
         }
         let cells = ((w.max_m[0] - w.min_m[0]) / w.cell_m) * ((w.max_m[1] - w.min_m[1]) / w.cell_m);
-        if cells > 4e7 {
+        if cells > MAX_CELLS {
             return Err(bad(
                 "world",
                 "cell_m",
                 config::short(w.cell_m),
-                "a cell coarse enough for at most 40 million cells",
+                &format!(
+                    "a cell coarse enough for at most {} cells over the world ({} asked)",
+                    config::approx(MAX_CELLS),
+                    config::approx(cells)
+                ),
+            ));
+        }
+        if p.face_height_m > MAX_HEIGHT_M {
+            return Err(bad(
+                "pile",
+                "face_height_m",
+                config::short(p.face_height_m),
+                "at most 1000 m",
             ));
         }
         if p.repose_deg >= 80.0 {
@@ -284,6 +324,7 @@ impl TomlFile for ShiftScenario {
                     && h.radius_m > 0.0
                     && h.height_m.is_finite()
                     && h.height_m > 0.0
+                    && h.height_m <= MAX_HEIGHT_M
                     && inside(h.center_m[0], h.center_m[1]);
                 if !ok {
                     return Err(ShiftError::from(invalid(
@@ -292,9 +333,27 @@ impl TomlFile for ShiftScenario {
                         (table, i),
                         "radius_m",
                         format!("{:?} / {:?}", h.radius_m, h.height_m),
-                        "a heap inside the world with radius and height > 0",
+                        "a heap inside the world with radius > 0 and height in (0, 1000] m",
                     )));
                 }
+            }
+        }
+        for (i, v) in self.parked.iter().enumerate() {
+            let ok = v.size_m.iter().all(|d| d.is_finite() && *d > 0.0)
+                && v.height_m.is_finite()
+                && v.height_m > 0.0
+                && v.height_m <= MAX_HEIGHT_M
+                && v.heading_deg.is_finite()
+                && inside(v.center_m[0], v.center_m[1]);
+            if !ok {
+                return Err(ShiftError::from(invalid(
+                    text,
+                    file,
+                    ("parked", i),
+                    "size_m",
+                    format!("{:?}, height {:?}", v.size_m, v.height_m),
+                    "a box inside the world with length and width > 0 and height in (0, 1000] m",
+                )));
             }
         }
         if s.scan_points < 1000 || s.scan_points > 2_000_000 {

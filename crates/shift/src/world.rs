@@ -1,5 +1,5 @@
 //! The simulator's truth: the pit as a 2.5-D height grid (the floor at
-//! z = 0, the muck pile, boulders, stockpiles), the LiDAR that scans it
+//! z = 0, the muck pile, boulders, stockpiles, parked vehicles), the LiDAR that scans it
 //! from the machine, and the dipper that cuts it. Nothing here is read by
 //! the machine's side of the run ([`crate::machine`]) except through a
 //! scan.
@@ -13,6 +13,7 @@ use autoshovel_cloud::PointCloud;
 use autoshovel_core::Pose2;
 use autoshovel_surface::sensor_from_level;
 
+use crate::grid::Layout;
 use crate::scenario::{HeapSpec, ShiftScenario};
 
 /// The pit: heights above the floor at cell centres, x fastest.
@@ -112,16 +113,17 @@ impl Cut {
 }
 
 impl World {
-    /// The pit of `scenario`: floor, pile, boulders and stockpiles.
+    /// The pit of `scenario`: floor, pile, boulders, stockpiles and parked vehicles.
     pub fn new(scenario: &ShiftScenario) -> Self {
         let w = &scenario.world;
         let cell = w.cell_m;
-        let size = [0, 1].map(|a| ((w.max_m[a] - w.min_m[a]) / cell).ceil() as usize);
+        let layout = Layout::over(w.min_m, w.max_m, cell);
+        let size = layout.size;
         let mut world = Self {
             origin: w.min_m,
             cell_m: cell,
             size,
-            z: vec![0.0; size[0] * size[1]],
+            z: vec![0.0; layout.len()],
         };
         let pile = &scenario.pile;
         let tan = pile.repose_deg.to_radians().tan();
@@ -162,6 +164,18 @@ impl World {
                     h = h.max(top);
                 }
             }
+            for v in &scenario.parked {
+                let (c, sn) = (
+                    v.heading_deg.to_radians().cos(),
+                    v.heading_deg.to_radians().sin(),
+                );
+                let (dx, dy) = (x - v.center_m[0], y - v.center_m[1]);
+                if (dx * c + dy * sn).abs() <= 0.5 * v.size_m[0]
+                    && (-dx * sn + dy * c).abs() <= 0.5 * v.size_m[1]
+                {
+                    h = h.max(v.height_m);
+                }
+            }
             *z = h;
         });
         world
@@ -191,15 +205,12 @@ impl World {
 
     /// The centre (x, y) of cell `i`.
     pub fn centre(&self, i: usize) -> [f64; 2] {
-        [
-            self.origin[0] + ((i % self.size[0]) as f64 + 0.5) * self.cell_m,
-            self.origin[1] + ((i / self.size[0]) as f64 + 0.5) * self.cell_m,
-        ]
+        self.layout().centre(i)
     }
 
     /// Everything above the floor [m³] (each cell a prism).
     pub fn volume_m3(&self) -> f64 {
-        self.z.iter().sum::<f64>() * self.cell_m * self.cell_m
+        self.layout().volume_m3(&self.z)
     }
 
     /// Whether a disc of `radius` about (x, y) lies on bare floor (nothing
@@ -238,7 +249,16 @@ impl World {
     /// cell the swept strip covers is lowered to the path, one it covers in
     /// part by that share of its height above the path.
     pub fn cut(&mut self, cut: &Cut) -> f64 {
-        cut_grid(self.origin, self.cell_m, self.size, &mut self.z, cut)
+        self.layout().cut(&mut self.z, cut)
+    }
+
+    /// The grid's layout.
+    pub fn layout(&self) -> Layout {
+        Layout {
+            origin: self.origin,
+            cell_m: self.cell_m,
+            size: self.size,
+        }
     }
 
     /// A scan from the LiDAR on the machine at `pose` (the swing axis on
@@ -332,70 +352,6 @@ impl World {
     }
 }
 
-/// [`World::cut`] on any height grid laid out as the world's (origin,
-/// cell edge, cells along x and y, heights x fastest); a NaN cell (never
-/// seen, in the machine's model) is left as it is.
-pub fn cut_grid(origin: [f64; 2], cell: f64, size: [usize; 2], z: &mut [f64], cut: &Cut) -> f64 {
-    let xs = cut.path.iter().map(|p| p[0]);
-    let (x_lo, x_hi) = xs.fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), x| {
-        (a.min(x), b.max(x))
-    });
-    if !(x_lo.is_finite() && x_hi > x_lo) {
-        return 0.0;
-    }
-    let (c, s) = (cut.heading.cos(), cut.heading.sin());
-    let corners = [
-        cut.world(x_lo, -cut.half_width_m),
-        cut.world(x_lo, cut.half_width_m),
-        cut.world(x_hi, -cut.half_width_m),
-        cut.world(x_hi, cut.half_width_m),
-    ];
-    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
-    for p in corners {
-        for a in 0..2 {
-            lo[a] = lo[a].min(p[a]);
-            hi[a] = hi[a].max(p[a]);
-        }
-    }
-    let index = |v: f64, a: usize| ((v - origin[a]) / cell).floor();
-    let range = |a: usize| {
-        let i0 = index(lo[a], a).max(0.0) as usize;
-        let i1 = (index(hi[a], a) + 1.0).clamp(0.0, size[a] as f64) as usize;
-        i0..i1
-    };
-    let mut removed = 0.0;
-    for j in range(1) {
-        for i in range(0) {
-            let k = j * size[0] + i;
-            let [x, y] = [
-                origin[0] + ((k % size[0]) as f64 + 0.5) * cell,
-                origin[1] + ((k / size[0]) as f64 + 0.5) * cell,
-            ];
-            let (dx, dy) = (x - cut.origin[0], y - cut.origin[1]);
-            let along = dx * c + dy * s - cut.toe_s_m;
-            let across = -dx * s + dy * c;
-            // The share of the cell's width the strip covers (the cell
-            // taken square to the strip): a cell half inside gives up
-            // half of what lies above the path, so the volume taken is
-            // the strip's, not the cells' whose centres it holds.
-            let share =
-                ((cut.half_width_m - (across.abs() - 0.5 * cell)).min(cell) / cell).clamp(0.0, 1.0);
-            if share == 0.0 {
-                continue;
-            }
-            if let Some(floor) = cut.floor_at(along) {
-                let floor = floor.max(0.0);
-                if z[k] > floor {
-                    let taken = share * (z[k] - floor);
-                    removed += taken;
-                    z[k] -= taken;
-                }
-            }
-        }
-    }
-    removed * cell * cell
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -409,6 +365,7 @@ mod tests {
         // 40 m only, where the section is the same everywhere.
         let mut s = ShiftScenario::bench();
         s.boulder.clear();
+        s.parked.clear();
         s.stockpile.clear();
         let world = World::new(&s);
         let p = &s.pile;
@@ -440,6 +397,7 @@ mod tests {
     fn a_cut_removes_what_lies_above_the_path_and_nothing_else() {
         let mut s = ShiftScenario::bench();
         s.boulder.clear();
+        s.parked.clear();
         s.stockpile.clear();
         let mut world = World::new(&s);
         let before = world.clone();
@@ -478,6 +436,33 @@ mod tests {
                 * 3.6
         };
         assert_relative_eq!(removed, expected, max_relative = 0.01);
+    }
+
+    #[test]
+    fn a_parked_truck_stands_as_a_box() {
+        let s = ShiftScenario::bench();
+        let world = World::new(&s);
+        let v = &s.parked[0];
+        let c = world.cell_m;
+        let (inside, outside) = world
+            .z
+            .iter()
+            .enumerate()
+            .filter(|&(k, _)| {
+                let [x, y] = world.centre(k);
+                (x - v.center_m[0]).abs() < 10.0 && (y - v.center_m[1]).abs() < 10.0
+            })
+            .partition::<Vec<_>, _>(|&(_, &z)| z == v.height_m);
+        // Heading 90°: its length along y. The cells at its height cover its
+        // footprint to a cell's rounding; none around it is raised.
+        let area = inside.len() as f64 * c * c;
+        assert!(
+            (area - v.size_m[0] * v.size_m[1]).abs() < (v.size_m[0] + v.size_m[1]) * c,
+            "{area}"
+        );
+        assert!(outside.iter().all(|&(_, &z)| z == 0.0));
+        assert_eq!(world.height(v.center_m[0], v.center_m[1] + 4.0), v.height_m);
+        assert_eq!(world.height(v.center_m[0] + 4.0, v.center_m[1]), 0.0);
     }
 
     #[test]

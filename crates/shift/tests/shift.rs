@@ -97,6 +97,7 @@ fn a_pile_out_of_reach_ends_the_shift_with_a_named_event() {
     let mut bare = ShiftScenario::bench();
     bare.pile.face_height_m = 0.1;
     bare.boulder.clear();
+    bare.parked.clear();
     bare.stockpile.clear();
     let run = shift(&bare, 2);
     assert_eq!(run.summary.passes, 0);
