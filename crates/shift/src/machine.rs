@@ -23,6 +23,9 @@ pub fn perception() -> autoshovel_surface::perceive::PerceptionParams {
     p
 }
 
+/// Returns a cell needs before a scan without perception sets its height.
+pub const RAW_RETURNS: usize = 3;
+
 /// Height above which a cell of the model is an obstacle to walking [m].
 pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
 
@@ -158,6 +161,43 @@ impl PileModel {
                 self.z[k] = (low_sum[k] / f64::from(low_count[k])).max(0.0);
                 updated += 1;
             }
+        }
+        updated
+    }
+
+    /// Folds in a scan of ground without a face (the machine looking round
+    /// before it walks): no perception to keep or set points aside, so each
+    /// cell with at least [`RAW_RETURNS`] returns takes their median height
+    /// (dust, a few returns in the air, does not move a median of many
+    /// floor returns, and a cell that only dust reached is left as it
+    /// was); cells within `own_m` of the machine are its own body and
+    /// left out. `seen` is levelled with the mounting's tilt perception
+    /// found on the face, the floor at `floor_z`.
+    pub fn update_raw(
+        &mut self,
+        seen: &PointCloud,
+        floor_z: f64,
+        pose: Pose2,
+        own_m: f64,
+    ) -> usize {
+        let (c, s) = (pose.theta.cos(), pose.theta.sin());
+        let mut raw: Vec<Vec<f32>> = vec![Vec::new(); self.z.len()];
+        for p in &seen.points {
+            let (x, y) = (f64::from(p[0]), f64::from(p[1]));
+            if let Some(k) = self.cell_of(pose.x + x * c - y * s, pose.y + x * s + y * c) {
+                raw[k].push((f64::from(p[2]) - floor_z) as f32);
+            }
+        }
+        let mut updated = 0;
+        for (k, v) in raw.iter_mut().enumerate() {
+            let [x, y] = self.centre(k);
+            if v.len() < RAW_RETURNS || (x - pose.x).hypot(y - pose.y) < own_m {
+                continue;
+            }
+            let mid = v.len() / 2;
+            v.select_nth_unstable_by(mid, f32::total_cmp);
+            self.z[k] = f64::from(v[mid]).max(0.0);
+            updated += 1;
         }
         updated
     }
