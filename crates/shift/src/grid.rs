@@ -2,9 +2,7 @@
 //! ([`crate::World`]) and the machine's model of it
 //! ([`crate::machine::PileModel`]): square cells from a corner, x fastest
 //! — and what is done the same way on either: finding a cell, its centre,
-//! the volume held, and the dipper's cut.
-
-use crate::world::Cut;
+//! the volume held, and the dipper's cut ([`Cut`]).
 
 /// Square cells of `cell_m` from `origin`, `size` along x and y, numbered x fastest.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -121,5 +119,54 @@ impl Layout {
             }
         }
         removed * cell * cell
+    }
+}
+
+/// A straight cut: the dipper's tooth path in the vertical plane through
+/// `origin` along `heading`, its dig frame's x measured from `toe_s_m`
+/// along the line, y up from the floor; `half_width_m` each side.
+#[derive(Debug, Clone, PartialEq)]
+pub struct Cut {
+    /// A point of the dig line (the swing axis) [m].
+    pub origin: [f64; 2],
+    /// Direction of the line [rad from +x].
+    pub heading: f64,
+    /// Distance along the line to the dig frame's origin (the toe) [m].
+    pub toe_s_m: f64,
+    /// Half the dipper's width [m].
+    pub half_width_m: f64,
+    /// The tooth path in the dig frame (x along, y up) [m].
+    pub path: Vec<[f64; 2]>,
+}
+
+impl Cut {
+    /// The lowest point of the path over dig-frame `x` (the tooth's lower
+    /// envelope), or `None` where the path does not pass.
+    pub fn floor_at(&self, x: f64) -> Option<f64> {
+        let mut lowest: Option<f64> = None;
+        for w in self.path.windows(2) {
+            let ([x0, y0], [x1, y1]) = (w[0], w[1]);
+            let (lo, hi) = if x0 <= x1 { (x0, x1) } else { (x1, x0) };
+            if x < lo || x > hi {
+                continue;
+            }
+            let y = if hi > lo {
+                y0 + (y1 - y0) * (x - x0) / (x1 - x0)
+            } else {
+                y0.min(y1)
+            };
+            lowest = Some(lowest.map_or(y, |l: f64| l.min(y)));
+        }
+        lowest
+    }
+
+    /// World (x, y) of dig-frame x at lateral offset `w` (left positive).
+    pub fn world(&self, x: f64, w: f64) -> [f64; 2] {
+        let (c, s) = (self.heading.cos(), self.heading.sin());
+        let along = self.toe_s_m + x;
+        [
+            self.origin[0] + along * c - w * s,
+            self.origin[1] + along * s + w * c,
+        ]
     }
 }

@@ -24,12 +24,15 @@ pub mod cycle;
 mod error;
 pub mod grid;
 pub mod machine;
+pub mod record;
 pub mod run;
 pub mod scenario;
 pub mod world;
 
 pub use autoshovel_core::config::TomlFile;
 pub use error::{Result, ShiftError};
-pub use run::{run_shift, Event, PassRecord, ShiftOptions, ShiftRun, ShiftSummary, StandRecord};
+pub use grid::{Cut, Layout};
+pub use record::{Event, PassRecord, ShiftRun, ShiftSummary, StandRecord, WalkRecord};
+pub use run::{run_shift, ShiftOptions};
 pub use scenario::ShiftScenario;
-pub use world::{Cut, Lidar, World};
+pub use world::{Lidar, World};

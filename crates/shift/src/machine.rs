@@ -206,7 +206,7 @@ impl PileModel {
     /// belief of where it stood: its RTK pose, the swing angle and the toe
     /// it planned from), as the dipper lowered the pit: until the next
     /// scan sees the result, the machine expects what it planned.
-    pub fn dug(&mut self, cut: &crate::world::Cut) {
+    pub fn dug(&mut self, cut: &crate::grid::Cut) {
         self.layout().cut(&mut self.z, cut);
     }
 
