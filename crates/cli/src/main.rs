@@ -70,7 +70,7 @@ enum Command {
     StudyBoulders(study_boulders::Args),
     /// Tune every tracker with the same budget, then score them on runs none was tuned on.
     TuneTrackers(tune_trackers::Args),
-    /// Print a built-in scenario (of plan-path, track or plan-excavate) as TOML, to copy and edit.
+    /// Print a built-in scenario (of plan-path, track, plan-excavate or shift) as TOML, to copy and edit.
     Scenario {
         /// Built-in scenario name (an unknown one lists them all, by job).
         name: String,
@@ -120,22 +120,33 @@ impl From<PlannerArg> for autoshovel_propel::FieldKind {
 
 /// `autoshovel scenario NAME`: a built-in's TOML, whichever job it is for
 /// (plan-path's travel scenarios, which `track` also takes, then track's
-/// own, then plan-excavate's).
+/// own, then plan-excavate's, then shift's).
 fn print_scenario(name: &str) -> anyhow::Result<()> {
     let text = autoshovel_propel::scenario::builtin_text(name)
         .ok()
         .or_else(|| autoshovel_track::scenario::builtin_text(name))
-        .or_else(|| autoshovel_excavate::Scenario::builtin_toml(name));
+        .or_else(|| autoshovel_excavate::Scenario::builtin_toml(name))
+        .or_else(|| {
+            autoshovel_shift::scenario::BUILTINS
+                .iter()
+                .find(|(n, _)| *n == name)
+                .map(|(_, text)| *text)
+        });
     let Some(text) = text else {
         let own: Vec<&str> = autoshovel_track::scenario::BUILTIN_TOML
             .iter()
             .map(|(n, _)| *n)
             .collect();
         anyhow::bail!(
-            "unknown built-in scenario '{name}': plan-path and track have {}; track also {}; plan-excavate has {}",
+            "unknown built-in scenario '{name}': plan-path and track have {}; track also {}; plan-excavate has {}; shift has {}",
             autoshovel_propel::scenario::builtin_names().join(", "),
             own.join(", "),
-            autoshovel_excavate::Scenario::builtin_names().join(", ")
+            autoshovel_excavate::Scenario::builtin_names().join(", "),
+            autoshovel_shift::scenario::BUILTINS
+                .iter()
+                .map(|(n, _)| *n)
+                .collect::<Vec<_>>()
+                .join(", ")
         );
     };
     use std::io::Write as _;
