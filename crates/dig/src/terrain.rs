@@ -248,8 +248,9 @@ impl DigSurface {
         if u.is_nan() || u <= 0.0 {
             return self.heights[0];
         }
+        // (u may be +∞: `as` saturates, and the comparison cannot overflow)
         let i = u as usize;
-        if i + 1 >= self.heights.len() {
+        if i >= self.heights.len() - 1 {
             return *self.heights.last().expect("non-empty");
         }
         let f = u - i as f64;
@@ -358,6 +359,15 @@ mod tests {
             DigSurface::from_shape(PileShape::Convex, 0.12).height(0.2),
             DigSurface::from_pile(&fig7, 0.0, 0.12).height(0.2)
         );
+    }
+
+    #[test]
+    fn heights_are_held_past_the_ends_even_at_infinity() {
+        let s = DigSurface::from_fn(|x, _| x, 0.12, 0.0, 0.5, "ramp");
+        assert_eq!(s.height(f64::INFINITY), s.height(0.5));
+        assert_eq!(s.height(1e300), s.height(0.5));
+        assert_eq!(s.height(f64::NEG_INFINITY), s.height(0.0));
+        assert_eq!(s.height(f64::NAN), s.height(0.0));
     }
 
     #[test]

@@ -275,6 +275,14 @@ impl TomlFile for ShiftScenario {
                 ),
             ));
         }
+        if m.lambda > 1000.0 {
+            return Err(bad(
+                "machine",
+                "lambda",
+                config::short(m.lambda),
+                "at most 1000 (the 1:30 model at 30 is a full-size shovel)",
+            ));
+        }
         if p.face_height_m > MAX_HEIGHT_M {
             return Err(bad(
                 "pile",
