@@ -34,6 +34,9 @@ pub enum FiguresError {
     /// A point cloud could not be written (names the file).
     #[error(transparent)]
     Cloud(#[from] autoshovel_cloud::CloudError),
+    /// A run log (MCAP) could not be written (names the file).
+    #[error(transparent)]
+    Link(#[from] autoshovel_link::LinkError),
     /// A dig file (the warm-start pack) could not be written.
     #[error(transparent)]
     Dig(#[from] autoshovel_dig::DigError),

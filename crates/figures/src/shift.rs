@@ -11,7 +11,8 @@
 //! - `timeline`: tonnes against time with the walks and the safety
 //!   events, and each pass's stage times;
 //! - `animation.html`: the shift as a page with a time slider (one
-//!   snapshot of the pit every few minutes, the machine on it), self-contained.
+//!   snapshot of the pit every few minutes, the machine on it), self-contained;
+//! - `shift.mcap`: the run log in the machine link's format ([`run_log`]).
 
 use std::fmt::Write as _;
 use std::path::Path;
@@ -22,11 +23,13 @@ use autoshovel_report::{
 };
 use autoshovel_shift::{ShiftRun, World};
 
+use crate::FiguresError;
+
 /// Stands drawn one by one (the first this many less one, and the last).
 pub const STAND_MAPS: usize = 12;
 
 /// Writes the job's tables and plots of `run` into `dir`.
-pub fn write(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), ReportError> {
+pub fn write(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), FiguresError> {
     tables(dir, run, written)?;
     written.plot(
         dir,
@@ -66,6 +69,8 @@ pub fn write(dir: &Path, run: &ShiftRun, written: &mut Written) -> Result<(), Re
         source,
     })?;
     written.file(dir, &page);
+    let log = run_log(&dir.join("shift.mcap"), run)?;
+    written.file(dir, &log);
     Ok(())
 }
 
@@ -503,4 +508,69 @@ draw(0);
 fn base64(bytes: &[u8]) -> String {
     use base64::Engine as _;
     base64::engine::general_purpose::STANDARD.encode(bytes)
+}
+
+/// The shift as an MCAP run log (the machine link's format and topics,
+/// docs/link.md; Foxglove replays it): the machine's true pose at each
+/// pass and along every walk, every event, every pass's record, the
+/// summary at the end. Times are the shift's.
+pub fn run_log(
+    path: &Path,
+    run: &ShiftRun,
+) -> Result<std::path::PathBuf, autoshovel_link::LinkError> {
+    use autoshovel_link::log::{topic, EventMsg, PoseMsg};
+    let mut log = autoshovel_link::RunLog::create(
+        path,
+        &[
+            ("job", "shift".to_string()),
+            ("scenario", run.summary.scenario.clone()),
+        ],
+        true,
+    )?;
+    // Messages in time order, as MCAP readers expect them.
+    enum Msg<'a> {
+        Pose(PoseMsg),
+        Event(&'a autoshovel_shift::Event),
+        Pass(&'a autoshovel_shift::PassRecord),
+    }
+    let mut msgs: Vec<(f64, Msg)> = Vec::new();
+    for p in &run.passes {
+        let s = &run.stands[p.stand - 1];
+        let pose = autoshovel_core::Pose2::new(s.x_m, s.y_m, s.heading_deg.to_radians());
+        msgs.push((p.t_start_s, Msg::Pose(pose.into())));
+        msgs.push((p.t_start_s, Msg::Pass(p)));
+    }
+    for w in &run.walks {
+        for (&[t, theta], q) in w.driven_at.iter().zip(&w.driven) {
+            msgs.push((
+                t,
+                Msg::Pose(PoseMsg {
+                    x: q[0],
+                    y: q[1],
+                    theta,
+                }),
+            ));
+        }
+    }
+    msgs.extend(run.events.iter().map(|e| (e.t_s, Msg::Event(e))));
+    msgs.sort_by(|a, b| a.0.total_cmp(&b.0));
+    for (t, msg) in msgs {
+        match msg {
+            Msg::Pose(pose) => log.write(topic::TRUTH, t, &pose)?,
+            Msg::Pass(p) => log.write("/shift/pass", t, p)?,
+            Msg::Event(e) => log.write(
+                topic::EVENT,
+                t,
+                &EventMsg {
+                    t_s: e.t_s,
+                    source: "shift".into(),
+                    kind: e.kind.into(),
+                    message: e.message.clone(),
+                },
+            )?,
+        }
+    }
+    let end = run.summary.hours * 3600.0;
+    log.write(topic::SUMMARY, end, &run.summary)?;
+    log.finish()
 }
