@@ -11,6 +11,17 @@ pub struct PointCloud {
     pub points: Vec<Point>,
 }
 
+/// A cloud reads as its slice of points: the filters take `&[Point]`, so a
+/// cloud, a `Vec` or a borrowed buffer (a numpy array from Python) all go in
+/// without a copy.
+impl std::ops::Deref for PointCloud {
+    type Target = [Point];
+
+    fn deref(&self) -> &[Point] {
+        &self.points
+    }
+}
+
 impl PointCloud {
     /// A cloud of these points.
     pub fn new(points: Vec<Point>) -> Self {

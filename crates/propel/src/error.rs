@@ -125,6 +125,10 @@ pub enum PropelError {
         /// Its value.
         value: f64,
     },
+    /// A random-road study asked for out of range (see
+    /// [`crate::study::StudyParams::check`]).
+    #[error("study-paths: {0}")]
+    BadStudy(String),
     /// An unknown built-in scenario name that is not a file either.
     #[error("unknown scenario '{name}': not a built-in ({}) and no such file", known.join(", "))]
     UnknownScenario {

@@ -12,7 +12,7 @@
 use autoshovel_core::{angle_diff, heading_vec, perp, Pose2, Vec2};
 use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
-use serde::Serialize;
+use serde::{Deserialize, Serialize};
 
 use crate::apf::FieldKind;
 use crate::astar::REFERENCE_PLANNER;
@@ -49,6 +49,48 @@ impl Default for StudyParams {
             road_length_m: 60.0,
             heading_tolerance_deg: crate::outcome::DEFAULT_HEADING_TOLERANCE_DEG,
         }
+    }
+}
+
+/// Most maps one study may hold (a million maps take about two hours on
+/// two cores; a cluster spreads them by seed ranges, `autoshovel.cluster`).
+pub const MAX_STUDY_MAPS: usize = 1_000_000;
+
+/// Most obstacles a map may hold.
+pub const MAX_STUDY_OBSTACLES: usize = 60;
+
+impl StudyParams {
+    /// Checks the counts: 1 to [`MAX_STUDY_MAPS`] maps, and
+    /// `min_obstacles <= max_obstacles <=` [`MAX_STUDY_OBSTACLES`].
+    pub fn check(&self) -> crate::Result<()> {
+        if self.maps == 0 || self.maps > MAX_STUDY_MAPS {
+            return Err(crate::PropelError::BadStudy(format!(
+                "maps = {} must be between 1 and {MAX_STUDY_MAPS}",
+                self.maps
+            )));
+        }
+        if self.min_obstacles > self.max_obstacles || self.max_obstacles > MAX_STUDY_OBSTACLES {
+            return Err(crate::PropelError::BadStudy(format!(
+                "min_obstacles = {} and max_obstacles = {} must satisfy min <= max <= {MAX_STUDY_OBSTACLES}",
+                self.min_obstacles, self.max_obstacles
+            )));
+        }
+        if !(self.road_length_m.is_finite()
+            && self.road_length_m > 20.0
+            && self.road_length_m <= 10_000.0)
+        {
+            return Err(crate::PropelError::BadStudy(format!(
+                "road_length_m = {} must be above 20 m and at most 10 km",
+                self.road_length_m
+            )));
+        }
+        if !(self.heading_tolerance_deg.is_finite() && self.heading_tolerance_deg >= 0.0) {
+            return Err(crate::PropelError::BadStudy(format!(
+                "heading_tolerance_deg = {} must be a non-negative number",
+                self.heading_tolerance_deg
+            )));
+        }
+        Ok(())
     }
 }
 
@@ -140,7 +182,7 @@ pub fn random_road(params: &StudyParams, index: usize) -> Scenario {
 }
 
 /// One planner's result on one map.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Outcome {
     /// Reached the goal with a collision-free smoothed path.
     pub reached: bool,
@@ -149,21 +191,43 @@ pub struct Outcome {
     /// Failed in a local minimum.
     pub local_minimum: bool,
     /// Smoothed length [m] (NaN on failure).
+    #[serde(deserialize_with = "nan_if_null")]
     pub length_m: f64,
     /// Smallest footprint clearance [m] (NaN on failure).
+    #[serde(deserialize_with = "nan_if_null")]
     pub min_clearance_m: f64,
     /// Final heading error [deg] (NaN on failure).
+    #[serde(deserialize_with = "nan_if_null")]
     pub final_heading_error_deg: f64,
     /// Escapes used.
     pub escapes: usize,
     /// Planning time [ms].
+    #[serde(deserialize_with = "nan_if_null")]
     pub plan_time_ms: f64,
     /// The error, if any.
     pub error: Option<String>,
 }
 
-/// One map's row.
-#[derive(Debug, Clone, PartialEq, Serialize)]
+/// A number that JSON wrote as `null` because it was NaN (serde_json
+/// writes non-finite numbers so).
+fn nan_if_null<'de, D: serde::Deserializer<'de>>(d: D) -> std::result::Result<f64, D::Error> {
+    Ok(Option::<f64>::deserialize(d)?.unwrap_or(f64::NAN))
+}
+
+/// Rows as JSON text (exact: every finite number round-trips bit for bit,
+/// NaN as `null`).
+pub fn rows_to_json(rows: &[MapRow]) -> String {
+    serde_json::to_string(rows).expect("rows serialise")
+}
+
+/// Rows written by [`rows_to_json`].
+pub fn rows_from_json(text: &str) -> crate::Result<Vec<MapRow>> {
+    serde_json::from_str(text).map_err(|e| crate::PropelError::BadStudy(format!("rows: {e}")))
+}
+
+/// One map's row (read back by [`rows_from_json`]: a study's rows can be
+/// made in many places and summarised in one).
+#[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct MapRow {
     /// Map index.
     pub index: usize,

@@ -37,7 +37,7 @@
 //! Rotations are about the origin of the cloud (the sensor for a raw scan).
 //! Points are stored as f32 ([`PointCloud`]); the rotation runs in f64.
 
-use autoshovel_cloud::PointCloud;
+use autoshovel_cloud::{Point, PointCloud};
 use nalgebra::{Matrix3, Vector3};
 
 /// The matrix T of [RS eq. 11]: `level_from_sensor` for roll α and pitch β [rad].
@@ -60,7 +60,7 @@ pub fn sensor_from_level(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
 
 /// Eq. 12: the levelled cloud `p = T · p_s` for a sensor with roll α and
 /// pitch β [rad] (see the module docs for which way they turn).
-pub fn level(cloud: &PointCloud, roll_rad: f64, pitch_rad: f64) -> PointCloud {
+pub fn level(cloud: &[Point], roll_rad: f64, pitch_rad: f64) -> PointCloud {
     // [RS eq. 12]: p = T · p_s.
     rotate(cloud, &level_from_sensor(roll_rad, pitch_rad))
 }
@@ -68,7 +68,7 @@ pub fn level(cloud: &PointCloud, roll_rad: f64, pitch_rad: f64) -> PointCloud {
 /// The inverse of [`level`], `p_s = Tᵀ · p`: what a sensor with roll α and
 /// pitch β [rad] sees of a level scene. `tilt(level(c, α, β), α, β) == c` up
 /// to rounding, and so is `level(tilt(c, α, β), α, β)`.
-pub fn tilt(cloud: &PointCloud, roll_rad: f64, pitch_rad: f64) -> PointCloud {
+pub fn tilt(cloud: &[Point], roll_rad: f64, pitch_rad: f64) -> PointCloud {
     rotate(cloud, &sensor_from_level(roll_rad, pitch_rad))
 }
 
@@ -93,8 +93,8 @@ pub fn angles_from_normal(normal: [f64; 3]) -> Option<(f64, f64)> {
 }
 
 /// Apply a rotation to every point (f64 arithmetic, f32 storage).
-pub(crate) fn rotate(cloud: &PointCloud, r: &Matrix3<f64>) -> PointCloud {
-    let points = cloud.points.iter().map(|p| rotate_point(r, p)).collect();
+pub(crate) fn rotate(cloud: &[Point], r: &Matrix3<f64>) -> PointCloud {
+    let points = cloud.iter().map(|p| rotate_point(r, p)).collect();
     PointCloud { points }
 }
 

@@ -98,15 +98,12 @@ impl BilateralParams {
 /// let smoothed = filter::bilateral_normal_smoothing(&PointCloud::new(points), &params).unwrap();
 /// assert!(smoothed.points[60][2].abs() < 1e-6);
 /// ```
-pub fn bilateral_normal_smoothing(
-    cloud: &PointCloud,
-    params: &BilateralParams,
-) -> Result<PointCloud> {
+pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> Result<PointCloud> {
     params.validate()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
-    let mut points: Vec<Point> = cloud.points.iter().copied().filter(is_finite).collect();
+    let mut points: Vec<Point> = cloud.iter().copied().filter(is_finite).collect();
     if points.is_empty() {
         return Err(super::common::emptied(
             FILTER,

@@ -59,17 +59,15 @@ fn next_down(t: f32) -> f32 {
 /// the finite points of `cloud` only and maps the indices back: PCL's tools
 /// drop non-finite points before these filters, and so do we. Clouds built
 /// by this crate's readers are finite already, which costs one scan.
-pub(crate) fn on_finite_points<F>(cloud: &PointCloud, kept: F) -> Result<Vec<usize>>
+pub(crate) fn on_finite_points<F>(cloud: &[Point], kept: F) -> Result<Vec<usize>>
 where
     F: FnOnce(&[Point]) -> Result<Vec<usize>>,
 {
-    if cloud.points.iter().all(is_finite) {
-        return kept(&cloud.points);
+    if cloud.iter().all(is_finite) {
+        return kept(cloud);
     }
-    let index: Vec<usize> = (0..cloud.len())
-        .filter(|&i| is_finite(&cloud.points[i]))
-        .collect();
-    let finite: Vec<Point> = index.iter().map(|&i| cloud.points[i]).collect();
+    let index: Vec<usize> = (0..cloud.len()).filter(|&i| is_finite(&cloud[i])).collect();
+    let finite: Vec<Point> = index.iter().map(|&i| cloud[i]).collect();
     Ok(kept(&finite)?.into_iter().map(|i| index[i]).collect())
 }
 
@@ -87,8 +85,8 @@ pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f32 {
 }
 
 /// The points of `cloud` at `indices`, in that order.
-pub(crate) fn gather(cloud: &PointCloud, indices: &[usize]) -> PointCloud {
-    PointCloud::new(indices.iter().map(|&i| cloud.points[i]).collect())
+pub(crate) fn gather(cloud: &[Point], indices: &[usize]) -> PointCloud {
+    PointCloud::new(indices.iter().map(|&i| cloud[i]).collect())
 }
 
 #[cfg(test)]

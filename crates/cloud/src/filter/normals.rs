@@ -15,7 +15,7 @@
 
 use super::common::{bad, empty_input, f32_at_most};
 use super::kdtree::{KdTree, Nearest};
-use crate::{Point, PointCloud, Result};
+use crate::{Point, Result};
 
 const FILTER: &str = "normal estimation";
 
@@ -103,19 +103,16 @@ impl NormalParams {
 /// let s = 1.25_f64.sqrt();
 /// assert!((n[0] + 0.5 / s).abs() < 1e-6 && n[1].abs() < 1e-6 && (n[2] - 1.0 / s).abs() < 1e-6);
 /// ```
-pub fn estimate_normals(
-    cloud: &PointCloud,
-    params: &NormalParams,
-) -> Result<Vec<Option<[f64; 3]>>> {
+pub fn estimate_normals(cloud: &[Point], params: &NormalParams) -> Result<Vec<Option<[f64; 3]>>> {
     params.validate()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
     // Search among the finite points only.
     let finite: Vec<usize> = (0..cloud.len())
-        .filter(|&i| super::common::is_finite(&cloud.points[i]))
+        .filter(|&i| super::common::is_finite(&cloud[i]))
         .collect();
-    let points: Vec<Point> = finite.iter().map(|&i| cloud.points[i]).collect();
+    let points: Vec<Point> = finite.iter().map(|&i| cloud[i]).collect();
     let tree = KdTree::new(&points);
     let normals: Vec<Option<[f64; 3]>> = tree.map_points(
         || Scratch::new(params.neighbourhood),

@@ -120,14 +120,14 @@ fn passes(p: &Point, axis: usize, lo: f32, hi: f32, keep_inside: bool) -> bool {
 }
 
 /// Indices of the points that pass, in input order.
-pub fn pass_through_indices(cloud: &PointCloud, params: &PassThroughParams) -> Result<Vec<usize>> {
+pub fn pass_through_indices(cloud: &[Point], params: &PassThroughParams) -> Result<Vec<usize>> {
     let (lo, hi) = params.limits()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
     let axis = params.axis.index();
     let keep = params.keep_inside;
-    let kept = compact(&cloud.points, |p| passes(p, axis, lo, hi, keep), |i, _| i);
+    let kept = compact(cloud, |p| passes(p, axis, lo, hi, keep), |i, _| i);
     if kept.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }
@@ -144,14 +144,14 @@ const HINT: &str = "widen [min_m, max_m], check the axis, or flip keep_inside";
 /// let kept = filter::pass_through(&cloud, &filter::PassThroughParams::ground_removal(0.1)).unwrap();
 /// assert_eq!(kept.points, vec![[0.0, 0.0, 0.1], [0.0, 0.0, 2.0]]);
 /// ```
-pub fn pass_through(cloud: &PointCloud, params: &PassThroughParams) -> Result<PointCloud> {
+pub fn pass_through(cloud: &[Point], params: &PassThroughParams) -> Result<PointCloud> {
     let (lo, hi) = params.limits()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
     let axis = params.axis.index();
     let keep = params.keep_inside;
-    let points = compact(&cloud.points, |p| passes(p, axis, lo, hi, keep), |_, p| *p);
+    let points = compact(cloud, |p| passes(p, axis, lo, hi, keep), |_, p| *p);
     if points.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }

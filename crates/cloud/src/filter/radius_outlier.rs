@@ -41,7 +41,7 @@ use rayon::prelude::*;
 use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_points};
 use super::grid::Grid;
 use super::kdtree::KdTree;
-use crate::{PointCloud, Result};
+use crate::{Point, PointCloud, Result};
 
 const FILTER: &str = "radius outlier removal";
 
@@ -91,7 +91,7 @@ const HINT: &str = "lower min_neighbors or raise radius_m";
 
 /// Indices of the points kept by radius outlier removal, in input order.
 pub fn radius_outlier_removal_indices(
-    cloud: &PointCloud,
+    cloud: &[Point],
     params: &RadiusOutlierParams,
 ) -> Result<Vec<usize>> {
     params.validate()?;
@@ -117,10 +117,7 @@ pub fn radius_outlier_removal_indices(
 /// let params = filter::RadiusOutlierParams { radius_m: 1.0, min_neighbors: 2 };
 /// assert_eq!(filter::radius_outlier_removal(&cloud, &params).unwrap().points, vec![[1.0, 0.0, 0.0]]);
 /// ```
-pub fn radius_outlier_removal(
-    cloud: &PointCloud,
-    params: &RadiusOutlierParams,
-) -> Result<PointCloud> {
+pub fn radius_outlier_removal(cloud: &[Point], params: &RadiusOutlierParams) -> Result<PointCloud> {
     let kept = radius_outlier_removal_indices(cloud, params)?;
     Ok(gather(cloud, &kept))
 }

@@ -122,7 +122,7 @@ impl StatisticalOutlierParams {
 
 /// Indices of the points kept by statistical outlier removal, in input order.
 pub fn statistical_outlier_removal_indices(
-    cloud: &PointCloud,
+    cloud: &[Point],
     params: &StatisticalOutlierParams,
 ) -> Result<Vec<usize>> {
     params.validate()?;
@@ -150,7 +150,7 @@ pub fn statistical_outlier_removal_indices(
 /// assert!(kept.points.iter().all(|p| p[2] == 0.0));
 /// ```
 pub fn statistical_outlier_removal(
-    cloud: &PointCloud,
+    cloud: &[Point],
     params: &StatisticalOutlierParams,
 ) -> Result<PointCloud> {
     let kept = statistical_outlier_removal_indices(cloud, params)?;

@@ -106,12 +106,12 @@ fn floor_i64(v: f32) -> i64 {
 /// assert_eq!(down.len(), 2);
 /// assert!((down.points[0][0] - 0.2).abs() < 1e-6 && (down.points[1][0] - 1.1).abs() < 1e-6);
 /// ```
-pub fn voxel_grid(cloud: &PointCloud, params: &VoxelGridParams) -> Result<PointCloud> {
+pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointCloud> {
     let inv = params.inverse_leaf()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
     }
-    let points = &cloud.points;
+    let points = cloud;
     // The voxel of a finite point ([RS eq. 18] per point), checked.
     let cell = |p: &Point| -> Result<[i64; 3]> {
         let mut c = [0_i64; 3];

@@ -1,0 +1,319 @@
+"""autoshovel from Python: the Rust toolkit's point clouds, perception, dig,
+walk and tracking planners, and its studies.
+
+Point clouds are numpy ``(N, 3)`` float32 arrays (what Open3D's
+``np.asarray(pcd.points, dtype=np.float32)`` and laspy's ``xyz`` give once
+converted); they are read in place and results come back without a copy.
+Parameters are keyword arguments with the library's defaults, results are
+typed objects whose fields are those of the command line's
+``summary.json``, and the library's errors are :class:`AutoshovelError`
+with the message the command line prints. A bad argument is a
+``TypeError`` or ``ValueError`` naming it; a missing file is
+``FileNotFoundError``.
+
+See ``crates/py/README.md`` for a walk through, and ``autoshovel.cluster``
+for studies spread over a Ray cluster.
+"""
+
+from __future__ import annotations
+
+import os
+from typing import Any, Mapping, Optional, Sequence, Union
+
+import numpy as np
+
+from . import _native
+from ._native import (
+    DEFAULT_HEADING_TOLERANCE_DEG,
+    DEFAULT_POLISH_EVALUATIONS,
+    AutoshovelError,
+)
+from ._summary import (
+    DigPlan,
+    Excavation,
+    PathPlan,
+    Perception,
+    StudySummary,
+    Summary,
+    Tracking,
+)
+
+__all__ = [
+    "AutoshovelError",
+    "DEFAULT_HEADING_TOLERANCE_DEG",
+    "DEFAULT_POLISH_EVALUATIONS",
+    "DigPlan",
+    "Excavation",
+    "PathPlan",
+    "Perception",
+    "StudySummary",
+    "Summary",
+    "Tracking",
+    "generate_pile",
+    "level",
+    "pass_through",
+    "perceive",
+    "plan_dig",
+    "plan_excavate",
+    "plan_path",
+    "radius_outlier_removal",
+    "read_cloud",
+    "statistical_outlier_removal",
+    "study_paths",
+    "track",
+    "voxel_grid",
+    "write_cloud",
+]
+
+__version__ = "0.1.0"
+
+PathLike = Union[str, "os.PathLike[str]"]
+
+
+def _existing(func: str, arg: str, path: PathLike) -> str:
+    p = os.fspath(path)
+    if not os.path.exists(p):
+        raise FileNotFoundError(2, f"{func}(): {arg}: no such file", p)
+    return p
+
+
+def _number(func: str, arg: str, value: Any) -> float:
+    try:
+        v = float(value)
+    except (TypeError, ValueError):
+        raise TypeError(f"{func}(): {arg} must be a number, got {value!r}") from None
+    if not np.isfinite(v):
+        raise ValueError(f"{func}(): {arg} = {v}: expected a finite number")
+    return v
+
+
+# ---------------------------------------------------------------- files
+
+
+def read_cloud(path: PathLike, *, with_info: bool = False):
+    """The finite points of a PCD, PLY, LAS, LAZ, XYZ or CSV file as an
+    (N, 3) float32 array; with ``with_info`` also the format read and the
+    number of non-finite points dropped, as ``(points, format, dropped)``."""
+    points, fmt, dropped = _native.read_cloud(_existing("read_cloud", "path", path))
+    return (points, fmt, dropped) if with_info else points
+
+
+def write_cloud(
+    path: PathLike,
+    points: np.ndarray,
+    *,
+    encoding: Optional[str] = None,
+    overwrite: bool = False,
+) -> None:
+    """Writes ``points`` to ``path`` in the format its extension names
+    (.pcd .ply .las .laz .xyz .csv); ``encoding`` as ``autoshovel
+    generate-pile --encoding`` (ascii, binary, binary_compressed,
+    binary_big_endian). An existing file is kept unless ``overwrite``; a
+    failed write leaves nothing behind."""
+    p = os.fspath(path)
+    if os.path.exists(p) and not overwrite:
+        raise FileExistsError(17, "write_cloud(): path exists (pass overwrite=True to replace it)", p)
+    _native.write_cloud(p, points, encoding)
+
+
+# ---------------------------------------------------------------- filters
+
+
+def voxel_grid(points: np.ndarray, leaf_m: Union[float, Sequence[float]]) -> np.ndarray:
+    """PCL's VoxelGrid: the centroid of the points of each occupied voxel of
+    edge ``leaf_m`` (one number, or x, y, z) [RS eq. 18]–[RS eq. 19]."""
+    if np.ndim(leaf_m) == 0:
+        leaf = [_number("voxel_grid", "leaf_m", leaf_m)] * 3
+    else:
+        leaf = [_number("voxel_grid", f"leaf_m[{i}]", v) for i, v in enumerate(leaf_m)]
+        if len(leaf) != 3:
+            raise ValueError(f"voxel_grid(): leaf_m must be one number or three, got {len(leaf)}")
+    return _native.voxel_grid(points, leaf)
+
+
+def statistical_outlier_removal(
+    points: np.ndarray,
+    mean_k: int = 50,
+    std_mul: float = 1.0,
+    *,
+    sides: str = "above",
+    return_indices: bool = False,
+) -> np.ndarray:
+    """PCL's StatisticalOutlierRemoval [RS eq. 14]–[RS eq. 16]: keeps the
+    points whose mean distance to their ``mean_k`` nearest neighbours is at
+    most the mean plus ``std_mul`` standard deviations (``sides="both"``
+    also drops those unusually close, as the paper prints eq. 16). The kept
+    points in input order, or their indices (int64)."""
+    return _native.statistical_outlier_removal(
+        points, mean_k, _number("statistical_outlier_removal", "std_mul", std_mul), sides, return_indices
+    )
+
+
+def radius_outlier_removal(
+    points: np.ndarray,
+    radius_m: float,
+    min_neighbors: int,
+    *,
+    return_indices: bool = False,
+) -> np.ndarray:
+    """PCL's RadiusOutlierRemoval [RS eq. 13]: keeps the points with at
+    least ``min_neighbors`` others within ``radius_m`` (at the radius
+    counts). The kept points in input order, or their indices (int64)."""
+    return _native.radius_outlier_removal(
+        points, _number("radius_outlier_removal", "radius_m", radius_m), min_neighbors, return_indices
+    )
+
+
+def pass_through(
+    points: np.ndarray,
+    axis: str = "z",
+    min_m: float = -np.inf,
+    max_m: float = np.inf,
+    *,
+    keep_inside: bool = True,
+    return_indices: bool = False,
+) -> np.ndarray:
+    """PCL's PassThrough on ``axis``: keeps the points with min_m <= v <=
+    max_m (or outside, with ``keep_inside=False``)."""
+    for name, v in (("min_m", min_m), ("max_m", max_m)):
+        if isinstance(v, float) and np.isnan(v):
+            raise ValueError(f"pass_through(): {name} = nan: expected a number")
+    return _native.pass_through(points, axis, float(min_m), float(max_m), keep_inside, return_indices)
+
+
+def level(points: np.ndarray, roll_deg: float, pitch_deg: float) -> np.ndarray:
+    """The scan levelled for a sensor with this roll and pitch [deg]
+    [RS eq. 11]–[RS eq. 12]."""
+    return _native.level(points, roll_deg, pitch_deg)
+
+
+# ---------------------------------------------------------------- piles and perception
+
+
+def generate_pile(
+    shape: str = "typical",
+    points: int = 100_000,
+    *,
+    scale: float = 1.0,
+    roll_deg: float = 3.0,
+    pitch_deg: float = -2.0,
+    pattern: str = "area",
+    sensor_height_m: float = 12.0,
+    fov_deg: float = 70.4,
+    seed: int = 1,
+) -> np.ndarray:
+    """A synthetic LiDAR scan of a pile of the rope-shovel paper's Fig. 7
+    (typical, convex, concave, convex-concave), as ``autoshovel
+    generate-pile`` makes it with the same arguments (``pattern``: area or
+    rosette)."""
+    return _native.generate_pile(
+        shape, points, scale, roll_deg, pitch_deg, pattern, sensor_height_m, fov_deg, seed
+    )
+
+
+def perceive(
+    cloud: Union[np.ndarray, PathLike],
+    *,
+    config: Optional[PathLike] = None,
+    **settings: Any,
+) -> Perception:
+    """The rope-shovel paper's §3 pipeline (level, floor, radius and
+    statistical outliers, voxel grid, smoothing, surface fit) on an (N, 3)
+    float32 array or a file, as ``autoshovel perceive``.
+
+    Settings are those of ``autoshovel perceive --print-config``: a TOML
+    file ``config`` and/or keywords, a table as a dict
+    (``perceive(pts, statistical={"mean_k": 30}, scale=1.0)``)."""
+    cfg = None if config is None else _existing("perceive", "config", config)
+    if isinstance(cloud, np.ndarray):
+        native = _native.perceive(cloud, None, cfg, settings)
+    elif isinstance(cloud, (str, os.PathLike)):
+        native = _native.perceive(None, _existing("perceive", "cloud", cloud), cfg, settings)
+    else:
+        raise TypeError(
+            f"perceive(): cloud must be an (N, 3) float32 array or a path, got {type(cloud).__name__}"
+        )
+    return Perception._from_json(native.summary_json(), _native=native)
+
+
+# ---------------------------------------------------------------- planners
+
+
+def plan_dig(
+    pile: Union[str, Perception] = "typical",
+    *,
+    profile: Optional[PathLike] = None,
+    seed: int = 1,
+    polish: int = DEFAULT_POLISH_EVALUATIONS,
+    search: str = "bends",
+    init: str = "good-point-set",
+) -> DigPlan:
+    """One rope-shovel dig plan (GWO under c1–c18, then a CMA-ES polish),
+    as ``autoshovel plan-dig``: on a Fig. 7 pile by name, or on what
+    :func:`perceive` returned (the scan cut into a dig profile by the
+    library's rule). A pile without a feasible plan is a summary with
+    ``success`` False and ``error`` set; a pile the machine cannot dig at
+    all is an :class:`AutoshovelError`."""
+    prof = None if profile is None else _existing("plan_dig", "profile", profile)
+    native_pile = pile._native if isinstance(pile, Perception) else pile
+    text, path, surface = _native.plan_dig(native_pile, prof, seed, polish, search, init)
+    return DigPlan._from_json(text, tooth_path=path, pile_profile=surface)
+
+
+def plan_path(
+    scenario: Union[str, PathLike] = "curve",
+    *,
+    planner: str = "improved-apf",
+    heading_tolerance_deg: float = DEFAULT_HEADING_TOLERANCE_DEG,
+) -> PathPlan:
+    """The crawler's walk (``autoshovel plan-path``) on a built-in scenario
+    (straight, straight-reverse, curve, curve-reverse, v-shape) or a TOML
+    file, with the improved (default) or classic ("apf") potential field."""
+    text, waypoints = _native.plan_path(os.fspath(scenario), planner, heading_tolerance_deg)
+    return PathPlan._from_json(text, waypoints=waypoints)
+
+
+def track(
+    scenario: Union[str, PathLike] = "fig9a",
+    *,
+    controller: str = "fuzzy",
+    noise: Optional[str] = None,
+    seed: int = 1,
+    compare: bool = False,
+    controllers: Optional[Mapping[str, Any]] = None,
+) -> Tracking:
+    """Drives the crawler along a scenario in the simulator (``autoshovel
+    track``): controller fuzzy, pid, pure-pursuit or stanley; noise off or
+    rtk (default: the scenario's); ``controllers`` lays gains over the
+    scenario's ``[controller.*]`` tables, e.g. ``{"pid": {"kp": 600}}``."""
+    text, trajectory = _native.track(
+        os.fspath(scenario), controller, noise, seed, compare, dict(controllers or {})
+    )
+    return Tracking._from_json(text, trajectory=trajectory)
+
+
+def plan_excavate(
+    scenario: Union[str, PathLike] = "paper-over",
+    *,
+    profile: Optional[PathLike] = None,
+) -> Excavation:
+    """The hydraulic excavator's volume-targeted dig round hidden boulders
+    (``autoshovel plan-excavate``): paper-over, paper-under, two-boulders or
+    a scenario TOML file."""
+    prof = None if profile is None else _existing("plan_excavate", "profile", profile)
+    return Excavation._from_json(_native.plan_excavate(os.fspath(scenario), prof))
+
+
+def study_paths(
+    maps: int = 500,
+    *,
+    seed: int = 1,
+    min_obstacles: int = 3,
+    max_obstacles: int = 12,
+) -> StudySummary:
+    """The seeded random haul-road study (``autoshovel study-paths``) on all
+    of this machine's cores: the summary and ``table``, the Markdown table
+    the command prints. ``autoshovel.cluster`` runs the same study over a
+    Ray cluster, with the same numbers."""
+    text, table = _native.study_paths(maps, seed, min_obstacles, max_obstacles)
+    return StudySummary._from_json(text, table=table)

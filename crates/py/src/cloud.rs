@@ -1,0 +1,391 @@
+//! Point clouds: the readers and writers, every filter, levelling, the
+//! synthetic pile scans and `perceive` ([RS eq. 11]–[RS eq. 21]).
+
+use std::path::{Path, PathBuf};
+
+use autoshovel_cloud::filter::{
+    self, Axis, OutlierSides, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
+    VoxelGridParams,
+};
+use autoshovel_cloud::io::Encoding;
+use autoshovel_cloud::PointCloud;
+use autoshovel_surface::perceive::{PerceiveSummary, Perceived, PerceptionParams};
+use numpy::{PyArray1, PyArray2, PyReadonlyArray1};
+use pyo3::prelude::*;
+use pyo3::types::PyDict;
+
+use crate::{
+    as_points, bad_arg, choose, finite, lib_err, points_arg, settings, summary_json, to_numpy,
+};
+
+/// `read_cloud(path)`: the finite points of a PCD, PLY, LAS, LAZ, XYZ or
+/// CSV file, the format read and the count of non-finite points dropped.
+#[pyfunction]
+fn read_cloud(
+    py: Python<'_>,
+    path: PathBuf,
+) -> PyResult<(Bound<'_, PyArray2<f32>>, &'static str, usize)> {
+    let report = py
+        .detach(|| autoshovel_cloud::io::read(&path, &mut |_, _| {}))
+        .map_err(lib_err)?;
+    Ok((
+        to_numpy(py, report.cloud.points),
+        report.format,
+        report.non_finite_dropped,
+    ))
+}
+
+/// `write_cloud(path, points, encoding)`: the points written whole to a
+/// file beside `path`, then moved over it (a failed write leaves nothing).
+#[pyfunction]
+#[pyo3(signature = (path, points, encoding=None))]
+fn write_cloud(
+    py: Python<'_>,
+    path: PathBuf,
+    points: &Bound<'_, PyAny>,
+    encoding: Option<&str>,
+) -> PyResult<()> {
+    let array = points_arg("write_cloud", "points", points)?;
+    let encoding = match encoding {
+        Some(e) => e
+            .parse::<Encoding>()
+            .map_err(|msg| bad_arg("write_cloud", format!("encoding: {msg}")))?,
+        None => Encoding::default_for(&path),
+    };
+    let cloud = PointCloud::new(as_points(&array).to_vec());
+    py.detach(|| {
+        let name = path
+            .file_name()
+            .map(|n| n.to_string_lossy().into_owned())
+            .unwrap_or_default();
+        // The extension names the format: keep it last.
+        let partial = path.with_file_name(format!(".partial-{}-{name}", std::process::id()));
+        let done = autoshovel_cloud::io::write(&partial, &cloud, encoding).and_then(|()| {
+            std::fs::rename(&partial, &path).map_err(|source| autoshovel_cloud::CloudError::Io {
+                path: path.clone(),
+                source,
+            })
+        });
+        if done.is_err() {
+            let _ = std::fs::remove_file(&partial);
+        }
+        done
+    })
+    .map_err(lib_err)
+}
+
+/// PCL's `VoxelGrid`: the centroid of each occupied voxel ([RS eq. 18]–[RS eq. 19]).
+#[pyfunction]
+fn voxel_grid<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    leaf_m: [f64; 3],
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    let array = points_arg("voxel_grid", "points", points)?;
+    let pts = as_points(&array);
+    let params = VoxelGridParams {
+        leaf_m,
+        ..VoxelGridParams::cube(1.0)
+    };
+    let out = py
+        .detach(|| filter::voxel_grid(pts, &params))
+        .map_err(lib_err)?;
+    Ok(to_numpy(py, out.points))
+}
+
+fn parse_sides(func: &str, s: &str) -> PyResult<OutlierSides> {
+    choose(
+        func,
+        "sides",
+        s,
+        &[("above", OutlierSides::Above), ("both", OutlierSides::Both)],
+    )
+}
+
+/// Statistical outlier removal ([RS eq. 14]–[RS eq. 16]); with `indices`
+/// the kept indices instead of the points.
+#[pyfunction]
+fn statistical_outlier_removal<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    mean_k: usize,
+    std_mul: f64,
+    sides: &str,
+    indices: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    const F: &str = "statistical_outlier_removal";
+    let array = points_arg(F, "points", points)?;
+    let pts = as_points(&array);
+    let params = StatisticalOutlierParams {
+        mean_k,
+        std_mul: finite(F, "std_mul", std_mul)?,
+        sides: parse_sides(F, sides)?,
+    };
+    kept(py, pts, indices, |p| {
+        filter::statistical_outlier_removal_indices(p, &params)
+    })
+}
+
+/// Radius outlier removal ([RS eq. 13]).
+#[pyfunction]
+fn radius_outlier_removal<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    radius_m: f64,
+    min_neighbors: usize,
+    indices: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    const F: &str = "radius_outlier_removal";
+    let array = points_arg(F, "points", points)?;
+    let pts = as_points(&array);
+    let params = RadiusOutlierParams {
+        radius_m: finite(F, "radius_m", radius_m)?,
+        min_neighbors,
+    };
+    kept(py, pts, indices, |p| {
+        filter::radius_outlier_removal_indices(p, &params)
+    })
+}
+
+/// PCL's `PassThrough` on one axis ([RS eq. 17] on z).
+#[pyfunction]
+#[allow(clippy::too_many_arguments)]
+fn pass_through<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    axis: &str,
+    min_m: f64,
+    max_m: f64,
+    keep_inside: bool,
+    indices: bool,
+) -> PyResult<Bound<'py, PyAny>> {
+    const F: &str = "pass_through";
+    let array = points_arg(F, "points", points)?;
+    let pts = as_points(&array);
+    let axis = choose(
+        F,
+        "axis",
+        axis,
+        &[("x", Axis::X), ("y", Axis::Y), ("z", Axis::Z)],
+    )?;
+    let params = PassThroughParams {
+        axis,
+        min_m,
+        max_m,
+        keep_inside,
+    };
+    kept(py, pts, indices, |p| {
+        filter::pass_through_indices(p, &params)
+    })
+}
+
+/// Runs an index-returning filter without the GIL, then hands back the
+/// indices (int64) or the kept points.
+fn kept<'py>(
+    py: Python<'py>,
+    pts: &[[f32; 3]],
+    indices: bool,
+    run: impl FnOnce(&[[f32; 3]]) -> autoshovel_cloud::Result<Vec<usize>> + Send,
+) -> PyResult<Bound<'py, PyAny>> {
+    let got = py.detach(|| {
+        run(pts).map(|kept| {
+            if indices {
+                Err(kept.into_iter().map(|i| i as i64).collect::<Vec<i64>>())
+            } else {
+                Ok(kept.into_iter().map(|i| pts[i]).collect::<Vec<[f32; 3]>>())
+            }
+        })
+    });
+    Ok(match got.map_err(lib_err)? {
+        Ok(points) => to_numpy(py, points).into_any(),
+        Err(idx) => PyArray1::from_vec(py, idx).into_any(),
+    })
+}
+
+/// Levels a scan by the sensor's roll and pitch ([RS eq. 11]–[RS eq. 12]).
+#[pyfunction]
+fn level<'py>(
+    py: Python<'py>,
+    points: &Bound<'py, PyAny>,
+    roll_deg: f64,
+    pitch_deg: f64,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    const F: &str = "level";
+    let array = points_arg(F, "points", points)?;
+    let (roll, pitch) = (
+        finite(F, "roll_deg", roll_deg)?.to_radians(),
+        finite(F, "pitch_deg", pitch_deg)?.to_radians(),
+    );
+    let pts = as_points(&array);
+    let out = py.detach(|| autoshovel_surface::level(pts, roll, pitch));
+    Ok(to_numpy(py, out.points))
+}
+
+/// A synthetic LiDAR scan of a Fig. 7 pile, from the generator's
+/// settings (`PileParams`) given as keywords.
+#[pyfunction]
+#[pyo3(signature = (shape, points, scale, roll_deg, pitch_deg, pattern, sensor_height_m, fov_deg, seed))]
+#[allow(clippy::too_many_arguments)]
+fn generate_pile<'py>(
+    py: Python<'py>,
+    shape: &str,
+    points: usize,
+    scale: f64,
+    roll_deg: f64,
+    pitch_deg: f64,
+    pattern: &str,
+    sensor_height_m: f64,
+    fov_deg: f64,
+    seed: u64,
+) -> PyResult<Bound<'py, PyArray2<f32>>> {
+    const F: &str = "generate_pile";
+    let params = autoshovel_surface::PileParams {
+        shape: shape
+            .parse()
+            .map_err(|e| bad_arg(F, format!("shape: {e}")))?,
+        pattern: pattern
+            .parse()
+            .map_err(|e| bad_arg(F, format!("pattern: {e}")))?,
+        points,
+        scale: finite(F, "scale", scale)?,
+        roll_rad: finite(F, "roll_deg", roll_deg)?.to_radians(),
+        pitch_rad: finite(F, "pitch_deg", pitch_deg)?.to_radians(),
+        sensor_height_m: finite(F, "sensor_height_m", sensor_height_m)?,
+        fov_rad: finite(F, "fov_deg", fov_deg)?.to_radians(),
+        seed,
+        ..Default::default()
+    };
+    let cloud = py
+        .detach(|| autoshovel_surface::generate_pile(&params))
+        .map_err(lib_err)?;
+    Ok(to_numpy(py, cloud.points))
+}
+
+/// What `perceive` made: the library's `Perceived`, its summary and the
+/// name the input goes by (a file, or `<array>`).
+#[pyclass(module = "autoshovel._native", frozen)]
+pub(crate) struct Perception {
+    pub(crate) got: Perceived,
+    pub(crate) source: String,
+    summary: String,
+}
+
+#[pymethods]
+impl Perception {
+    /// The summary as the JSON of `autoshovel perceive --json`.
+    fn summary_json(&self) -> String {
+        self.summary.clone()
+    }
+
+    /// The cleaned, levelled points (a copy: the perception keeps its own).
+    fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
+        to_numpy(py, self.got.cloud.points.clone())
+    }
+
+    /// The fitted surface z = f(x, y) ([RS eq. 21]) at each (x, y).
+    fn surface_height<'py>(
+        &self,
+        py: Python<'py>,
+        x: PyReadonlyArray1<'py, f64>,
+        y: PyReadonlyArray1<'py, f64>,
+    ) -> PyResult<Bound<'py, PyArray1<f64>>> {
+        let (x, y) = (x.as_array(), y.as_array());
+        if x.len() != y.len() {
+            return Err(bad_arg(
+                "surface_height",
+                format!("x has {} values, y {}", x.len(), y.len()),
+            ));
+        }
+        let z: Vec<f64> = x
+            .iter()
+            .zip(y.iter())
+            .map(|(&x, &y)| self.got.fit.height(x, y))
+            .collect();
+        Ok(PyArray1::from_vec(py, z))
+    }
+
+    /// The floor height in the levelled frame [m].
+    #[getter]
+    fn floor_height_m(&self) -> f64 {
+        self.got.floor_height_m
+    }
+}
+
+/// The §3 pipeline on a file (`path`) or an array, with the settings of
+/// `PerceptionParams` (a TOML `config` and/or keyword tables).
+#[pyfunction]
+#[pyo3(signature = (points=None, path=None, config=None, overrides=None))]
+fn perceive(
+    py: Python<'_>,
+    points: Option<&Bound<'_, PyAny>>,
+    path: Option<PathBuf>,
+    config: Option<&str>,
+    overrides: Option<&Bound<'_, PyDict>>,
+) -> PyResult<Perception> {
+    const F: &str = "perceive";
+    let params: PerceptionParams = settings(F, config, overrides, || {
+        autoshovel_core::config::TomlFile::to_toml(&PerceptionParams::default())
+    })?;
+    let (got, source) = match (points, path) {
+        (Some(obj), None) => {
+            let array = points_arg(F, "points", obj)?;
+            let cloud = PointCloud::new(as_points(&array).to_vec());
+            let got = py
+                .detach(|| autoshovel_surface::perceive::perceive(&cloud, &params))
+                .map_err(lib_err)?;
+            (got, "<array>".to_string())
+        }
+        (None, Some(p)) => {
+            let got = py
+                .detach(|| {
+                    autoshovel_surface::perceive::perceive_file_with(
+                        &p,
+                        &params,
+                        &mut |_, _| {},
+                        &mut |_| {},
+                    )
+                })
+                .map_err(|e| match e {
+                    autoshovel_surface::SurfaceError::Cloud(e) => lib_err(e),
+                    e => crate::AutoshovelError::new_err(format!(
+                        "{}: {}",
+                        p.display(),
+                        strip(lib_err(e), py)
+                    )),
+                })?;
+            (got, p.display().to_string())
+        }
+        _ => {
+            return Err(bad_arg(
+                F,
+                "give the points (an (N, 3) float32 array) or a path, not both",
+            ))
+        }
+    };
+    let summary = summary_json(&PerceiveSummary::new(Path::new(&source), &params, &got))?;
+    Ok(Perception {
+        got,
+        source,
+        summary,
+    })
+}
+
+/// The message of an error made by [`lib_err`].
+fn strip(e: PyErr, py: Python<'_>) -> String {
+    e.value(py).to_string()
+}
+
+/// Adds this module's functions to `m`.
+pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
+    m.add_class::<Perception>()?;
+    m.add_function(wrap_pyfunction!(read_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(write_cloud, m)?)?;
+    m.add_function(wrap_pyfunction!(voxel_grid, m)?)?;
+    m.add_function(wrap_pyfunction!(statistical_outlier_removal, m)?)?;
+    m.add_function(wrap_pyfunction!(radius_outlier_removal, m)?)?;
+    m.add_function(wrap_pyfunction!(pass_through, m)?)?;
+    m.add_function(wrap_pyfunction!(level, m)?)?;
+    m.add_function(wrap_pyfunction!(generate_pile, m)?)?;
+    m.add_function(wrap_pyfunction!(perceive, m)?)?;
+    Ok(())
+}

@@ -1,0 +1,77 @@
+"""Studies on a local Ray cluster (a head and two worker processes on
+loopback) give the single-machine numbers for the same seeds."""
+
+import os
+import re
+
+import numpy as np
+import pytest
+
+import autoshovel
+
+if os.environ.get("AUTOSHOVEL_REQUIRE_RAY"):
+    import ray  # noqa: F401  (CI: fail, do not skip, without Ray)
+else:
+    pytest.importorskip("ray")
+
+from autoshovel import cluster  # noqa: E402
+from test_jobs import same_but_times  # noqa: E402
+
+
+@pytest.fixture(scope="module")
+def local():
+    with cluster.LocalCluster(workers=2) as c:
+        yield c
+
+
+def without_time_column(table: str) -> str:
+    # The last column is the measured mean plan time.
+    return "\n".join(re.sub(r"\| [^|]* \|$", "|", line) for line in table.splitlines())
+
+
+def test_shards_cover_every_index_once():
+    for total, shards in [(10, 3), (3, 10), (0, 2), (100_000, 7)]:
+        ranges = cluster.shard_ranges(total, shards)
+        assert [i for r in ranges for i in r] == list(range(total))
+        sizes = [len(r) for r in ranges]
+        assert not sizes or max(sizes) - min(sizes) <= 1
+
+
+def test_study_on_the_cluster_equals_one_machine(local):
+    import ray
+
+    assert ray.cluster_resources().get("CPU") == 2
+    alone = autoshovel.study_paths(300, seed=3)
+    spread = cluster.study_paths(300, seed=3, shards=7)
+    same_but_times(spread.to_dict(), alone.to_dict())
+    assert without_time_column(spread.table) == without_time_column(alone.table)
+
+
+def test_study_refuses_missing_or_doubled_maps():
+    from autoshovel import _native
+
+    one = _native.study_paths_rows(4, 1, 3, 12, 0, 2, 1)
+    with pytest.raises(autoshovel.AutoshovelError, match="expected 4"):
+        _native.study_paths_summary(4, 1, 3, 12, [one])
+    with pytest.raises(autoshovel.AutoshovelError, match="map 1 where map 2 belongs"):
+        _native.study_paths_summary(4, 1, 3, 12, [one, one])
+
+
+def test_track_grid_equals_direct_runs(local):
+    rows = cluster.track_grid("fig9a", controller="pid", gains={"pid.kp": [400.0, 900.0]}, seeds=[1, 2])
+    assert [(r["gains"]["pid.kp"], r["seed"]) for r in rows] == [(400.0, 1), (400.0, 2), (900.0, 1), (900.0, 2)]
+    for r in rows:
+        direct = autoshovel.track("fig9a", controller="pid", seed=r["seed"], noise="rtk", controllers={"pid": {"kp": r["gains"]["pid.kp"]}})
+        same_but_times(r["summary"], direct.to_dict())
+
+
+def test_plan_dig_over_a_folder_of_scans(local, tmp_path):
+    for seed in (1, 2):
+        autoshovel.write_cloud(tmp_path / f"scan{seed}.pcd", autoshovel.generate_pile("convex", 40_000, seed=seed))
+    (tmp_path / "notes.txt").write_text("not a scan")
+    rows = cluster.plan_dig_folder(tmp_path, polish=100)
+    assert [os.path.basename(r["file"]) for r in rows] == ["scan1.pcd", "scan2.pcd"]
+    for r in rows:
+        assert r["error"] is None
+        direct = autoshovel.plan_dig(autoshovel.perceive(r["file"]), polish=100)
+        same_but_times(r["dig"], direct.to_dict())
