@@ -83,10 +83,7 @@ fn voxel_grid<'py>(
 ) -> PyResult<Bound<'py, PyArray2<f32>>> {
     let array = points_arg("voxel_grid", "points", points)?;
     let pts = as_points(&array);
-    let params = VoxelGridParams {
-        leaf_m,
-        ..VoxelGridParams::cube(1.0)
-    };
+    let params = VoxelGridParams { leaf_m };
     let out = py
         .detach(|| filter::voxel_grid(pts, &params))
         .map_err(lib_err)?;

@@ -58,13 +58,11 @@ fn describe(obj: &Bound<'_, PyAny>) -> String {
     };
     match (attr("dtype"), attr("shape")) {
         (Some(dtype), Some(shape)) => format!("a {dtype} array of shape {shape}"),
-        _ => format!(
-            "{}",
-            obj.get_type()
-                .name()
-                .map(|n| format!("a {n}"))
-                .unwrap_or_else(|_| "an object".into())
-        ),
+        _ => obj
+            .get_type()
+            .name()
+            .map(|n| format!("a {n}"))
+            .unwrap_or_else(|_| "an object".into()),
     }
 }
 

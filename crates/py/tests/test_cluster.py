@@ -53,7 +53,7 @@ def test_study_refuses_missing_or_doubled_maps():
     one = _native.study_paths_rows(4, 1, 3, 12, 0, 2, 1)
     with pytest.raises(autoshovel.AutoshovelError, match="expected 4"):
         _native.study_paths_summary(4, 1, 3, 12, [one])
-    with pytest.raises(autoshovel.AutoshovelError, match="map 1 where map 2 belongs"):
+    with pytest.raises(autoshovel.AutoshovelError, match="map 0 where map 1 belongs"):
         _native.study_paths_summary(4, 1, 3, 12, [one, one])
 
 

@@ -74,12 +74,14 @@ def test_laspy_reads_our_las(tmp_path, pile, name):
 
 
 def test_radius_outlier_removal_agrees_with_open3d(pile):
-    # Same rule, counted differently: Open3D's nb_points counts the point
-    # itself, PCL's (and ours) min_neighbors does not: ours(k) = Open3D(k + 1).
-    radius, k = 0.3, 4
-    ours = autoshovel.radius_outlier_removal(pile, radius, k, return_indices=True)
-    _, theirs = o3d_cloud(pile).remove_radius_outlier(nb_points=k + 1, radius=radius)
-    np.testing.assert_array_equal(ours, np.asarray(theirs))
+    # The same rule: a point stays with at least k others within the radius
+    # (Open3D's nb_points, PCL's min_neighbors). Distances differ in the last
+    # bits (PCL's f32 squares against r² in f64, Open3D's f64 throughout),
+    # which on these scans changes no point.
+    for radius, k in [(0.3, 4), (0.2, 2), (0.5, 10)]:
+        ours = autoshovel.radius_outlier_removal(pile, radius, k, return_indices=True)
+        _, theirs = o3d_cloud(pile).remove_radius_outlier(nb_points=k, radius=radius)
+        np.testing.assert_array_equal(ours, np.asarray(theirs))
 
 
 def test_statistical_outlier_removal_against_open3d(pile):
@@ -104,7 +106,10 @@ def test_voxel_grid_agrees_with_open3d_on_the_same_cells(pile):
     shifted = (pile - pile.min(axis=0) + np.float32(leaf / 2)).astype(np.float32)
     ours = autoshovel.voxel_grid(shifted, leaf).astype(np.float64)
     theirs = np.asarray(o3d_cloud(shifted).voxel_down_sample(leaf).points)
-    key = lambda a: a[np.lexsort(np.round(a, 4).T[::-1])]
-    assert abs(len(ours) - len(theirs)) <= 1e-3 * len(theirs)
-    if len(ours) == len(theirs):
-        np.testing.assert_allclose(key(ours), key(theirs), atol=1e-5)
+    def by_cell(a):
+        c = np.floor(a / leaf).astype(np.int64)
+        return a[np.lexsort(c.T[::-1])]
+    # The grids coincide up to Open3D's f64 origin (within 1e-9 of ours):
+    # the same cells, the same centroids to f32 rounding.
+    assert len(ours) == len(theirs)
+    np.testing.assert_allclose(by_cell(ours), by_cell(theirs), atol=1e-5)

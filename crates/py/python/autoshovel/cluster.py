@@ -174,24 +174,29 @@ class LocalCluster:
 
     def __init__(self, workers: int = 2, cpus_per_worker: int = 1):
         _need_ray()
+        from ray._private import ray_constants
         from ray.cluster_utils import Cluster
 
+        # Every address on loopback: Ray otherwise names a node (and turns a
+        # bootstrap address of 127.0.0.1) by the interface that routes
+        # outwards. Its single-machine mode (the macOS/Windows default) keeps
+        # to 127.0.0.1; this process reads the constant, the nodes it starts
+        # read the environment. Undone by shutdown().
+        self._saved = (os.environ.get("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"), ray_constants.ENABLE_RAY_CLUSTER)
+        os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = "0"
+        ray_constants.ENABLE_RAY_CLUSTER = False
         os.environ.setdefault("RAY_USAGE_STATS_ENABLED", "0")
         self.cluster = Cluster(
             initialize_head=True,
-            head_node_args={
-                "num_cpus": 0,
-                "node_ip_address": "127.0.0.1",
-                "include_dashboard": False,
-            },
+            head_node_args={"num_cpus": 0, "include_dashboard": False},
         )
         self.nodes = [self.add_worker(cpus_per_worker) for _ in range(workers)]
-        ray.init(address=self.cluster.address, _node_ip_address="127.0.0.1", log_to_driver=False)
+        ray.init(address=self.cluster.address, log_to_driver=False)
         self.cluster.wait_for_nodes()
 
     def add_worker(self, cpus: int = 1):
-        node = self.cluster.add_node(num_cpus=cpus, node_ip_address="127.0.0.1")
-        return node
+        """Adds a worker node (a raylet and its worker processes) of ``cpus`` CPUs."""
+        return self.cluster.add_node(num_cpus=cpus)
 
     def __enter__(self) -> "LocalCluster":
         return self
@@ -200,8 +205,16 @@ class LocalCluster:
         self.shutdown()
 
     def shutdown(self) -> None:
+        from ray._private import ray_constants
+
         ray.shutdown()
         self.cluster.shutdown()
+        env, constant = self._saved
+        if env is None:
+            os.environ.pop("RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER", None)
+        else:
+            os.environ["RAY_ENABLE_WINDOWS_OR_OSX_CLUSTER"] = env
+        ray_constants.ENABLE_RAY_CLUSTER = constant
 
 
 def _connect(address: str, workers: int) -> Optional[LocalCluster]:
