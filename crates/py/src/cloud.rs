@@ -118,9 +118,13 @@ fn statistical_outlier_removal<'py>(
         std_mul: finite(F, "std_mul", std_mul)?,
         sides: parse_sides(F, sides)?,
     };
-    kept(py, pts, indices, |p| {
-        filter::statistical_outlier_removal_indices(p, &params)
-    })
+    kept(
+        py,
+        pts,
+        indices,
+        |p| filter::statistical_outlier_removal_indices(p, &params),
+        |p| filter::statistical_outlier_removal(p, &params),
+    )
 }
 
 /// Radius outlier removal ([RS eq. 13]).
@@ -139,9 +143,13 @@ fn radius_outlier_removal<'py>(
         radius_m: finite(F, "radius_m", radius_m)?,
         min_neighbors,
     };
-    kept(py, pts, indices, |p| {
-        filter::radius_outlier_removal_indices(p, &params)
-    })
+    kept(
+        py,
+        pts,
+        indices,
+        |p| filter::radius_outlier_removal_indices(p, &params),
+        |p| filter::radius_outlier_removal(p, &params),
+    )
 }
 
 /// PCL's `PassThrough` on one axis ([RS eq. 17] on z).
@@ -171,32 +179,35 @@ fn pass_through<'py>(
         max_m,
         keep_inside,
     };
-    kept(py, pts, indices, |p| {
-        filter::pass_through_indices(p, &params)
-    })
+    kept(
+        py,
+        pts,
+        indices,
+        |p| filter::pass_through_indices(p, &params),
+        |p| filter::pass_through(p, &params),
+    )
 }
 
-/// Runs an index-returning filter without the GIL, then hands back the
-/// indices (int64) or the kept points.
+/// Runs a filter without the GIL: its index form (`indices`, handed back
+/// as int64) or its point form (the library's own, as Rust callers get it).
 fn kept<'py>(
     py: Python<'py>,
     pts: &[[f32; 3]],
     indices: bool,
-    run: impl FnOnce(&[[f32; 3]]) -> autoshovel_cloud::Result<Vec<usize>> + Send,
+    index_form: impl FnOnce(&[[f32; 3]]) -> autoshovel_cloud::Result<Vec<usize>> + Send,
+    point_form: impl FnOnce(&[[f32; 3]]) -> autoshovel_cloud::Result<PointCloud> + Send,
 ) -> PyResult<Bound<'py, PyAny>> {
-    let got = py.detach(|| {
-        run(pts).map(|kept| {
-            if indices {
-                Err(kept.into_iter().map(|i| i as i64).collect::<Vec<i64>>())
-            } else {
-                Ok(kept.into_iter().map(|i| pts[i]).collect::<Vec<[f32; 3]>>())
-            }
-        })
-    });
-    Ok(match got.map_err(lib_err)? {
-        Ok(points) => to_numpy(py, points).into_any(),
-        Err(idx) => PyArray1::from_vec(py, idx).into_any(),
-    })
+    if indices {
+        let idx = py
+            .detach(|| {
+                index_form(pts).map(|k| k.into_iter().map(|i| i as i64).collect::<Vec<i64>>())
+            })
+            .map_err(lib_err)?;
+        Ok(PyArray1::from_vec(py, idx).into_any())
+    } else {
+        let cloud = py.detach(|| point_form(pts)).map_err(lib_err)?;
+        Ok(to_numpy(py, cloud.points).into_any())
+    }
 }
 
 /// Levels a scan by the sensor's roll and pitch ([RS eq. 11]–[RS eq. 12]).
@@ -372,6 +383,88 @@ fn strip(e: PyErr, py: Python<'_>) -> String {
     e.value(py).to_string()
 }
 
+/// For `crates/py/bench/bench_calls.py`: the wall times [s] of `repeats`
+/// calls of one library function made from Rust, on the very array the
+/// script times from Python (the same data, process and machine state).
+/// `kind`: voxel (leaf 0.05 m), statistical (k 50, 1σ), radius (0.05 m, 3),
+/// pass (z in [lo, hi]), perceive (defaults).
+#[pyfunction]
+fn _time_in_rust(
+    py: Python<'_>,
+    kind: &str,
+    points: &Bound<'_, PyAny>,
+    repeats: usize,
+    lo: f64,
+    hi: f64,
+) -> PyResult<Vec<f64>> {
+    const F: &str = "_time_in_rust";
+    let array = points_arg(F, "points", points)?;
+    let pts = as_points(&array);
+    let cloud = if kind == "perceive" {
+        Some(PointCloud::new(pts.to_vec()))
+    } else {
+        None
+    };
+    let run = |pts: &[[f32; 3]]| -> Result<usize, String> {
+        Ok(match kind {
+            "voxel" => filter::voxel_grid(pts, &VoxelGridParams::cube(0.05))
+                .map_err(|e| e.to_string())?
+                .len(),
+            "statistical" => filter::statistical_outlier_removal(
+                pts,
+                &StatisticalOutlierParams {
+                    mean_k: 50,
+                    std_mul: 1.0,
+                    sides: OutlierSides::Above,
+                },
+            )
+            .map_err(|e| e.to_string())?
+            .len(),
+            "radius" => filter::radius_outlier_removal(
+                pts,
+                &RadiusOutlierParams {
+                    radius_m: 0.05,
+                    min_neighbors: 3,
+                },
+            )
+            .map_err(|e| e.to_string())?
+            .len(),
+            "pass" => filter::pass_through(
+                pts,
+                &PassThroughParams {
+                    axis: Axis::Z,
+                    min_m: lo,
+                    max_m: hi,
+                    keep_inside: true,
+                },
+            )
+            .map_err(|e| e.to_string())?
+            .len(),
+            "perceive" => autoshovel_surface::perceive::perceive(
+                cloud.as_ref().expect("made above"),
+                &PerceptionParams::default(),
+            )
+            .map_err(|e| e.to_string())?
+            .cloud
+            .len(),
+            other => {
+                return Err(format!(
+                    "kind = {other:?}: expected voxel, statistical, radius, pass or perceive"
+                ))
+            }
+        })
+    };
+    py.detach(|| {
+        (0..repeats)
+            .map(|_| {
+                let t0 = std::time::Instant::now();
+                run(pts).map(|_| t0.elapsed().as_secs_f64())
+            })
+            .collect::<Result<Vec<f64>, String>>()
+    })
+    .map_err(|e| bad_arg(F, e))
+}
+
 /// Adds this module's functions to `m`.
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_class::<Perception>()?;
@@ -384,5 +477,6 @@ pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(level, m)?)?;
     m.add_function(wrap_pyfunction!(generate_pile, m)?)?;
     m.add_function(wrap_pyfunction!(perceive, m)?)?;
+    m.add_function(wrap_pyfunction!(_time_in_rust, m)?)?;
     Ok(())
 }

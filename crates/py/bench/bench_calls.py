@@ -1,0 +1,92 @@
+"""What a call from Python costs beside the same call from Rust, and what a
+study gains from one to two Ray worker processes (BENCHMARKS.md, "Python").
+
+    python crates/py/bench/bench_calls.py [--points 1000000] [--repeats 7] [--maps 2000]
+
+Calls: each filter and ``perceive`` on one generated pile (the Livox-like
+rosette pattern, 1.5 % outliers), timed from Python (``autoshovel.voxel_grid``
+...) and from Rust inside the same process on the very same array
+(``_native._time_in_rust``), interleaved, median of ``--repeats``.
+
+Ray: the random-road study of ``--maps`` maps on a local cluster of one
+worker process, then of two (each task one thread), against the same
+study on one thread without Ray.
+"""
+
+import argparse
+import os
+import statistics
+import sys
+import time
+
+import numpy as np
+
+import autoshovel
+from autoshovel import _native
+
+
+def median_ms(times):
+    return 1e3 * statistics.median(times)
+
+
+def calls(points: int, repeats: int) -> None:
+    pts = autoshovel.generate_pile("typical", points, pattern="rosette", seed=1)
+    lo, hi = float(np.quantile(pts[:, 2], 0.1)), float(np.quantile(pts[:, 2], 0.9))
+    py_calls = {
+        "voxel": lambda: autoshovel.voxel_grid(pts, 0.05),
+        "statistical": lambda: autoshovel.statistical_outlier_removal(pts, 50, 1.0),
+        "radius": lambda: autoshovel.radius_outlier_removal(pts, 0.05, 3),
+        "pass": lambda: autoshovel.pass_through(pts, "z", lo, hi),
+        "perceive": lambda: autoshovel.perceive(pts),
+    }
+    print(f"| call ({points:,} points, rosette) | from Python | from Rust | Python / Rust |")
+    print("|---|---|---|---|")
+    for kind, call in py_calls.items():
+        call()  # warm
+        py, rs = [], []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            call()
+            py.append(time.perf_counter() - t0)
+            rs.extend(_native._time_in_rust(kind, pts, 1, lo, hi))
+        p, r = median_ms(py), median_ms(rs)
+        print(f"| {kind} | {p:.1f} ms | {r:.1f} ms | {p / r:.3f} |")
+
+
+def ray_speedup(maps: int) -> None:
+    from autoshovel import cluster
+
+    t0 = time.perf_counter()
+    _native.study_paths_rows(maps, 1, 3, 12, 0, maps, 1)
+    alone = time.perf_counter() - t0
+    rows = [f"| one thread, no Ray | {alone:.1f} s | 1.00 |"]
+    walls = {}
+    for workers in (1, 2):
+        with cluster.LocalCluster(workers=workers):
+            cluster.study_paths(8 * workers, shards=workers)  # start the worker processes
+            t0 = time.perf_counter()
+            s = cluster.study_paths(maps, shards=16)
+            walls[workers] = time.perf_counter() - t0
+        rows.append(f"| Ray, {workers} worker process{'es' if workers > 1 else ''} | {walls[workers]:.1f} s | {alone / walls[workers]:.2f} |")
+    print(f"\n| random-road study, {maps:,} maps (16 tasks) | wall | speed-up |")
+    print("|---|---|---|")
+    print("\n".join(rows))
+    print(f"\nfrom 1 to 2 worker processes: {walls[1] / walls[2]:.2f}x")
+
+
+def main() -> int:
+    ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
+    ap.add_argument("--points", type=int, default=1_000_000)
+    ap.add_argument("--repeats", type=int, default=7)
+    ap.add_argument("--maps", type=int, default=2000)
+    ap.add_argument("--skip-ray", action="store_true")
+    a = ap.parse_args()
+    print(f"autoshovel {autoshovel.__version__}, Python {sys.version.split()[0]}, numpy {np.__version__}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}\n")
+    calls(a.points, a.repeats)
+    if not a.skip_ray:
+        ray_speedup(a.maps)
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())
