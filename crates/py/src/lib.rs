@@ -154,6 +154,14 @@ pub(crate) fn finite(func: &str, arg: &str, v: f64) -> PyResult<f64> {
     if v.is_finite() {
         Ok(v)
     } else {
+        // As Python writes them.
+        let v = if v.is_nan() {
+            "nan"
+        } else if v > 0.0 {
+            "inf"
+        } else {
+            "-inf"
+        };
         Err(bad_arg(
             func,
             format!("{arg} = {v}: expected a finite number"),

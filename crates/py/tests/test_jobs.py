@@ -76,18 +76,26 @@ def test_perceive_matches_the_cli(tmp_path, pile, cli):
     same_but_times(autoshovel.perceive(path).to_dict(), want)
 
 
-def test_plan_dig_on_a_perceived_scan(pile):
-    seen = autoshovel.perceive(pile)
+def test_plan_dig_on_a_perceived_scan():
+    # The planner's built-in machine is the paper's 1:30 model: a pile at that scale.
+    seen = autoshovel.perceive(autoshovel.generate_pile("typical", 60_000, scale=1 / 30, seed=2))
     plan = autoshovel.plan_dig(seen, polish=300)
     assert isinstance(plan, autoshovel.DigPlan) and plan.job == "plan-dig"
+    assert plan.success, plan.error
     assert plan.tooth_path.shape[1] == 4 and plan.pile_profile.shape[1] == 2
-    if plan.success:
-        assert plan.m_dig_kg > 0 and 0 < plan.fill_factor
-        # The tooth path starts at the toe, on the pile's profile.
-        x0, y0 = plan.tooth_path[0, 1:3]
-        assert abs(np.interp(x0, *plan.pile_profile.T) - y0) < 0.05
-    else:
-        assert plan.error
+    assert plan.m_dig_kg > 0 and 0.5 < plan.fill_factor <= 1.0
+    # The tooth path starts on the pile's profile and ends above it, and its
+    # time column ends at the dig time t_d.
+    x0, y0 = plan.tooth_path[0, 1:3]
+    assert abs(np.interp(x0, *plan.pile_profile.T) - y0) < 0.01
+    x1, y1 = plan.tooth_path[-1, 1:3]
+    assert y1 > np.interp(x1, *plan.pile_profile.T)
+    assert abs(plan.tooth_path[-1, 0] - plan.td_s) < 1e-9
+
+
+def test_a_full_size_scan_is_no_pile_for_the_scale_model(pile):
+    plan = autoshovel.plan_dig(autoshovel.perceive(pile), polish=0)
+    assert not plan.success and "1:30 scale" in plan.error or "scale" in plan.error
 
 
 def test_plan_dig_matches_the_cli(cli):
