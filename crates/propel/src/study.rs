@@ -509,4 +509,86 @@ mod tests {
             i.mean_length_ratio
         );
     }
+
+    #[test]
+    fn rows_survive_json_and_shards_summarise_as_the_whole() {
+        let p = StudyParams {
+            maps: 12,
+            seed: 4,
+            ..Default::default()
+        };
+        let rows: Vec<MapRow> = (0..p.maps).map(|i| run_map(&p, i)).collect();
+        // Failures carry NaN lengths: they must come back NaN, the rest bit for bit.
+        assert!(rows.iter().any(|r| r.classic.length_m.is_nan()));
+        let back = rows_from_json(&rows_to_json(&rows)).unwrap();
+        let bits = |r: &MapRow| {
+            serde_json::to_string(r).unwrap() // NaN and null alike; numbers exact
+        };
+        assert_eq!(
+            rows.iter().map(bits).collect::<Vec<_>>(),
+            back.iter().map(bits).collect::<Vec<_>>()
+        );
+        for (a, b) in rows.iter().zip(&back) {
+            for (x, y) in [
+                (a.classic.length_m, b.classic.length_m),
+                (a.improved.min_clearance_m, b.improved.min_clearance_m),
+                (
+                    a.improved.final_heading_error_deg,
+                    b.improved.final_heading_error_deg,
+                ),
+            ] {
+                assert!(
+                    x.to_bits() == y.to_bits() || (x.is_nan() && y.is_nan()),
+                    "{x} {y}"
+                );
+            }
+        }
+        // Two shards made apart, read back in the other order, summarise as the whole.
+        let (lo, hi) = rows.split_at(5);
+        let mut gathered = rows_from_json(&rows_to_json(hi)).unwrap();
+        gathered.extend(rows_from_json(&rows_to_json(lo)).unwrap());
+        gathered.sort_by_key(|r| r.index);
+        let strip = |s: StudySummary| {
+            let mut v = serde_json::to_value(s).unwrap();
+            for planner in v["planners"].as_array_mut().unwrap() {
+                planner.as_object_mut().unwrap().remove("mean_plan_time_ms");
+            }
+            v
+        };
+        assert_eq!(strip(summarize(&p, &gathered)), strip(summarize(&p, &rows)));
+        assert!(rows_from_json("[{\"index\": 1}]").is_err());
+    }
+
+    #[test]
+    fn study_counts_are_checked() {
+        let ok = StudyParams::default();
+        assert!(ok.check().is_ok());
+        for bad in [
+            StudyParams { maps: 0, ..ok },
+            StudyParams {
+                maps: MAX_STUDY_MAPS + 1,
+                ..ok
+            },
+            StudyParams {
+                min_obstacles: 5,
+                max_obstacles: 4,
+                ..ok
+            },
+            StudyParams {
+                max_obstacles: 61,
+                ..ok
+            },
+            StudyParams {
+                road_length_m: f64::NAN,
+                ..ok
+            },
+            StudyParams {
+                heading_tolerance_deg: -1.0,
+                ..ok
+            },
+        ] {
+            let e = bad.check().unwrap_err().to_string();
+            assert!(e.starts_with("study-paths: "), "{e}");
+        }
+    }
 }
