@@ -47,16 +47,22 @@ pub fn study(
     out: Option<&OutDir>,
     progress: bool,
 ) -> Result<Job<StudySummary>> {
-    if params.maps == 0 || params.maps > 100_000 {
-        bail!("--maps {} must be between 1 and 100000", params.maps);
-    }
-    if params.min_obstacles > params.max_obstacles || params.max_obstacles > 60 {
+    // The library's limits (StudyParams::check), said in the flags' names.
+    use autoshovel_propel::study::{MAX_STUDY_MAPS, MAX_STUDY_OBSTACLES};
+    if params.maps == 0 || params.maps > MAX_STUDY_MAPS {
         bail!(
-            "--min-obstacles {} and --max-obstacles {} must satisfy min <= max <= 60",
+            "--maps {} must be between 1 and {MAX_STUDY_MAPS}",
+            params.maps
+        );
+    }
+    if params.min_obstacles > params.max_obstacles || params.max_obstacles > MAX_STUDY_OBSTACLES {
+        bail!(
+            "--min-obstacles {} and --max-obstacles {} must satisfy min <= max <= {MAX_STUDY_OBSTACLES}",
             params.min_obstacles,
             params.max_obstacles
         );
     }
+    params.check()?;
     let bar = progress_bar(progress, "{msg} [{bar:40}] {pos}/{len} maps, {eta} left");
     bar.set_length(params.maps as u64);
     bar.set_message("planning");

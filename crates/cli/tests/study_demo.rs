@@ -113,7 +113,7 @@ fn study_refuses_zero_maps_and_bad_obstacle_ranges() {
             args.push("--json");
         }
         let r = run(&args).fails();
-        assert_eq!(r.error_message(), "--maps 0 must be between 1 and 100000");
+        assert_eq!(r.error_message(), "--maps 0 must be between 1 and 1000000");
         assert!(r.stdout.is_empty(), "{}", r.stdout);
     }
     let r = run(&[
