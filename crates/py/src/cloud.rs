@@ -265,7 +265,43 @@ fn generate_pile<'py>(
     };
     let cloud = py
         .detach(|| autoshovel_surface::generate_pile(&params))
-        .map_err(lib_err)?;
+        .map_err(|e| match e {
+            // The generator names its fields; the caller wrote keywords (in degrees).
+            autoshovel_surface::SurfaceError::BadParameter {
+                name,
+                value,
+                expected,
+            } => {
+                let (arg, degrees) = match name {
+                    "PileParams.points" => ("points", false),
+                    "PileParams.scale" => ("scale", false),
+                    "PileParams.roll_rad" => ("roll_deg", true),
+                    "PileParams.pitch_rad" => ("pitch_deg", true),
+                    "PileParams.sensor_height_m" => ("sensor_height_m", false),
+                    "PileParams.fov_rad" => ("fov_deg", true),
+                    _ => {
+                        return lib_err(autoshovel_surface::SurfaceError::BadParameter {
+                            name,
+                            value,
+                            expected,
+                        })
+                    }
+                };
+                let (value, expected) = if degrees {
+                    (value.to_degrees(), expected.replace(" [rad]", ""))
+                } else {
+                    (value, expected.to_string())
+                };
+                bad_arg(
+                    F,
+                    format!(
+                        "{arg} = {}: expected {expected}",
+                        autoshovel_core::config::short(value)
+                    ),
+                )
+            }
+            e => lib_err(e),
+        })?;
     Ok(to_numpy(py, cloud.points))
 }
 

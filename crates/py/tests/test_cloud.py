@@ -132,7 +132,7 @@ def test_nan_and_bad_parameters_are_named(pile):
         autoshovel.radius_outlier_removal(pile, float("inf"), 3)
     with pytest.raises(ValueError, match="axis"):
         autoshovel.pass_through(pile, "w", 0, 1)
-    with pytest.raises(OverflowError, match="mean_k"):
+    with pytest.raises(ValueError, match="mean_k = -3"):
         autoshovel.statistical_outlier_removal(pile, -3, 1.0)
     # The library's own refusal, with its message.
     with pytest.raises(AutoshovelError, match="mean_k must be at least 1"):
@@ -150,3 +150,22 @@ def test_missing_and_broken_files(tmp_path):
     with pytest.raises(AutoshovelError) as e:
         autoshovel.read_cloud(broken)
     assert "broken.pcd" in str(e.value)
+
+
+@pytest.mark.parametrize(
+    "kw,words",
+    [
+        (dict(points=0), "points = 0: expected at least 1"),
+        (dict(roll_deg=80.0), "roll_deg = 80: expected an angle within ±45°"),
+        (dict(fov_deg=0.0), "fov_deg = 0: expected a field of view"),
+        (dict(scale=-1.0), "scale = -1"),
+        (dict(shape="cube"), "shape: unknown pile shape 'cube'"),
+        (dict(pattern="x"), "pattern: unknown scan pattern"),
+        (dict(seed=-1), "seed = -1: expected 0 to 2**64 - 1"),
+        (dict(points=1.5), "points must be a whole number"),
+    ],
+)
+def test_generate_pile_names_the_keyword(kw, words):
+    with pytest.raises((ValueError, TypeError)) as e:
+        autoshovel.generate_pile(**kw)
+    assert words in str(e.value)

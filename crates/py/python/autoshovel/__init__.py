@@ -87,6 +87,16 @@ def _number(func: str, arg: str, value: Any) -> float:
     return v
 
 
+def _whole(func: str, arg: str, value: Any) -> int:
+    """A count or seed: an int (or numpy integer) in 0 .. 2**64 - 1."""
+    if isinstance(value, bool) or not isinstance(value, (int, np.integer)):
+        raise TypeError(f"{func}(): {arg} must be a whole number, got {value!r}")
+    v = int(value)
+    if not 0 <= v < 2**64:
+        raise ValueError(f"{func}(): {arg} = {v}: expected 0 to 2**64 - 1")
+    return v
+
+
 # ---------------------------------------------------------------- files
 
 
@@ -145,7 +155,7 @@ def statistical_outlier_removal(
     also drops those unusually close, as the paper prints eq. 16). The kept
     points in input order, or their indices (int64)."""
     return _native.statistical_outlier_removal(
-        points, mean_k, _number("statistical_outlier_removal", "std_mul", std_mul), sides, return_indices
+        points, _whole("statistical_outlier_removal", "mean_k", mean_k), _number("statistical_outlier_removal", "std_mul", std_mul), sides, return_indices
     )
 
 
@@ -160,7 +170,10 @@ def radius_outlier_removal(
     least ``min_neighbors`` others within ``radius_m`` (at the radius
     counts). The kept points in input order, or their indices (int64)."""
     return _native.radius_outlier_removal(
-        points, _number("radius_outlier_removal", "radius_m", radius_m), min_neighbors, return_indices
+        points,
+        _number("radius_outlier_removal", "radius_m", radius_m),
+        _whole("radius_outlier_removal", "min_neighbors", min_neighbors),
+        return_indices,
     )
 
 
@@ -206,8 +219,17 @@ def generate_pile(
     (typical, convex, concave, convex-concave), as ``autoshovel
     generate-pile`` makes it with the same arguments (``pattern``: area or
     rosette)."""
+    f = "generate_pile"
     return _native.generate_pile(
-        shape, points, scale, roll_deg, pitch_deg, pattern, sensor_height_m, fov_deg, seed
+        shape,
+        _whole(f, "points", points),
+        _number(f, "scale", scale),
+        _number(f, "roll_deg", roll_deg),
+        _number(f, "pitch_deg", pitch_deg),
+        pattern,
+        _number(f, "sensor_height_m", sensor_height_m),
+        _number(f, "fov_deg", fov_deg),
+        _whole(f, "seed", seed),
     )
 
 
@@ -256,7 +278,9 @@ def plan_dig(
     all is an :class:`AutoshovelError`."""
     prof = None if profile is None else _existing("plan_dig", "profile", profile)
     native_pile = pile._native if isinstance(pile, Perception) else pile
-    text, path, surface = _native.plan_dig(native_pile, prof, seed, polish, search, init)
+    text, path, surface = _native.plan_dig(
+        native_pile, prof, _whole("plan_dig", "seed", seed), _whole("plan_dig", "polish", polish), search, init
+    )
     return DigPlan._from_json(text, tooth_path=path, pile_profile=surface)
 
 
@@ -269,7 +293,9 @@ def plan_path(
     """The crawler's walk (``autoshovel plan-path``) on a built-in scenario
     (straight, straight-reverse, curve, curve-reverse, v-shape) or a TOML
     file, with the improved (default) or classic ("apf") potential field."""
-    text, waypoints = _native.plan_path(os.fspath(scenario), planner, heading_tolerance_deg)
+    text, waypoints = _native.plan_path(
+        os.fspath(scenario), planner, _number("plan_path", "heading_tolerance_deg", heading_tolerance_deg)
+    )
     return PathPlan._from_json(text, waypoints=waypoints)
 
 
@@ -287,7 +313,7 @@ def track(
     rtk (default: the scenario's); ``controllers`` lays gains over the
     scenario's ``[controller.*]`` tables, e.g. ``{"pid": {"kp": 600}}``."""
     text, trajectory = _native.track(
-        os.fspath(scenario), controller, noise, seed, compare, dict(controllers or {})
+        os.fspath(scenario), controller, noise, _whole("track", "seed", seed), compare, dict(controllers or {})
     )
     return Tracking._from_json(text, trajectory=trajectory)
 
@@ -315,5 +341,8 @@ def study_paths(
     of this machine's cores: the summary and ``table``, the Markdown table
     the command prints. ``autoshovel.cluster`` runs the same study over a
     Ray cluster, with the same numbers."""
-    text, table = _native.study_paths(maps, seed, min_obstacles, max_obstacles)
+    f = "study_paths"
+    text, table = _native.study_paths(
+        _whole(f, "maps", maps), _whole(f, "seed", seed), _whole(f, "min_obstacles", min_obstacles), _whole(f, "max_obstacles", max_obstacles)
+    )
     return StudySummary._from_json(text, table=table)
