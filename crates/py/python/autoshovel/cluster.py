@@ -9,9 +9,9 @@ and the gathered result equals the single-machine run for the same seeds
 From the shell (``--address`` of a running cluster, ``local`` for a
 throwaway one on this machine)::
 
-    python -m autoshovel.cluster study-paths --maps 10000 --seed 1 --address local
-    python -m autoshovel.cluster plan-dig SCANS_FOLDER --address auto
-    python -m autoshovel.cluster track --controller pid --gain pid.kp=400,800,1200 --seeds 1-8
+    python -m autoshovel.cluster --address local study-paths --maps 10000 --seed 1
+    python -m autoshovel.cluster --address auto plan-dig SCANS_FOLDER
+    python -m autoshovel.cluster --address auto track --controller pid --gain pid.kp=400,800,1200 --seeds 1-8
 
 From Python: :func:`study_paths`, :func:`plan_dig_folder`, :func:`track_grid`.
 
@@ -281,8 +281,10 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                     if r["error"]:
                         print(f"{r['file']}: {r['error']}")
                     else:
-                        plan = dig.get("plan") or {}
-                        print(f"{r['file']}: {'feasible' if dig['success'] else 'no feasible plan'}, m_dig {plan.get('m_dig_kg', float('nan')):.3f} kg, f {plan.get('f', float('nan')):.3f}")
+                        if dig["success"]:
+                            print(f"{r['file']}: m_dig {dig['m_dig_kg']:.3f} kg, fill {100 * dig['fill_factor']:.0f} %, t_d {dig['td_s']:.2f} s, f {dig['f']:.3f}")
+                        else:
+                            print(f"{r['file']}: no feasible plan: {dig['error']}")
         else:
             gains = {}
             for g in args.gain:
