@@ -35,15 +35,17 @@ fn read_cloud(
     ))
 }
 
-/// `write_cloud(path, points, encoding)`: the points written whole to a
-/// file beside `path`, then moved over it (a failed write leaves nothing).
+/// `write_cloud(path, points, encoding, overwrite)`: the points written
+/// whole to a file beside `path`, then moved over it (a failed write leaves
+/// nothing); an existing file is kept unless `overwrite`.
 #[pyfunction]
-#[pyo3(signature = (path, points, encoding=None))]
+#[pyo3(signature = (path, points, encoding=None, overwrite=false))]
 fn write_cloud(
     py: Python<'_>,
     path: PathBuf,
     points: &Bound<'_, PyAny>,
     encoding: Option<&str>,
+    overwrite: bool,
 ) -> PyResult<()> {
     let array = points_arg("write_cloud", "points", points)?;
     let encoding = match encoding {
@@ -53,25 +55,38 @@ fn write_cloud(
         None => Encoding::default_for(&path),
     };
     let cloud = PointCloud::new(as_points(&array).to_vec());
+    // The output rule of every job (autoshovel_report::staging): a file
+    // beside the target, renamed over it once whole; `overwrite` is --force.
     py.detach(|| {
-        let name = path
-            .file_name()
-            .map(|n| n.to_string_lossy().into_owned())
-            .unwrap_or_default();
-        // The extension names the format: keep it last.
-        let partial = path.with_file_name(format!(".partial-{}-{name}", std::process::id()));
-        let done = autoshovel_cloud::io::write(&partial, &cloud, encoding).and_then(|()| {
-            std::fs::rename(&partial, &path).map_err(|source| autoshovel_cloud::CloudError::Io {
-                path: path.clone(),
-                source,
-            })
-        });
-        if done.is_err() {
-            let _ = std::fs::remove_file(&partial);
-        }
-        done
+        autoshovel_report::write_file_atomically::<WriteError>(
+            &path,
+            &[],
+            (&Default::default(), overwrite),
+            |p| Ok(autoshovel_cloud::io::write(p, &cloud, encoding)?),
+        )
     })
-    .map_err(lib_err)
+    .map_err(|e| match e {
+        WriteError::Report(e) => lib_err(e),
+        WriteError::Cloud(e) => lib_err(e),
+    })
+}
+
+/// What writing a cloud file can meet: the output rule's refusal, or the writer's error.
+enum WriteError {
+    Report(autoshovel_report::ReportError),
+    Cloud(autoshovel_cloud::CloudError),
+}
+
+impl From<autoshovel_report::ReportError> for WriteError {
+    fn from(e: autoshovel_report::ReportError) -> Self {
+        WriteError::Report(e)
+    }
+}
+
+impl From<autoshovel_cloud::CloudError> for WriteError {
+    fn from(e: autoshovel_cloud::CloudError) -> Self {
+        WriteError::Cloud(e)
+    }
 }
 
 /// PCL's `VoxelGrid`: the centroid of each occupied voxel ([RS eq. 18]–[RS eq. 19]).

@@ -169,3 +169,13 @@ def test_generate_pile_names_the_keyword(kw, words):
     with pytest.raises((ValueError, TypeError)) as e:
         autoshovel.generate_pile(**kw)
     assert words in str(e.value)
+
+
+def test_a_failed_write_names_the_file_and_leaves_nothing(tmp_path, pile):
+    with pytest.raises(AutoshovelError) as e:
+        autoshovel.write_cloud(tmp_path / "no-such-folder" / "x.pcd", pile)
+    assert "no-such-folder/x.pcd" in str(e.value)
+    with pytest.raises(AutoshovelError, match="encoding"):
+        # PLY has no compressed encoding: the writer refuses before writing.
+        autoshovel.write_cloud(tmp_path / "y.ply", pile, encoding="binary_compressed")
+    assert list(tmp_path.iterdir()) == []

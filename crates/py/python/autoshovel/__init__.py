@@ -123,7 +123,7 @@ def write_cloud(
     p = os.fspath(path)
     if os.path.exists(p) and not overwrite:
         raise FileExistsError(17, "write_cloud(): path exists (pass overwrite=True to replace it)", p)
-    _native.write_cloud(p, points, encoding)
+    _native.write_cloud(p, points, encoding, overwrite)
 
 
 # ---------------------------------------------------------------- filters
