@@ -409,7 +409,7 @@ fn perceive(
                     e => crate::AutoshovelError::new_err(format!(
                         "{}: {}",
                         p.display(),
-                        strip(lib_err(e), py)
+                        crate::message(&e)
                     )),
                 })?;
             (got, p.display().to_string())
@@ -427,11 +427,6 @@ fn perceive(
         source,
         summary,
     })
-}
-
-/// The message of an error made by [`lib_err`].
-fn strip(e: PyErr, py: Python<'_>) -> String {
-    e.value(py).to_string()
 }
 
 /// For `crates/py/bench/bench_calls.py`: the wall times [s] of `repeats`

@@ -212,7 +212,7 @@ fn plan_excavate(py: Python<'_>, scenario: &str, profile: Option<PathBuf>) -> Py
             "plan-excavate {} ({}): {}",
             setup.scenario.name,
             setup.scenario_source,
-            crate::lib_err(e).value(py)
+            crate::message(&e)
         ))
     })?;
     summary_json(&autoshovel_excavate::ExcavateSummary::new(&setup, &ex))

@@ -28,9 +28,9 @@ pyo3::create_exception!(
     "An error of the autoshovel library, with the message the command line prints."
 );
 
-/// The library's error as Python's `AutoshovelError`: the message and its
-/// causes, as the CLI prints them (`error: {e:#}`).
-pub(crate) fn lib_err(e: impl std::error::Error) -> PyErr {
+/// The message of a library error and its causes, as the CLI prints them
+/// (`error: {e:#}`).
+pub(crate) fn message(e: &dyn std::error::Error) -> String {
     let mut msg = e.to_string();
     let mut source = e.source();
     while let Some(s) = source {
@@ -40,7 +40,12 @@ pub(crate) fn lib_err(e: impl std::error::Error) -> PyErr {
         }
         source = s.source();
     }
-    AutoshovelError::new_err(msg)
+    msg
+}
+
+/// The library's error as Python's `AutoshovelError` with [`message`].
+pub(crate) fn lib_err(e: impl std::error::Error) -> PyErr {
+    AutoshovelError::new_err(message(&e))
 }
 
 /// A bad argument: `ValueError("{func}(): {what}")`.
