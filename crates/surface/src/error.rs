@@ -169,6 +169,25 @@ pub enum SurfaceError {
         #[source]
         source: std::io::Error,
     },
+    /// A tile's working file is not what the run wrote: missing, or of
+    /// another size (a worker that does not see the run's working folder,
+    /// or a file changed under the run).
+    #[error("tile working file {path}: {problem}")]
+    TileFile {
+        /// The file.
+        path: std::path::PathBuf,
+        /// What is wrong.
+        problem: String,
+    },
+    /// The executor of a stage's tiles failed, or its reports do not
+    /// answer its tasks one for one.
+    #[error("the {stage} stage's tiles: {problem}")]
+    TileExecutor {
+        /// The stage.
+        stage: String,
+        /// What went wrong.
+        problem: String,
+    },
     /// The scan holds no finite point.
     #[error("the scan holds no finite points ({non_finite_dropped} non-finite dropped)")]
     NoFinitePoints {

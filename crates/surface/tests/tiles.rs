@@ -13,7 +13,10 @@ use std::path::{Path, PathBuf};
 use autoshovel_cloud::io::{read, write, Encoding};
 use autoshovel_cloud::{Point, PointCloud};
 use autoshovel_surface::perceive::{perceive_after, PerceptionParams, Prior};
-use autoshovel_surface::tiles::{perceive_tiled, Survey, TileOptions, TiledPerceived};
+use autoshovel_surface::tiles::{
+    perceive_tiled, perceive_tiled_with, run_tile_task, Survey, TileExecutor, TileOptions,
+    TileReport, TileTask, TiledPerceived,
+};
 use autoshovel_surface::{generate_pile, PileParams, ScanPattern, SurfaceError};
 
 fn dir(name: &str) -> PathBuf {
@@ -337,5 +340,184 @@ fn a_survey_in_utm_metres_keeps_its_millimetres() {
         .map(|(p, q)| (0..3).map(|k| (q[k] - p[k]).abs()).fold(0.0f32, f32::max))
         .fold(0.0f32, f32::max);
     assert!(worst < 1e-4, "worst {worst} m");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+/// An executor as a cluster would be: every task sent as JSON and read
+/// back, the stage's tasks run last to first on two threads at once.
+struct Elsewhere {
+    /// Rewrites each task's JSON on its way (a worker's view of it).
+    route: fn(String) -> String,
+    /// Reports dropped from each stage's answer (a lost task).
+    drop_reports: usize,
+    stages: Vec<(String, usize)>,
+}
+
+impl Elsewhere {
+    fn new() -> Self {
+        Self {
+            route: |s| s,
+            drop_reports: 0,
+            stages: Vec::new(),
+        }
+    }
+}
+
+impl TileExecutor for Elsewhere {
+    fn run(
+        &mut self,
+        stage: &str,
+        tasks: Vec<TileTask>,
+        _progress: &mut dyn FnMut(&str, u64, u64),
+    ) -> Result<Vec<TileReport>, SurfaceError> {
+        self.stages.push((stage.to_string(), tasks.len()));
+        let sent: Vec<String> = tasks
+            .iter()
+            .rev()
+            .map(|t| (self.route)(serde_json::to_string(t).unwrap()))
+            .collect();
+        let half = sent.len().div_ceil(2);
+        let (a, b) = sent.split_at(half);
+        let work = |part: &[String]| -> Result<Vec<String>, SurfaceError> {
+            part.iter()
+                .map(|json| {
+                    let task: TileTask = serde_json::from_str(json).unwrap();
+                    let report = run_tile_task(&task)?;
+                    Ok(serde_json::to_string(&report).unwrap())
+                })
+                .collect()
+        };
+        let (ra, rb) = std::thread::scope(|s| {
+            let ha = s.spawn(|| work(a));
+            let hb = s.spawn(|| work(b));
+            (ha.join().unwrap(), hb.join().unwrap())
+        });
+        let mut reports: Vec<TileReport> = ra?
+            .into_iter()
+            .chain(rb?)
+            .map(|j| serde_json::from_str(&j).unwrap())
+            .collect();
+        reports.truncate(reports.len().saturating_sub(self.drop_reports));
+        Ok(reports)
+    }
+}
+
+fn run_elsewhere(
+    file: &Path,
+    opt: &TileOptions,
+    exec: &mut Elsewhere,
+) -> Result<(TiledPerceived, Vec<Point>), SurfaceError> {
+    let survey = Survey::open(&[file.to_path_buf()]).expect("survey");
+    let mut cleaned = Vec::new();
+    let got = perceive_tiled_with(
+        &survey,
+        &PerceptionParams::default(),
+        opt,
+        exec,
+        &mut |_, _, _| {},
+        &mut |tile| {
+            cleaned.extend_from_slice(&tile.cloud.points);
+            Ok(())
+        },
+    )?;
+    Ok((got, cleaned))
+}
+
+#[test]
+fn tasks_sent_elsewhere_in_any_order_give_the_same_survey_bit_for_bit() {
+    let d = dir("elsewhere");
+    let file = d.join("pile.laz");
+    write(
+        &file,
+        &pile(60_000, 13, ScanPattern::Rosette),
+        Encoding::Binary,
+    )
+    .unwrap();
+    let opt = options(3.0, &d);
+    let params = PerceptionParams::default();
+    let (here, cleaned_here) = tiled(std::slice::from_ref(&file), &params, &opt);
+    let mut exec = Elsewhere::new();
+    let (there, cleaned_there) = run_elsewhere(&file, &opt, &mut exec).expect("elsewhere");
+    // Tiles come back in the same order, so the cleaned survey is the same
+    // sequence, not only the same set.
+    assert!(
+        cleaned_here
+            .iter()
+            .map(|p| p.map(f32::to_bits))
+            .eq(cleaned_there.iter().map(|p| p.map(f32::to_bits))),
+        "the cleaned survey differs"
+    );
+    let no_times = |g: &TiledPerceived| {
+        let mut g = g.clone();
+        g.stages.iter_mut().for_each(|s| s.ms = 0.0);
+        g.peak_memory = None;
+        g
+    };
+    // Compared as printed: the height model's empty cells are NaN, which
+    // no float equals, and each value prints as the shortest text that
+    // reads back to it.
+    assert!(
+        format!("{:?}", no_times(&here)) == format!("{:?}", no_times(&there)),
+        "the runs' results differ"
+    );
+    // Radius, the statistical filter's two rounds, voxel, smoothing.
+    let names: Vec<&str> = exec.stages.iter().map(|s| s.0.as_str()).collect();
+    assert_eq!(
+        names,
+        ["radius", "statistical", "statistical", "voxel", "smooth"]
+    );
+    assert!(exec.stages.iter().all(|s| s.1 >= 20), "{:?}", exec.stages);
+    let left: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    let _ = std::fs::remove_dir_all(&d);
+}
+
+#[test]
+fn a_lost_task_or_a_worker_that_cannot_see_the_folder_stops_the_run_saying_so() {
+    let d = dir("lost");
+    let file = d.join("pile.laz");
+    write(
+        &file,
+        &pile(20_000, 17, ScanPattern::Area),
+        Encoding::Binary,
+    )
+    .unwrap();
+    let opt = options(4.0, &d);
+    // One report missing from a stage's answer.
+    let mut lost = Elsewhere {
+        drop_reports: 1,
+        ..Elsewhere::new()
+    };
+    let err = run_elsewhere(&file, &opt, &mut lost).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, SurfaceError::TileExecutor { .. }), "{msg}");
+    assert!(
+        msg.starts_with("the radius stage's tiles:") && msg.contains("1 tile(s) unanswered"),
+        "{msg}"
+    );
+    // Workers whose view of the working folder is elsewhere (an empty
+    // folder): the first file they read is named, not taken as empty.
+    let mut blind = Elsewhere {
+        route: |json| json.replace(".autoshovel-tiles-", "not-shared/.autoshovel-tiles-"),
+        ..Elsewhere::new()
+    };
+    let err = run_elsewhere(&file, &opt, &mut blind).unwrap_err();
+    let msg = err.to_string();
+    assert!(matches!(err, SurfaceError::TileFile { .. }), "{msg}");
+    assert!(
+        msg.contains("not-shared")
+            && msg.contains("does every worker see the run's working folder"),
+        "{msg}"
+    );
+    // Nothing left behind by either (the blind workers' own writes fail:
+    // their folder does not exist).
+    let left: Vec<_> = std::fs::read_dir(&d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
     let _ = std::fs::remove_dir_all(&d);
 }

@@ -32,11 +32,12 @@ use super::kdtree::KdTree;
 use super::normals::pca_normal;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
+use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "bilateral normal smoothing";
 
 /// Parameters of [`bilateral_normal_smoothing`] ([RS eq. 19]–[RS eq. 20]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BilateralParams {
     /// The neighbourhood radius r of N_r(P) [m], inclusive.
     pub radius_m: f64,

@@ -42,11 +42,12 @@ use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_po
 use super::grid::Grid;
 use super::kdtree::KdTree;
 use crate::{Point, PointCloud, Result};
+use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "radius outlier removal";
 
 /// Parameters of [`radius_outlier_removal`] ([RS eq. 13]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RadiusOutlierParams {
     /// The search radius K_s [m], inclusive.
     pub radius_m: f64,

@@ -70,7 +70,7 @@ pub enum OutlierSides {
 }
 
 /// Parameters of [`statistical_outlier_removal`] ([RS eq. 14]–[RS eq. 16]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct StatisticalOutlierParams {
     /// The number k of neighbours (not counting the point) whose mean
     /// distance d̄_i is taken (PCL's `mean_k_`, `-mean_k`).
@@ -272,7 +272,7 @@ fn mean_of(nearest: &[f32], mean_k: usize) -> f32 {
 /// The global sums of [RS eq. 14] in PCL's arithmetic (f64 sums, the square
 /// in f32), to be added in input order: the order fixes the rounding, so a
 /// caller that computes d̄_i by parts adds them back in the cloud's order.
-#[derive(Debug, Clone, Copy, Default, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq, Serialize, Deserialize)]
 pub struct DistanceSums {
     sum: f64,
     sq_sum: f64,

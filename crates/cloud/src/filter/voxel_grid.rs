@@ -31,11 +31,12 @@ use rayon::prelude::*;
 
 use super::common::{bad, empty_input, is_finite};
 use crate::{Point, PointCloud, Result};
+use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "voxel grid";
 
 /// Parameters of [`voxel_grid`] ([RS eq. 17]–[RS eq. 18]).
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct VoxelGridParams {
     /// The voxel edge r along x, y and z [m].
     pub leaf_m: [f64; 3],

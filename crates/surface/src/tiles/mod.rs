@@ -47,26 +47,40 @@
 //! to disk; a tile that would need more than [`TileOptions::memory_limit`]
 //! is an error that names it. The working files live in a folder of their
 //! own under [`TileOptions::work_dir`], removed when the run ends, failed
-//! or not. Tiles are independent units of work within a stage: the same
-//! loop could hand them to other machines.
+//! or not.
+//!
+//! **Anywhere.** Within a stage, tiles are independent: each is a
+//! [`TileTask`] (serialisable) that [`run_tile_task`] runs wherever the
+//! run's working folder can be seen, writing files no other task writes
+//! ([`store`]'s layout). [`perceive_tiled_with`] hands each stage's tasks to
+//! a [`TileExecutor`] and waits for all of them before the next; the
+//! statistical filter is two rounds, the mean distances and then the cut,
+//! with the sums of [RS eq. 14] added in survey order by the driver
+//! between them. [`perceive_tiled`] runs the tasks one after another here
+//! ([`InProcess`]); the Python package's Ray executor spreads them over a
+//! cluster, with the same result bit for bit.
+
+mod store;
+mod task;
 
 use std::collections::BTreeMap;
-use std::fs::{self, File, OpenOptions};
-use std::io::{BufReader, BufWriter, Read, Write};
+use std::fs::{self, File};
+use std::io::{BufReader, Read};
 use std::path::{Path, PathBuf};
 use std::time::Instant;
 
 use autoshovel_cloud::filter::{
-    bilateral_normal_smoothing, mean_distances_and_reach, mean_distances_and_reach_at,
-    pass_through_indices, radius_outlier_removal_indices, voxel_grid, BilateralParams,
-    DistanceSums, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams, VoxelCells,
-    VoxelGridParams,
+    pass_through_indices, BilateralParams, DistanceSums, PassThroughParams, RadiusOutlierParams,
+    StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_cloud::io::{las_header, read_files_in_order, LasHeader};
 use autoshovel_cloud::{CloudError, Point, PointCloud};
-use autoshovel_core::config;
 use nalgebra::Matrix3;
 use serde::Serialize;
+
+use store::{dist_path, Filing, Grid, Rec, Stage, DIST_RECORD};
+use task::{filter_err, Step};
+pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
 use crate::calibrate::{level, level_from_sensor, rotate_point};
 use crate::error::{Result, SurfaceError};
@@ -86,12 +100,6 @@ pub const BYTES_PER_POINT: u64 = 160;
 /// Most tiles a survey may be cut into (every tile's list is open at once
 /// when the statistical sums are merged).
 pub const MAX_TILES: usize = 512;
-
-/// Bytes of a point on disk: its index (u64) and x, y, z (f32), little-endian.
-const RECORD: usize = 20;
-
-/// Points a tile buffers before appending them to its file.
-const FLUSH_POINTS: usize = 1 << 14;
 
 /// Points per chunk read from the survey.
 const READ_CHUNK: usize = 1 << 16;
@@ -485,13 +493,6 @@ impl TiledSummary {
     }
 }
 
-/// A point on its way: its index in the survey and its position.
-#[derive(Debug, Clone, Copy, PartialEq)]
-struct Rec {
-    id: u64,
-    p: Point,
-}
-
 /// The working folder, removed when dropped.
 struct WorkDir(PathBuf);
 
@@ -499,264 +500,6 @@ impl Drop for WorkDir {
     fn drop(&mut self) {
         let _ = fs::remove_dir_all(&self.0);
     }
-}
-
-/// The tile grid in the levelled (x, y) plane.
-#[derive(Debug, Clone, Copy)]
-struct Grid {
-    origin: [f64; 2],
-    side: f64,
-    size: [usize; 2],
-}
-
-impl Grid {
-    fn tiles(&self) -> usize {
-        self.size[0] * self.size[1]
-    }
-
-    /// The tile of (x, y) (clamped to the grid).
-    fn tile_of(&self, p: &Point) -> usize {
-        let i = |a: usize| {
-            (((f64::from(p[a]) - self.origin[a]) / self.side)
-                .floor()
-                .max(0.0) as usize)
-                .min(self.size[a] - 1)
-        };
-        i(1) * self.size[0] + i(0)
-    }
-
-    /// The box of tile `t`: min x, min y, max x, max y.
-    fn bounds(&self, t: usize) -> [f64; 4] {
-        let (ix, iy) = (t % self.size[0], t / self.size[0]);
-        let x0 = self.origin[0] + ix as f64 * self.side;
-        let y0 = self.origin[1] + iy as f64 * self.side;
-        [x0, y0, x0 + self.side, y0 + self.side]
-    }
-
-    /// The (x, y) distance from `p` to tile `t`'s box (0 inside).
-    fn gap(&self, t: usize, p: &Point) -> f64 {
-        let b = self.bounds(t);
-        let (x, y) = (f64::from(p[0]), f64::from(p[1]));
-        let dx = (b[0] - x).max(x - b[2]).max(0.0);
-        let dy = (b[1] - y).max(y - b[3]).max(0.0);
-        dx.hypot(dy)
-    }
-
-    /// The tiles other than `t` whose boxes lie within `reach` of `t`'s.
-    fn around(&self, t: usize, reach: f64) -> Vec<usize> {
-        let most = self.size[0].max(self.size[1]) as f64;
-        let n = (reach / self.side).ceil().min(most) as isize;
-        let (ix, iy) = ((t % self.size[0]) as isize, (t / self.size[0]) as isize);
-        let mut out = Vec::new();
-        for y in (iy - n).max(0)..=(iy + n).min(self.size[1] as isize - 1) {
-            for x in (ix - n).max(0)..=(ix + n).min(self.size[0] as isize - 1) {
-                if (x, y) != (ix, iy) {
-                    out.push(y as usize * self.size[0] + x as usize);
-                }
-            }
-        }
-        out
-    }
-
-    fn name(&self, t: usize) -> String {
-        let b = self.bounds(t);
-        format!(
-            "({}, {}) [x {:.1}…{:.1} m, y {:.1}…{:.1} m]",
-            t % self.size[0],
-            t / self.size[0],
-            b[0],
-            b[2],
-            b[1],
-            b[3]
-        )
-    }
-}
-
-/// The tiles' files of one stage: each tile's own points and its halo,
-/// written through per-tile buffers.
-struct Lists {
-    dir: PathBuf,
-    tag: String,
-    own: Vec<Vec<Rec>>,
-    halo: Vec<Vec<Rec>>,
-    counts: Vec<u64>,
-}
-
-impl Lists {
-    fn new(dir: &Path, tag: &str, tiles: usize) -> Self {
-        Self {
-            dir: dir.to_path_buf(),
-            tag: tag.into(),
-            own: vec![Vec::new(); tiles],
-            halo: vec![Vec::new(); tiles],
-            counts: vec![0; tiles],
-        }
-    }
-
-    fn path(&self, t: usize, halo: bool) -> PathBuf {
-        self.dir.join(format!(
-            "{}-{t}.{}",
-            self.tag,
-            if halo { "halo" } else { "own" }
-        ))
-    }
-
-    /// Files `recs` (in survey order) under tile `t`, with a copy of each
-    /// in the halo of every other tile within `halo_m`.
-    fn put(&mut self, grid: &Grid, t: usize, recs: &[Rec], halo_m: f64) -> Result<()> {
-        for r in recs {
-            self.own[t].push(*r);
-            self.counts[t] += 1;
-        }
-        if self.own[t].len() >= FLUSH_POINTS {
-            self.flush_one(t, false)?;
-        }
-        // Only a point within halo_m of its tile's edge (or outside it)
-        // can lie within halo_m of another tile's box.
-        let b = grid.bounds(t);
-        let edge: Vec<Rec> = recs
-            .iter()
-            .filter(|r| {
-                let (x, y) = (f64::from(r.p[0]), f64::from(r.p[1]));
-                (x - b[0]).min(b[2] - x).min(y - b[1]).min(b[3] - y) <= halo_m
-            })
-            .copied()
-            .collect();
-        if edge.is_empty() {
-            return Ok(());
-        }
-        // The tiles whose halo may take a point of `t`: its neighbours
-        // within halo_m (points may lie a little outside their tile).
-        for u in grid.around(t, 2.0 * halo_m) {
-            let before = self.halo[u].len();
-            self.halo[u].extend(edge.iter().filter(|r| grid.gap(u, &r.p) <= halo_m));
-            if self.halo[u].len() >= FLUSH_POINTS && self.halo[u].len() > before {
-                self.flush_one(u, true)?;
-            }
-        }
-        Ok(())
-    }
-
-    fn flush_one(&mut self, t: usize, halo: bool) -> Result<()> {
-        let path = self.path(t, halo);
-        let buf = if halo {
-            &mut self.halo[t]
-        } else {
-            &mut self.own[t]
-        };
-        if buf.is_empty() {
-            return Ok(());
-        }
-        let spill = |source| SurfaceError::Spill {
-            path: path.clone(),
-            source,
-        };
-        let file = OpenOptions::new()
-            .create(true)
-            .append(true)
-            .open(&path)
-            .map_err(spill)?;
-        // Encoded on every core, written in one piece.
-        use rayon::prelude::*;
-        let mut bytes = vec![0u8; buf.len() * RECORD];
-        bytes
-            .par_chunks_exact_mut(RECORD)
-            .zip(buf.par_iter())
-            .for_each(|(b, r)| {
-                b[..8].copy_from_slice(&r.id.to_le_bytes());
-                for a in 0..3 {
-                    b[8 + 4 * a..12 + 4 * a].copy_from_slice(&r.p[a].to_le_bytes());
-                }
-            });
-        let mut file = file;
-        file.write_all(&bytes).map_err(spill)?;
-        // A whole tile's survivors pass through at once: keep no more
-        // than a buffer's worth, or every tile would hold its size.
-        buf.clear();
-        buf.shrink_to(FLUSH_POINTS);
-        Ok(())
-    }
-
-    /// Writes every buffer out.
-    fn flush(&mut self) -> Result<()> {
-        for t in 0..self.own.len() {
-            self.flush_one(t, false)?;
-            self.flush_one(t, true)?;
-        }
-        Ok(())
-    }
-
-    /// Tile `t`'s own points (or its halo), as written.
-    fn read(&self, t: usize, halo: bool) -> Result<Vec<Rec>> {
-        read_recs(&self.path(t, halo))
-    }
-
-    /// Removes the stage's files.
-    fn remove(&self) {
-        for t in 0..self.own.len() {
-            let _ = fs::remove_file(self.path(t, false));
-            let _ = fs::remove_file(self.path(t, true));
-        }
-    }
-
-    fn total(&self) -> u64 {
-        self.counts.iter().sum()
-    }
-}
-
-/// The records of a working file (none if it does not exist).
-fn read_recs(path: &Path) -> Result<Vec<Rec>> {
-    let spill = |source| SurfaceError::Spill {
-        path: path.to_path_buf(),
-        source,
-    };
-    let bytes = match fs::read(path) {
-        Ok(b) => b,
-        Err(e) if e.kind() == std::io::ErrorKind::NotFound => return Ok(Vec::new()),
-        Err(e) => return Err(spill(e)),
-    };
-    use rayon::prelude::*;
-    Ok(bytes.par_chunks_exact(RECORD).map(decode).collect())
-}
-
-#[inline]
-fn decode(b: &[u8]) -> Rec {
-    let f = |at: usize| f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
-    Rec {
-        id: u64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
-        p: [f(8), f(12), f(16)],
-    }
-}
-
-/// A tile with its halo: all points in survey order, and which are its own.
-struct Loaded {
-    recs: Vec<Rec>,
-    own: Vec<bool>,
-}
-
-impl Loaded {
-    fn cloud(&self) -> PointCloud {
-        PointCloud::new(self.recs.iter().map(|r| r.p).collect())
-    }
-}
-
-/// Merges two lists in survey order.
-fn merge(a: Vec<Rec>, b: Vec<Rec>) -> Loaded {
-    let mut recs = Vec::with_capacity(a.len() + b.len());
-    let mut own = Vec::with_capacity(a.len() + b.len());
-    let (mut i, mut j) = (0, 0);
-    while i < a.len() || j < b.len() {
-        if j == b.len() || (i < a.len() && a[i].id < b[j].id) {
-            recs.push(a[i]);
-            own.push(true);
-            i += 1;
-        } else {
-            recs.push(b[j]);
-            own.push(false);
-            j += 1;
-        }
-    }
-    Loaded { recs, own }
 }
 
 /// The process's peak resident memory [bytes] (Linux: VmHWM).
@@ -767,13 +510,29 @@ pub fn peak_memory() -> Option<u64> {
     Some(kb * 1024)
 }
 
-/// The pipeline of [`crate::perceive`] on a survey by tiles (module docs).
+/// The pipeline of [`crate::perceive`] on a survey by tiles (module docs),
+/// each stage's tiles one after another in this process.
 /// `progress(what, done, total)` reports each pass; `on_tile` receives each
 /// tile's cleaned points as they are done (its error stops the run).
 pub fn perceive_tiled(
     survey: &Survey,
     params: &PerceptionParams,
     options: &TileOptions,
+    progress: &mut dyn FnMut(&str, u64, u64),
+    on_tile: &mut dyn FnMut(&TileOutput) -> Result<()>,
+) -> Result<TiledPerceived> {
+    perceive_tiled_with(survey, params, options, &mut InProcess, progress, on_tile)
+}
+
+/// [`perceive_tiled`] with each stage's tiles run by `executor` (module
+/// docs): the survey is read, and the cleaned tiles handed on, here; the
+/// stages' tasks run wherever `executor` sends them, which must see
+/// [`TileOptions::work_dir`]. The result is the same whichever runs them.
+pub fn perceive_tiled_with(
+    survey: &Survey,
+    params: &PerceptionParams,
+    options: &TileOptions,
+    executor: &mut dyn TileExecutor,
     progress: &mut dyn FnMut(&str, u64, u64),
     on_tile: &mut dyn FnMut(&TileOutput) -> Result<()>,
 ) -> Result<TiledPerceived> {
@@ -908,7 +667,7 @@ pub fn perceive_tiled(
     let t1 = Instant::now();
     let threshold = floor.floor_height_m + p.ground.margin_m * scale;
     let ground = PassThroughParams::ground_removal(threshold);
-    let mut lists = Lists::new(&work.0, "s0", grid.tiles());
+    let mut lists = Filing::new(Stage::create(&work.0, 0, grid.tiles())?);
     let mut id = 0u64;
     let mut by_tile: Vec<Vec<Rec>> = vec![Vec::new(); grid.tiles()];
     let mut level_ms = 0.0;
@@ -958,7 +717,7 @@ pub fn perceive_tiled(
         return Err(e);
     }
     read?;
-    lists.flush()?;
+    let mut lists = lists.finish()?;
     let read2_ms = elapsed_ms(t1);
 
     stages[0].ms += read2_ms - level_ms;
@@ -996,13 +755,15 @@ pub fn perceive_tiled(
         points: ground_points as usize,
         ms: 0.0,
     });
-    let mut run = TileRun {
+    let mut run = Driver {
         grid,
         halo,
         limit: options.memory_limit,
-        largest: 0,
-        dir: work.0.clone(),
+        run: work.0.clone(),
         next: 1,
+        largest: 0,
+        researched: 0,
+        executor,
     };
     // The stages, in the paper's order.
     if p.radius.enabled {
@@ -1012,18 +773,7 @@ pub fn perceive_tiled(
             min_neighbors: p.radius.min_neighbors,
         };
         let before = lists.total();
-        lists = run.pass(lists, "radius", progress, |loaded| {
-            let kept = match radius_outlier_removal_indices(&loaded.cloud(), &params) {
-                Ok(kept) => kept,
-                Err(CloudError::Emptied { .. }) => Vec::new(),
-                Err(e) => return Err(filter_err("radius", e)),
-            };
-            Ok(kept
-                .into_iter()
-                .filter(|&i| loaded.own[i])
-                .map(|i| loaded.recs[i])
-                .collect())
-        })?;
+        lists = run.pass(lists, Step::Radius(params), progress)?;
         if lists.total() == 0 {
             return Err(emptied(
                 "radius",
@@ -1034,21 +784,19 @@ pub fn perceive_tiled(
         }
         stages.push(record("radius", &lists, t));
     }
-    let mut researched = 0;
     if p.statistical.enabled {
         let t = Instant::now();
-        let (next, again) = run.statistical(lists, p, progress)?;
-        lists = next;
-        researched = again;
+        let params = StatisticalOutlierParams {
+            mean_k: p.statistical.mean_k,
+            std_mul: p.statistical.std_mul,
+            sides: p.statistical.sides,
+        };
+        lists = run.statistical(lists, params, progress)?;
         stages.push(record("statistical", &lists, t));
     }
     if p.voxel.enabled {
         let t = Instant::now();
-        let params = VoxelGridParams::cube(leaf);
-        let cells = VoxelCells::new(&params).map_err(|e| filter_err("voxel", e))?;
-        lists = run.pass(lists, "voxel", progress, |loaded| {
-            voxels_of_tile(loaded, &params, &cells)
-        })?;
+        lists = run.pass(lists, Step::Voxel(VoxelGridParams::cube(leaf)), progress)?;
         stages.push(record("voxel", &lists, t));
     }
     if p.smooth.enabled {
@@ -1060,18 +808,7 @@ pub fn perceive_tiled(
             iterations: 1,
         };
         for _ in 0..p.smooth.iterations {
-            lists = run.pass(lists, "smooth", progress, |loaded| {
-                let moved = bilateral_normal_smoothing(&loaded.cloud(), &params)
-                    .map_err(|e| filter_err("smooth", e))?;
-                Ok(loaded
-                    .recs
-                    .iter()
-                    .zip(&moved.points)
-                    .zip(&loaded.own)
-                    .filter(|(_, &own)| own)
-                    .map(|((r, q), _)| Rec { id: r.id, p: *q })
-                    .collect())
-            })?;
+            lists = run.pass(lists, Step::Smooth(params), progress)?;
         }
         stages.push(record("smooth", &lists, t));
     }
@@ -1093,7 +830,7 @@ pub fn perceive_tiled(
     let mut used = 0;
     for tile in 0..grid.tiles() {
         progress("writing", tile as u64, grid.tiles() as u64);
-        let recs = lists.read(tile, false)?;
+        let recs = lists.read_own(tile)?;
         if recs.is_empty() {
             continue;
         }
@@ -1166,7 +903,7 @@ pub fn perceive_tiled(
         tiles_used: used,
         halo_m: halo,
         largest_tile_points: run.largest,
-        statistical_researched: researched,
+        statistical_researched: run.researched,
         stages,
         output_points,
         fit,
@@ -1177,7 +914,7 @@ pub fn perceive_tiled(
     })
 }
 
-fn record(stage: &'static str, lists: &Lists, t: Instant) -> StageRecord {
+fn record(stage: &'static str, lists: &Stage, t: Instant) -> StageRecord {
     StageRecord {
         stage,
         points: lists.total() as usize,
@@ -1189,11 +926,6 @@ fn elapsed_ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
-fn filter_err(stage: &'static str, source: CloudError) -> SurfaceError {
-    SurfaceError::Filter { stage, source }
-}
-
-/// A fresh working folder under `dir`.
 fn tempdir_in(dir: &Path) -> Result<WorkDir> {
     let stamp = std::time::SystemTime::now()
         .duration_since(std::time::UNIX_EPOCH)
@@ -1255,76 +987,107 @@ fn grid_over(
     Ok(Grid { origin, side, size })
 }
 
-/// The tiles of one run, stage after stage.
-struct TileRun {
+/// The stages of one run, each a round of tasks handed to the executor.
+struct Driver<'a> {
     grid: Grid,
     halo: f64,
     limit: u64,
-    largest: u64,
-    dir: PathBuf,
+    run: PathBuf,
     next: usize,
+    largest: u64,
+    researched: u64,
+    executor: &'a mut dyn TileExecutor,
 }
 
-impl TileRun {
-    /// Tile `t` with its halo, checked against the memory limit.
-    fn load(&mut self, lists: &Lists, t: usize) -> Result<Loaded> {
-        let own = lists.read(t, false)?;
-        let mut halo = lists.read(t, true)?;
-        let points = (own.len() + halo.len()) as u64;
-        self.largest = self.largest.max(points);
-        if points * BYTES_PER_POINT > self.limit {
-            return Err(SurfaceError::TileTooLarge {
-                tile: self.grid.name(t),
-                points,
-                need: config::bytes((points * BYTES_PER_POINT) as f64),
-                limit: config::bytes(self.limit as f64),
-            });
-        }
-        halo.sort_unstable_by_key(|r| r.id);
-        Ok(merge(own, halo))
+impl Driver<'_> {
+    /// A task of `step` for every tile of `input` that holds points.
+    fn tasks(&self, input: &Stage, output: &Path, step: &Step) -> Vec<TileTask> {
+        (0..self.grid.tiles())
+            .filter(|&t| input.own[t] > 0)
+            .map(|t| TileTask {
+                tile: t,
+                step: step.clone(),
+                input: input.dir.clone(),
+                output: output.to_path_buf(),
+                grid: self.grid,
+                halo_m: self.halo,
+                memory_limit: self.limit,
+                own: input.own.clone(),
+                halo: input.halo[t].clone(),
+            })
+            .collect()
     }
 
-    /// One stage over every tile: `stage` maps a tile with its halo to the
-    /// tile's own survivors (in survey order), filed for the next stage.
+    /// Runs `tasks` and checks that their reports answer them one for one
+    /// (sorted by tile).
+    fn execute(
+        &mut self,
+        stage: &'static str,
+        tasks: Vec<TileTask>,
+        progress: &mut dyn FnMut(&str, u64, u64),
+    ) -> Result<Vec<TileReport>> {
+        let asked: Vec<usize> = tasks.iter().map(|t| t.tile).collect();
+        let mut reports = self.executor.run(stage, tasks, progress)?;
+        reports.sort_by_key(|r| r.tile);
+        let answered: Vec<usize> = reports.iter().map(|r| r.tile).collect();
+        let bad = |problem: String| SurfaceError::TileExecutor {
+            stage: stage.into(),
+            problem,
+        };
+        if answered != asked {
+            let missing = asked.iter().filter(|t| !answered.contains(t)).count();
+            return Err(bad(format!(
+                "{} reports for {} tasks ({missing} tile(s) unanswered, the rest doubled or unknown)",
+                answered.len(),
+                asked.len()
+            )));
+        }
+        for r in &reports {
+            if let Some(&(u, _)) = r.halo.iter().find(|h| h.0 >= self.grid.tiles()) {
+                return Err(bad(format!(
+                    "tile {} reports a halo piece for tile {u}, outside the grid of {}",
+                    r.tile,
+                    self.grid.tiles()
+                )));
+            }
+            self.largest = self.largest.max(r.loaded);
+            self.researched += r.researched;
+        }
+        Ok(reports)
+    }
+
+    /// One stage: `step` on every tile of `input`, filed as the next stage.
     fn pass(
         &mut self,
-        lists: Lists,
-        name: &str,
+        input: Stage,
+        step: Step,
         progress: &mut dyn FnMut(&str, u64, u64),
-        mut stage: impl FnMut(&Loaded) -> Result<Vec<Rec>>,
-    ) -> Result<Lists> {
-        let tiles = self.grid.tiles();
-        let mut next = Lists::new(&self.dir, &format!("s{}", self.next), tiles);
+    ) -> Result<Stage> {
+        let mut output = Stage::create(&self.run, self.next, self.grid.tiles())?;
         self.next += 1;
-        for t in 0..tiles {
-            progress(name, t as u64, tiles as u64);
-            if lists.counts[t] == 0 {
-                continue;
+        let tasks = self.tasks(&input, &output.dir, &step);
+        for r in self.execute(step.stage(), tasks, progress)? {
+            output.own[r.tile] = r.kept;
+            for (u, n) in r.halo {
+                output.halo[u].push((Some(r.tile), n));
             }
-            let loaded = self.load(&lists, t)?;
-            let survivors = stage(&loaded)?;
-            next.put(&self.grid, t, &survivors, self.halo)?;
         }
-        progress(name, tiles as u64, tiles as u64);
-        next.flush()?;
-        lists.remove();
-        Ok(next)
+        input.remove();
+        Ok(output)
     }
 
-    /// The statistical filter [RS eq. 14]–[RS eq. 16] over every tile:
-    /// d̄_i of each point (searched again past the halo where its k-th
-    /// neighbour lies beyond what the halo vouches for), the global sums in
-    /// survey order, then the cut. Returns the survivors and how many
-    /// points were searched again.
+    /// The statistical filter [RS eq. 14]–[RS eq. 16]: every tile's d̄_i
+    /// (searched again past the halo where a point's k-th neighbour lies
+    /// beyond what the halo vouches for), the global sums in survey order
+    /// here, then the cut on every tile.
     fn statistical(
         &mut self,
-        lists: Lists,
-        p: &PerceptionParams,
+        input: Stage,
+        params: StatisticalOutlierParams,
         progress: &mut dyn FnMut(&str, u64, u64),
-    ) -> Result<(Lists, u64)> {
-        let tiles = self.grid.tiles();
-        let k = p.statistical.mean_k;
-        let total = lists.total();
+    ) -> Result<Stage> {
+        let k = params.mean_k;
+        let total = input.total();
         if k as u64 >= total {
             return Err(filter_err(
                 "statistical",
@@ -1337,161 +1100,21 @@ impl TileRun {
                 },
             ));
         }
-        let mut again = 0u64;
-        let dir = self.dir.clone();
-        let dist_path = |t: usize| dir.join(format!("dist-{t}"));
-        for t in 0..tiles {
-            progress("statistical", t as u64, tiles as u64);
-            if lists.counts[t] == 0 {
-                continue;
-            }
-            let loaded = self.load(&lists, t)?;
-            let cloud = loaded.cloud();
-            // Fewer points than k + 1 in the tile and halo: every own point
-            // is searched again.
-            let found = if cloud.len() > k {
-                mean_distances_and_reach(&cloud.points, k)
-                    .map_err(|e| filter_err("statistical", e))?
-            } else {
-                vec![(f32::NAN, f32::INFINITY); cloud.len()]
-            };
-            let mut own: Vec<(u64, Point, f32)> = Vec::new();
-            let mut unsure = Vec::new();
-            for (i, r) in loaded.recs.iter().enumerate() {
-                if !loaded.own[i] {
-                    continue;
-                }
-                let (d, reach2) = found[i];
-                // Points not loaded lie more than `halo` from the box, so
-                // more than halo − gap from this point.
-                let vouched = self.halo - self.grid.gap(t, &r.p);
-                if f64::from(reach2).sqrt() * (1.0 + 1e-6) > vouched {
-                    unsure.push((own.len(), f64::from(reach2).sqrt() + self.grid.gap(t, &r.p)));
-                }
-                own.push((r.id, r.p, d));
-            }
-            drop((loaded, cloud, found));
-            if !unsure.is_empty() {
-                again += unsure.len() as u64;
-                // Every point within the farthest reach, from the tiles'
-                // own lists (complete out to that distance).
-                let reach = unsure
-                    .iter()
-                    .map(|u| u.1)
-                    .fold(0.0_f64, f64::max)
-                    .min(f64::from(f32::MAX));
-                let mut wide: Vec<Point> = lists.read(t, false)?.iter().map(|r| r.p).collect();
-                for u in self.grid.around(t, reach + self.halo) {
-                    if lists.counts[u] == 0 {
-                        continue;
-                    }
-                    wide.extend(
-                        lists
-                            .read(u, false)?
-                            .iter()
-                            .filter(|r| self.grid.gap(t, &r.p) <= reach * (1.0 + 1e-6))
-                            .map(|r| r.p),
-                    );
-                    let points = wide.len() as u64;
-                    if points * BYTES_PER_POINT > self.limit {
-                        return Err(SurfaceError::TileTooLarge {
-                            tile: format!(
-                                "{} (searching {} outlier(s) {} m wide)",
-                                self.grid.name(t),
-                                unsure.len(),
-                                config::approx(reach)
-                            ),
-                            points,
-                            need: config::bytes((points * BYTES_PER_POINT) as f64),
-                            limit: config::bytes(self.limit as f64),
-                        });
-                    }
-                }
-                let queries: Vec<Point> = unsure.iter().map(|u| own[u.0].1).collect();
-                let exact = mean_distances_and_reach_at(&wide, &queries, k)
-                    .map_err(|e| filter_err("statistical", e))?;
-                for (u, (d, _)) in unsure.iter().zip(exact) {
-                    own[u.0].2 = d;
-                }
-            }
-            // The tile's d̄_i, in survey order.
-            let path = dist_path(t);
-            let spill = |source| SurfaceError::Spill {
-                path: path.clone(),
-                source,
-            };
-            let mut w = BufWriter::new(File::create(&path).map_err(spill)?);
-            for (id, _, d) in &own {
-                w.write_all(&id.to_le_bytes()).map_err(spill)?;
-                w.write_all(&d.to_le_bytes()).map_err(spill)?;
-            }
-            w.flush().map_err(spill)?;
-        }
-        // [RS eq. 14]: the sums in survey order, merging the tiles' lists.
-        let mut sums = DistanceSums::default();
-        {
-            // Each tile's list and its next (id, d̄_i).
-            type Head = (BufReader<File>, Option<(u64, f32)>);
-            let mut heads: Vec<Head> = Vec::new();
-            for t in 0..tiles {
-                if lists.counts[t] == 0 {
-                    continue;
-                }
-                let path = dist_path(t);
-                let f = File::open(&path).map_err(|source| SurfaceError::Spill {
-                    path: path.clone(),
-                    source,
-                })?;
-                let mut r = BufReader::with_capacity(1 << 16, f);
-                let first = next_dist(&mut r, &path)?;
-                heads.push((r, first));
-            }
-            let mut queue: std::collections::BinaryHeap<std::cmp::Reverse<(u64, usize)>> = heads
-                .iter()
-                .enumerate()
-                .filter_map(|(i, h)| h.1.map(|(id, _)| std::cmp::Reverse((id, i))))
-                .collect();
-            while let Some(std::cmp::Reverse((_, i))) = queue.pop() {
-                let (_, d) = heads[i].1.expect("queued heads hold a value");
-                sums.add(d);
-                let path = PathBuf::new();
-                heads[i].1 = next_dist(&mut heads[i].0, &path)?;
-                if let Some((id, _)) = heads[i].1 {
-                    queue.push(std::cmp::Reverse((id, i)));
-                }
+        let tasks = self.tasks(&input, &input.dir, &Step::Distances { mean_k: k });
+        for r in self.execute("statistical", tasks, progress)? {
+            if r.kept != input.own[r.tile] {
+                return Err(SurfaceError::TileExecutor {
+                    stage: "statistical".into(),
+                    problem: format!(
+                        "tile {} reports {} mean distances for its {} points",
+                        r.tile, r.kept, input.own[r.tile]
+                    ),
+                });
             }
         }
-        let cut = sums.cut(&StatisticalOutlierParams {
-            mean_k: k,
-            std_mul: p.statistical.std_mul,
-            sides: p.statistical.sides,
-        });
-        // [RS eq. 15]–[RS eq. 16]: the cut, tile by tile.
-        let mut next = Lists::new(&self.dir, &format!("s{}", self.next), tiles);
-        self.next += 1;
-        for t in 0..tiles {
-            if lists.counts[t] == 0 {
-                continue;
-            }
-            let own = lists.read(t, false)?;
-            let path = dist_path(t);
-            let bytes = fs::read(&path).map_err(|source| SurfaceError::Spill {
-                path: path.clone(),
-                source,
-            })?;
-            let kept: Vec<Rec> = own
-                .into_iter()
-                .zip(bytes.chunks_exact(12))
-                .filter(|(_, b)| cut.keeps(f32::from_le_bytes([b[8], b[9], b[10], b[11]])))
-                .map(|(r, _)| r)
-                .collect();
-            let _ = fs::remove_file(&path);
-            next.put(&self.grid, t, &kept, self.halo)?;
-        }
-        progress("statistical", tiles as u64, tiles as u64);
-        next.flush()?;
-        lists.remove();
-        if next.total() == 0 {
+        let sums = distance_sums(&input)?;
+        let output = self.pass(input, Step::Cut { sums, params }, progress)?;
+        if output.total() == 0 {
             return Err(filter_err(
                 "statistical",
                 CloudError::Emptied {
@@ -1501,8 +1124,53 @@ impl TileRun {
                 },
             ));
         }
-        Ok((next, again))
+        Ok(output)
     }
+}
+
+/// [RS eq. 14]: the sums of every tile's d̄_i in survey order, merging the
+/// tiles' `dist-{t}` files (each in survey order) by point index.
+fn distance_sums(stage: &Stage) -> Result<DistanceSums> {
+    let mut sums = DistanceSums::default();
+    // Each tile's file and its next (id, d̄_i).
+    type Head = (BufReader<File>, Option<(u64, f32)>, PathBuf);
+    let mut heads: Vec<Head> = Vec::new();
+    for (t, &n) in stage.own.iter().enumerate() {
+        if n == 0 {
+            continue;
+        }
+        let path = dist_path(&stage.dir, t);
+        let spill = |source| SurfaceError::Spill {
+            path: path.clone(),
+            source,
+        };
+        let f = File::open(&path).map_err(spill)?;
+        let len = f.metadata().map_err(spill)?.len();
+        if len != n * DIST_RECORD as u64 {
+            return Err(SurfaceError::TileFile {
+                path,
+                problem: format!("holds {len} bytes where {n} mean distances were written"),
+            });
+        }
+        let mut r = BufReader::with_capacity(1 << 16, f);
+        let first = next_dist(&mut r, &path)?;
+        heads.push((r, first, path));
+    }
+    let mut queue: std::collections::BinaryHeap<std::cmp::Reverse<(u64, usize)>> = heads
+        .iter()
+        .enumerate()
+        .filter_map(|(i, h)| h.1.map(|(id, _)| std::cmp::Reverse((id, i))))
+        .collect();
+    while let Some(std::cmp::Reverse((_, i))) = queue.pop() {
+        let (_, d) = heads[i].1.expect("queued heads hold a value");
+        sums.add(d);
+        let (r, next, path) = &mut heads[i];
+        *next = next_dist(r, path)?;
+        if let Some((id, _)) = *next {
+            queue.push(std::cmp::Reverse((id, i)));
+        }
+    }
+    Ok(sums)
 }
 
 /// The next (id, d̄_i) of a tile's list.
@@ -1519,96 +1187,4 @@ fn next_dist(r: &mut BufReader<File>, path: &Path) -> Result<Option<(u64, f32)>>
             source,
         }),
     }
-}
-
-/// The voxel grid [RS eq. 17]–[RS eq. 18] of the voxels a tile owns (those
-/// whose first point in survey order is its own), each centroid filed
-/// under its first point's index.
-fn voxels_of_tile(
-    loaded: &Loaded,
-    params: &VoxelGridParams,
-    cells: &VoxelCells,
-) -> Result<Vec<Rec>> {
-    use rayon::prelude::*;
-    // (voxel z, y, x, position) of every loaded point, sorted: a voxel's
-    // run starts with its first point. Packed into one u64 (voxel index
-    // above, position below) when the tile's voxels number at most 2³².
-    let voxel: Vec<[i64; 3]> = loaded.recs.par_iter().map(|r| cells.of(&r.p)).collect();
-    let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
-    for c in &voxel {
-        for a in 0..3 {
-            lo[a] = lo[a].min(c[a]);
-            hi[a] = hi[a].max(c[a]);
-        }
-    }
-    let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]) as u128 + 1);
-    let keys: Vec<([i64; 3], u32)> = if extent[0] * extent[1] * extent[2] <= 1 << 32 {
-        let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
-        let mut packed: Vec<u64> = voxel
-            .par_iter()
-            .enumerate()
-            .map(|(i, c)| {
-                let l = (c[0] - lo[0]) as u64
-                    + (c[1] - lo[1]) as u64 * ex
-                    + (c[2] - lo[2]) as u64 * exy;
-                (l << 32) | i as u64
-            })
-            .collect();
-        packed.par_sort_unstable();
-        packed
-            .into_iter()
-            .map(|k| {
-                let i = (k & 0xffff_ffff) as usize;
-                let c = voxel[i];
-                ([c[2], c[1], c[0]], i as u32)
-            })
-            .collect()
-    } else {
-        let mut keys: Vec<([i64; 3], u32)> = voxel
-            .iter()
-            .enumerate()
-            .map(|(i, c)| ([c[2], c[1], c[0]], i as u32))
-            .collect();
-        keys.par_sort_unstable();
-        keys
-    };
-    let mut mine = vec![false; loaded.recs.len()];
-    let mut owners = Vec::new();
-    let mut s = 0;
-    while s < keys.len() {
-        let mut e = s;
-        while e < keys.len() && keys[e].0 == keys[s].0 {
-            e += 1;
-        }
-        let first = keys[s].1 as usize;
-        if loaded.own[first] {
-            owners.push(loaded.recs[first].id);
-            for k in &keys[s..e] {
-                mine[k.1 as usize] = true;
-            }
-        }
-        s = e;
-    }
-    if owners.is_empty() {
-        return Ok(Vec::new());
-    }
-    // The owned voxels' points in survey order, averaged by the filter
-    // itself; its centroids come in (z, y, x) voxel order, as `owners`.
-    let points: Vec<Point> = loaded
-        .recs
-        .iter()
-        .zip(&mine)
-        .filter(|(_, &m)| m)
-        .map(|(r, _)| r.p)
-        .collect();
-    let centroids =
-        voxel_grid(&PointCloud::new(points), params).map_err(|e| filter_err("voxel", e))?;
-    debug_assert_eq!(centroids.len(), owners.len());
-    let mut out: Vec<Rec> = owners
-        .into_iter()
-        .zip(centroids.points)
-        .map(|(id, p)| Rec { id, p })
-        .collect();
-    out.sort_unstable_by_key(|r| r.id);
-    Ok(out)
 }
