@@ -370,7 +370,7 @@ pub fn perceive_tiles(
         },
         &mut |tile| {
             if let Some(d) = &tiles_dir {
-                let f = d.join(format!("tile-{:03}-{:03}.laz", tile.tile[0], tile.tile[1]));
+                let f = d.join(tile.file_name());
                 autoshovel_cloud::io::write(
                     &f,
                     &tile.cloud,

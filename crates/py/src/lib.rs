@@ -20,6 +20,7 @@ use pyo3::types::{PyBool, PyDict, PyFloat, PyInt, PyList, PyString, PyTuple};
 
 mod cloud;
 mod jobs;
+mod survey;
 
 pyo3::create_exception!(
     _native,
@@ -207,7 +208,39 @@ where
         Some(path) => format!("{path} with {func}()'s keyword arguments"),
         None => format!("{func}()'s keyword arguments"),
     };
-    T::from_toml(&text, &source).map_err(lib_err)
+    T::from_toml(&text, &source)
+        .map_err(|e| AutoshovelError::new_err(at_key(&message(&e), &source, &text)))
+}
+
+/// A settings error located by line (and column) in the merged text the
+/// caller never sees, located instead by its table and key:
+/// `f()'s keyword arguments:31:10: invalid type…` becomes
+/// `f()'s keyword arguments: [statistical] mean_k = "many": invalid type…`.
+fn at_key(msg: &str, source: &str, text: &str) -> String {
+    let Some(rest) = msg.strip_prefix(source).and_then(|r| r.strip_prefix(':')) else {
+        return msg.to_string();
+    };
+    // "31:10: why" or "31: why".
+    let Some(line) = rest.split(':').next().and_then(|l| l.parse::<usize>().ok()) else {
+        return msg.to_string();
+    };
+    let tail = rest.split_once(": ").map_or(rest, |x| x.1).trim();
+    let lines: Vec<&str> = text.lines().collect();
+    let Some(own) = line.checked_sub(1).and_then(|i| lines.get(i)) else {
+        return format!("{source}: {tail}");
+    };
+    let table = lines[..line - 1]
+        .iter()
+        .rev()
+        .find(|l| l.trim_start().starts_with('['))
+        .map(|l| format!("{} ", l.trim()));
+    let entry = own.trim();
+    let key = entry.split('=').next().unwrap_or("").trim();
+    if !key.is_empty() && tail.contains(key) {
+        format!("{source}: {tail}")
+    } else {
+        format!("{source}: {}{entry}: {tail}", table.unwrap_or_default())
+    }
 }
 
 /// Lays the keywords of `d` over `table` (a nested dict over a table).
@@ -292,5 +325,6 @@ fn _native(m: &Bound<'_, PyModule>) -> PyResult<()> {
     )?;
     cloud::register(m)?;
     jobs::register(m)?;
+    survey::register(m)?;
     Ok(())
 }

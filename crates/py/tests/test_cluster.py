@@ -75,3 +75,21 @@ def test_plan_dig_over_a_folder_of_scans(local, tmp_path):
         assert r["error"] is None
         direct = autoshovel.plan_dig(autoshovel.perceive(r["file"]), polish=100)
         same_but_times(r["dig"], direct.to_dict())
+
+
+def test_a_survey_on_the_cluster_equals_one_machine(local, tmp_path, pile):
+    survey = tmp_path / "pile.laz"
+    autoshovel.write_cloud(survey, pile)
+    alone = autoshovel.perceive_survey(survey, tile_m=4.0, tiles_dir=tmp_path / "alone")
+    spread = cluster.perceive_survey(survey, tile_m=4.0, tiles_dir=tmp_path / "spread", work_dir=tmp_path)
+    drop = ("peak_memory_bytes", "points_per_s")
+    same_but_times(
+        {k: v for k, v in spread.to_dict().items() if k not in drop},
+        {k: v for k, v in alone.to_dict().items() if k not in drop},
+    )
+    assert np.array_equal(spread.height_model, alone.height_model, equal_nan=True)
+    assert [os.path.basename(f) for f in spread.tile_files] == [os.path.basename(f) for f in alone.tile_files]
+    for a, b in zip(alone.tile_files, spread.tile_files):
+        np.testing.assert_array_equal(autoshovel.read_cloud(a), autoshovel.read_cloud(b))
+    # The run's working files are gone.
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["alone", "pile.laz", "spread"]

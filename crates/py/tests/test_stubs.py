@@ -3,6 +3,7 @@ result class exactly the fields of the summary the library makes."""
 
 import ast
 import inspect
+import tempfile
 from pathlib import Path
 
 import pytest
@@ -11,7 +12,13 @@ import autoshovel
 
 STUB = Path(autoshovel.__file__).with_name("__init__.pyi")
 # Arrays and the table that a result carries beside its summary's fields.
-EXTRAS = {"tooth_path", "pile_profile", "waypoints", "trajectory", "table"}
+EXTRAS = {"tooth_path", "pile_profile", "waypoints", "trajectory", "table", "height_model", "model_origin", "tile_files"}
+
+
+def as_laz(points):
+    path = Path(tempfile.mkdtemp()) / "survey.laz"
+    autoshovel.write_cloud(path, points)
+    return path
 
 
 def stub_classes():
@@ -40,6 +47,7 @@ def test_every_public_function_has_a_stub():
         ("Tracking", lambda pile: autoshovel.track("fig9a")),
         ("Excavation", lambda pile: autoshovel.plan_excavate("paper-over")),
         ("StudySummary", lambda pile: autoshovel.study_paths(3)),
+        ("SurveyPerception", lambda pile: autoshovel.perceive_survey(as_laz(pile), tile_m=4.0)),
     ],
 )
 def test_stub_fields_are_the_summary_fields(pile, cls, make):

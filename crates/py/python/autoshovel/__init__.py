@@ -18,7 +18,7 @@ for studies spread over a Ray cluster.
 from __future__ import annotations
 
 import os
-from typing import Any, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, List, Mapping, Optional, Sequence, Union
 
 import numpy as np
 
@@ -35,6 +35,7 @@ from ._summary import (
     Perception,
     StudySummary,
     Summary,
+    SurveyPerception,
     Tracking,
 )
 
@@ -48,11 +49,13 @@ __all__ = [
     "Perception",
     "StudySummary",
     "Summary",
+    "SurveyPerception",
     "Tracking",
     "generate_pile",
     "level",
     "pass_through",
     "perceive",
+    "perceive_survey",
     "plan_dig",
     "plan_excavate",
     "plan_path",
@@ -256,6 +259,82 @@ def perceive(
             f"perceive(): cloud must be an (N, 3) float32 array or a path, got {type(cloud).__name__}"
         )
     return Perception._from_json(native.summary_json(), _native=native)
+
+
+Executor = Callable[[str, List[str]], List[str]]
+
+
+def perceive_survey(
+    inputs: Union[PathLike, Sequence[PathLike]],
+    *,
+    tiles_dir: Optional[PathLike] = None,
+    overwrite: bool = False,
+    tile_m: Optional[float] = None,
+    memory_limit_gib: float = 2.0,
+    sample_points: int = 2_000_000,
+    model_cell_m: float = 1.0,
+    work_dir: Optional[PathLike] = None,
+    executor: Optional[Executor] = None,
+    config: Optional[PathLike] = None,
+    **settings: Any,
+) -> SurveyPerception:
+    """The §3 pipeline on a LAS/LAZ survey larger than memory, by tiles with
+    halos, as ``autoshovel perceive --tiles``: the whole cloud's result in
+    bounded memory. ``inputs``: a file, a folder of .las/.laz files, or a
+    list of them, taken as one survey in order.
+
+    The cleaned points go to ``tiles_dir`` as ``tile-CCC-RRR.laz`` (written
+    beside and moved in when the run succeeds; existing tiles are kept
+    unless ``overwrite``). The result's ``height_model`` is the mean
+    cleaned height per ``model_cell_m`` cell (rows y, columns x, NaN where
+    nothing), its lower corner ``model_origin``.
+
+    Each stage's tiles are tasks; ``executor(stage, tasks) -> reports``
+    (JSON text, each task run by ``autoshovel._native.run_tile_task``) may
+    run them elsewhere, as :func:`autoshovel.cluster.perceive_survey` does
+    on Ray; every worker must then see ``work_dir``, where the run keeps
+    its working files (default: the system's temporary folder). Settings:
+    as :func:`perceive`."""
+    f = "perceive_survey"
+    if isinstance(inputs, (str, os.PathLike)):
+        items = [inputs]
+    elif isinstance(inputs, (list, tuple)) and all(isinstance(p, (str, os.PathLike)) for p in inputs):
+        items = list(inputs)
+    else:
+        raise TypeError(f"{f}(): inputs must be a LAS/LAZ path (file or folder) or a list of them, got {type(inputs).__name__}")
+    if not items:
+        raise ValueError(f"{f}(): inputs is empty: give a LAS/LAZ file or folder")
+    paths = [_existing(f, "inputs", p) for p in items]
+    cfg = None if config is None else _existing(f, "config", config)
+    limit = _number(f, "memory_limit_gib", memory_limit_gib)
+    if limit <= 0:
+        raise ValueError(f"{f}(): memory_limit_gib = {limit}: expected a size > 0")
+    tiles = None
+    if tiles_dir is not None:
+        tiles = os.fspath(tiles_dir)
+        if os.path.exists(tiles) and not os.path.isdir(tiles):
+            raise NotADirectoryError(20, f"{f}(): tiles_dir is a file", tiles)
+        if os.path.isdir(tiles) and not overwrite:
+            taken = sorted(n for n in os.listdir(tiles) if n.startswith("tile-") and n.endswith(".laz"))
+            if taken:
+                raise FileExistsError(
+                    17, f"{f}(): tiles_dir holds {len(taken)} tile file(s) ({taken[0]}, …): give overwrite=True to replace them", tiles
+                )
+    if executor is not None and not callable(executor):
+        raise TypeError(f"{f}(): executor must be callable(stage, tasks) -> reports, got {type(executor).__name__}")
+    text, model, origin, files = _native.perceive_survey(
+        paths,
+        cfg,
+        settings,
+        None if tile_m is None else _number(f, "tile_m", tile_m),
+        int(limit * 2**30),
+        _whole(f, "sample_points", sample_points),
+        _number(f, "model_cell_m", model_cell_m),
+        None if work_dir is None else _existing(f, "work_dir", work_dir),
+        tiles,
+        executor,
+    )
+    return SurveyPerception._from_json(text, height_model=model, model_origin=origin, tile_files=files)
 
 
 # ---------------------------------------------------------------- planners

@@ -3,7 +3,7 @@
 # summary.json for the job; tests/test_stubs.py holds them to the summaries
 # the library makes.
 from os import PathLike
-from typing import Any, Iterator, Mapping, Optional, Sequence, Union
+from typing import Any, Callable, Iterator, Mapping, Optional, Sequence, Union
 
 import numpy as np
 import numpy.typing as npt
@@ -57,6 +57,51 @@ class Perception(Summary):
     @property
     def points(self) -> npt.NDArray[np.float32]: ...
     def surface_height(self, x: npt.ArrayLike, y: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
+
+class SurveyPerception(Summary):
+    """What perceive_survey() made: `autoshovel perceive --tiles --json`'s fields, the height model and the tiles written."""
+    fit: Optional[Summary]
+    fit_note: Optional[str]
+    files: list[str]
+    floor_height_m: float
+    floor_points: int
+    floor_rms_m: float
+    floor_share: float
+    format: str
+    grid: list[int]
+    halo_m: float
+    input: str
+    input_points: int
+    job: str
+    largest_tile_points: int
+    memory_limit_bytes: int
+    mode: str
+    model_cell_m: float
+    model_size: list[int]
+    non_finite_dropped: int
+    origin_m: list[float]
+    output_points: int
+    peak_memory_bytes: Optional[int]
+    pipeline: Summary
+    pitch_deg: float
+    points_below_floor: int
+    points_per_s: float
+    r2: Optional[float]
+    roll_deg: float
+    sample_points: int
+    scale: float
+    spacing_m: float
+    stage_points: Summary
+    stages: list[Any]
+    statistical_researched: int
+    success: bool
+    tile_m: float
+    tiles_used: int
+    timings_ms: Summary
+    total_ms: float
+    height_model: npt.NDArray[np.float64]
+    model_origin: tuple[float, float]
+    tile_files: list[str]
 
 class DigPlan(Summary):
     """A dig plan: `autoshovel plan-dig --json`'s fields, the tooth path and the pile's profile."""
@@ -223,6 +268,7 @@ def pass_through(points: Points, axis: str = "z", min_m: float = ..., max_m: flo
 def level(points: Points, roll_deg: float, pitch_deg: float) -> Points: ...
 def generate_pile(shape: str = "typical", points: int = 100_000, *, scale: float = 1.0, roll_deg: float = 3.0, pitch_deg: float = -2.0, pattern: str = "area", sensor_height_m: float = 12.0, fov_deg: float = 70.4, seed: int = 1) -> Points: ...
 def perceive(cloud: Union[Points, str, PathLike[str]], *, config: Optional[Union[str, PathLike[str]]] = None, **settings: Any) -> Perception: ...
+def perceive_survey(inputs: Union[str, PathLike[str], Sequence[Union[str, PathLike[str]]]], *, tiles_dir: Optional[Union[str, PathLike[str]]] = None, overwrite: bool = False, tile_m: Optional[float] = None, memory_limit_gib: float = 2.0, sample_points: int = 2_000_000, model_cell_m: float = 1.0, work_dir: Optional[Union[str, PathLike[str]]] = None, executor: Optional[Callable[[str, list[str]], list[str]]] = None, config: Optional[Union[str, PathLike[str]]] = None, **settings: Any) -> SurveyPerception: ...
 def plan_dig(pile: Union[str, Perception] = "typical", *, profile: Optional[Union[str, PathLike[str]]] = None, seed: int = 1, polish: int = ..., search: str = "bends", init: str = "good-point-set") -> DigPlan: ...
 def plan_path(scenario: Union[str, PathLike[str]] = "curve", *, planner: str = "improved-apf", heading_tolerance_deg: float = ...) -> PathPlan: ...
 def track(scenario: Union[str, PathLike[str]] = "fig9a", *, controller: str = "fuzzy", noise: Optional[str] = None, seed: int = 1, compare: bool = False, controllers: Optional[Mapping[str, Any]] = None) -> Tracking: ...

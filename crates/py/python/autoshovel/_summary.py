@@ -99,6 +99,16 @@ class Perception(Summary):
         return self._native.surface_height(x, y)
 
 
+class SurveyPerception(Summary):
+    """What :func:`autoshovel.perceive_survey` made: the fields of
+    ``autoshovel perceive --tiles --json``, ``height_model`` (mean cleaned
+    height per cell, rows y and columns x, NaN where no point) with its
+    lower corner ``model_origin`` (x, y) [m], and ``tile_files``, the
+    cleaned tiles written (empty without ``tiles_dir``)."""
+
+    __slots__ = ("height_model", "model_origin", "tile_files")
+
+
 class DigPlan(Summary):
     """A dig plan (``autoshovel plan-dig --json``) with the tooth path
     ``tooth_path`` [t_s, x_m, y_m, load_kg] and the pile's profile

@@ -13,7 +13,10 @@ throwaway one on this machine)::
     python -m autoshovel.cluster --address auto plan-dig SCANS_FOLDER
     python -m autoshovel.cluster --address auto track --controller pid --gain pid.kp=400,800,1200 --seeds 1-8
 
-From Python: :func:`study_paths`, :func:`plan_dig_folder`, :func:`track_grid`.
+    python -m autoshovel.cluster --address auto perceive-survey SURVEY.laz --work-dir /shared/tmp --tiles-dir out/tiles
+
+From Python: :func:`study_paths`, :func:`plan_dig_folder`, :func:`track_grid`,
+:func:`perceive_survey`.
 
 Ray is this community's engine for many small independent tasks (Dask fits
 array pipelines better; these studies are bags of tasks). Every task runs
@@ -34,7 +37,7 @@ from typing import Any, Dict, Iterable, List, Mapping, Optional, Sequence
 
 import autoshovel
 from autoshovel import _native
-from autoshovel._summary import StudySummary
+from autoshovel._summary import StudySummary, SurveyPerception
 
 try:  # Ray is optional: pip install "./crates/py[ray]"
     import ray
@@ -162,6 +165,42 @@ def track_grid(
     return ray.get(refs)
 
 
+def _tile(task: str, threads: int) -> str:
+    return _native.run_tile_task(task, threads)
+
+
+def ray_executor(cpus_per_task: int = 1):
+    """An executor for :func:`autoshovel.perceive_survey`: each stage's tile
+    tasks as Ray tasks of ``cpus_per_task`` CPUs (the tile's filters on as
+    many threads), all gathered before the next stage."""
+    _need_ray()
+    if cpus_per_task < 1:
+        raise ValueError(f"ray_executor(): cpus_per_task = {cpus_per_task}: expected at least 1")
+    task = ray.remote(num_cpus=cpus_per_task)(_tile)
+
+    def run(stage: str, tasks: List[str]) -> List[str]:
+        return ray.get([task.remote(t, cpus_per_task) for t in tasks])
+
+    return run
+
+
+def perceive_survey(
+    inputs: Any,
+    *,
+    work_dir: Optional[os.PathLike | str] = None,
+    cpus_per_task: int = 1,
+    **options: Any,
+) -> SurveyPerception:
+    """:func:`autoshovel.perceive_survey` with each stage's tiles spread
+    over the Ray cluster (:func:`ray_executor`): the same result, bit for
+    bit, as on one machine. The survey is read, and the cleaned tiles
+    written, by this process; the tiles' working files live in
+    ``work_dir``, which every worker must see (storage shared by the
+    cluster's machines; a local cluster shares this one's). A worker that
+    does not see it fails naming the file it could not find."""
+    return autoshovel.perceive_survey(inputs, work_dir=work_dir, executor=ray_executor(cpus_per_task), **options)
+
+
 # ---------------------------------------------------------------- a local cluster
 
 
@@ -258,6 +297,13 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
     t.add_argument("--controller", default="fuzzy")
     t.add_argument("--gain", action="append", default=[], help="NAME=V1,V2,... (e.g. pid.kp=400,800); repeatable")
     t.add_argument("--seeds", default="1-8", help="e.g. 1-8 or 1,5,9")
+    v = sub.add_parser("perceive-survey", help="a LAS/LAZ survey by tiles, the tiles of each stage spread over the cluster")
+    v.add_argument("inputs", nargs="+", help="LAS/LAZ files or folders, one survey in order")
+    v.add_argument("--work-dir", default=None, help="the run's working files: a folder every worker sees (default: the system's temporary folder)")
+    v.add_argument("--tiles-dir", default=None, help="where the cleaned tiles go (tile-CCC-RRR.laz)")
+    v.add_argument("--tile-size", type=float, default=None, help="tile side [m] (default: from the memory limit and density)")
+    v.add_argument("--memory-limit", type=float, default=2.0, help="most working memory of a tile [GiB]")
+    v.add_argument("--config", default=None, help="pipeline settings (TOML), as autoshovel perceive --config")
     args = p.parse_args(argv)
 
     local = _connect(args.address, args.workers)
@@ -285,6 +331,25 @@ def main(argv: Optional[Sequence[str]] = None) -> int:
                             print(f"{r['file']}: m_dig {dig['m_dig_kg']:.3f} kg, fill {100 * dig['fill_factor']:.0f} %, t_d {dig['td_s']:.2f} s, f {dig['f']:.3f}")
                         else:
                             print(f"{r['file']}: no feasible plan: {dig['error']}")
+        elif args.study == "perceive-survey":
+            got = perceive_survey(
+                args.inputs,
+                work_dir=args.work_dir,
+                tiles_dir=args.tiles_dir,
+                tile_m=args.tile_size,
+                memory_limit_gib=args.memory_limit,
+                config=args.config,
+            )
+            wall = time.perf_counter() - t0
+            if args.json:
+                print(got.to_json())
+            else:
+                print(
+                    f"{got.input}: {got.input_points} points in {got.tiles_used} tiles of {got.tile_m:.1f} m "
+                    f"(halo {got.halo_m:.2f} m) -> {got.output_points} cleaned; "
+                    + ", ".join(f"{s['stage']} {s['points']}" for s in got.stages)
+                )
+                print(f"{len(got.tile_files)} tile file(s) written; {wall:.1f} s on {int(ray.cluster_resources().get('CPU', 0))} worker CPUs", file=sys.stderr)
         else:
             gains = {}
             for g in args.gain:

@@ -288,6 +288,14 @@ pub struct TileOutput {
     pub cloud: PointCloud,
 }
 
+impl TileOutput {
+    /// The file name of the tile's cleaned points, `tile-{column}-{row}.laz`
+    /// (three digits each, so that names sort as the grid).
+    pub fn file_name(&self) -> String {
+        format!("tile-{:03}-{:03}.laz", self.tile[0], self.tile[1])
+    }
+}
+
 /// What [`perceive_tiled`] did.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TiledPerceived {
