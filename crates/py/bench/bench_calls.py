@@ -1,7 +1,7 @@
 """What a call from Python costs beside the same call from Rust, and what a
 study gains from one to two Ray worker processes (BENCHMARKS.md, "Python").
 
-    python crates/py/bench/bench_calls.py [--points 1000000] [--repeats 7] [--maps 2000]
+    python crates/py/bench/bench_calls.py [--points 1000000] [--repeats 7] [--maps 2000] [--survey-points 2000000]
 
 Calls: each filter and ``perceive`` on one generated pile (the Livox-like
 rosette pattern, 1.5 % outliers), timed from Python (``autoshovel.voxel_grid``
@@ -10,7 +10,9 @@ rosette pattern, 1.5 % outliers), timed from Python (``autoshovel.voxel_grid``
 
 Ray: the random-road study of ``--maps`` maps on a local cluster of one
 worker process, then of two (each task one thread), against the same
-study on one thread without Ray.
+study on one thread without Ray; and a survey by tiles, each stage's
+tiles as Ray tasks on one worker process, then two, against the same
+survey in this process on every core.
 """
 
 import argparse
@@ -74,17 +76,50 @@ def ray_speedup(maps: int) -> None:
     print(f"\nfrom 1 to 2 worker processes: {walls[1] / walls[2]:.2f}x")
 
 
+def survey_speedup(points: int) -> None:
+    """A survey of ``points`` (the rosette pile in one LAZ file, tiles of
+    2 m: about 60 of them) by tiles in this process (every core), then with
+    each stage's tiles as Ray tasks on one worker process, then on two."""
+    import tempfile
+
+    from autoshovel import cluster
+
+    with tempfile.TemporaryDirectory() as d:
+        path = os.path.join(d, "survey.laz")
+        autoshovel.write_cloud(path, autoshovel.generate_pile("typical", points, pattern="rosette", seed=1))
+        t0 = time.perf_counter()
+        here = autoshovel.perceive_survey(path, tile_m=2.0, work_dir=d)
+        walls = {0: time.perf_counter() - t0}
+        for workers in (1, 2):
+            with cluster.LocalCluster(workers=workers):
+                cluster.perceive_survey(path, tile_m=2.0, work_dir=d)  # start the worker processes
+                t0 = time.perf_counter()
+                got = cluster.perceive_survey(path, tile_m=2.0, work_dir=d)
+                walls[workers] = time.perf_counter() - t0
+            assert got.output_points == here.output_points
+    print(f"\n| survey by tiles, {points:,} points, {here.tiles_used} tiles of 2 m | wall | speed-up |")
+    print("|---|---|---|")
+    print(f"| this process, every core (rayon within a tile) | {walls[0]:.1f} s | 1.00 |")
+    for w in (1, 2):
+        print(f"| Ray, {w} worker process{'es' if w > 1 else ''} (a tile a task, one thread) | {walls[w]:.1f} s | {walls[0] / walls[w]:.2f} |")
+    print(f"\nfrom 1 to 2 worker processes: {walls[1] / walls[2]:.2f}x")
+
+
 def main() -> int:
     ap = argparse.ArgumentParser(description=__doc__.split("\n\n")[0])
     ap.add_argument("--points", type=int, default=1_000_000)
     ap.add_argument("--repeats", type=int, default=7)
     ap.add_argument("--maps", type=int, default=2000)
+    ap.add_argument("--survey-points", type=int, default=2_000_000)
+    ap.add_argument("--skip-calls", action="store_true")
     ap.add_argument("--skip-ray", action="store_true")
     a = ap.parse_args()
     print(f"autoshovel {autoshovel.__version__}, Python {sys.version.split()[0]}, numpy {np.__version__}, {os.cpu_count()} cores, {time.strftime('%Y-%m-%d')}\n")
-    calls(a.points, a.repeats)
+    if not a.skip_calls:
+        calls(a.points, a.repeats)
     if not a.skip_ray:
         ray_speedup(a.maps)
+        survey_speedup(a.survey_points)
     return 0
 
 

@@ -240,8 +240,22 @@ fn run_tile_task(py: Python<'_>, task: &str, threads: Option<usize>) -> PyResult
     serde_json::to_string(&report).map_err(lib_err)
 }
 
+/// Points a tile task loads (its tile and halo): what its time follows,
+/// for an executor that balances tasks.
+#[pyfunction]
+fn tile_task_points(task: &str) -> PyResult<u64> {
+    let task: TileTask = serde_json::from_str(task).map_err(|e| {
+        bad_arg(
+            "tile_task_points",
+            format!("task {task:.80?} is not a tile task: {e}"),
+        )
+    })?;
+    Ok(task.points())
+}
+
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
     m.add_function(wrap_pyfunction!(perceive_survey, m)?)?;
     m.add_function(wrap_pyfunction!(run_tile_task, m)?)?;
+    m.add_function(wrap_pyfunction!(tile_task_points, m)?)?;
     Ok(())
 }

@@ -37,6 +37,22 @@ def test_shards_cover_every_index_once():
         assert not sizes or max(sizes) - min(sizes) <= 1
 
 
+def test_balanced_groups_hold_every_index_once_and_near_equal_sums():
+    weights = [5, 1, 1, 200, 3, 0, 40, 40, 39, 2, 7, 7]
+    for bins in (1, 3, 5, 20):
+        groups = cluster.balanced(weights, bins)
+        assert sorted(i for g in groups for i in g) == list(range(len(weights)))
+        assert len(groups) <= bins and all(groups)
+        sums = [sum(weights[i] for i in g) for g in groups]
+        # Greedy heaviest-first: no group exceeds the lightest by more than
+        # its own lightest item, unless that item stands alone.
+        for g, s in zip(groups, sums):
+            assert len(g) == 1 or s - min(sums) <= min(weights[i] for i in g)
+    assert cluster.balanced(weights, 3) == cluster.balanced(list(weights), 3)
+    with pytest.raises(ValueError, match="bins = 0"):
+        cluster.balanced(weights, 0)
+
+
 def test_study_on_the_cluster_equals_one_machine(local):
     import ray
 

@@ -165,21 +165,42 @@ def track_grid(
     return ray.get(refs)
 
 
-def _tile(task: str, threads: int) -> str:
-    return _native.run_tile_task(task, threads)
+def _tiles(tasks: List[str], threads: int) -> List[str]:
+    return [_native.run_tile_task(t, threads) for t in tasks]
 
 
-def ray_executor(cpus_per_task: int = 1):
+def balanced(weights: Sequence[int], bins: int) -> List[List[int]]:
+    """Indices of ``weights`` in at most ``bins`` groups of near-equal sums:
+    the heaviest first, each to the lightest group so far (ties to the
+    lowest group); empty groups dropped. Deterministic."""
+    if bins < 1:
+        raise ValueError(f"balanced(): bins = {bins}: expected at least 1")
+    groups: List[List[int]] = [[] for _ in range(bins)]
+    sums = [0] * bins
+    for i in sorted(range(len(weights)), key=lambda i: (-weights[i], i)):
+        g = min(range(bins), key=lambda b: (sums[b], b))
+        groups[g].append(i)
+        sums[g] += weights[i]
+    return [g for g in groups if g]
+
+
+def ray_executor(cpus_per_task: int = 1, tasks_per_cpu: int = 4):
     """An executor for :func:`autoshovel.perceive_survey`: each stage's tile
-    tasks as Ray tasks of ``cpus_per_task`` CPUs (the tile's filters on as
-    many threads), all gathered before the next stage."""
+    tasks packed into ``tasks_per_cpu`` Ray tasks per CPU of the cluster,
+    balanced by the points each tile loads (a survey has many near-empty
+    edge tiles, and a Ray task costs a millisecond or two), each Ray task
+    of ``cpus_per_task`` CPUs (the filters on as many threads); all
+    gathered before the next stage."""
     _need_ray()
-    if cpus_per_task < 1:
-        raise ValueError(f"ray_executor(): cpus_per_task = {cpus_per_task}: expected at least 1")
-    task = ray.remote(num_cpus=cpus_per_task)(_tile)
+    if cpus_per_task < 1 or tasks_per_cpu < 1:
+        raise ValueError(f"ray_executor(): cpus_per_task = {cpus_per_task}, tasks_per_cpu = {tasks_per_cpu}: expected at least 1")
+    remote = ray.remote(num_cpus=cpus_per_task)(_tiles)
 
     def run(stage: str, tasks: List[str]) -> List[str]:
-        return ray.get([task.remote(t, cpus_per_task) for t in tasks])
+        cpus = max(1, int(ray.cluster_resources().get("CPU", 1)))
+        groups = balanced([_native.tile_task_points(t) for t in tasks], tasks_per_cpu * cpus)
+        done = ray.get([remote.remote([tasks[i] for i in g], cpus_per_task) for g in groups])
+        return [report for part in done for report in part]
 
     return run
 
