@@ -26,6 +26,17 @@ fn dir(name: &str) -> PathBuf {
     d
 }
 
+/// Asserts that the work folder `d` holds the survey file alone (no
+/// working file left behind), then removes it.
+fn only_the_survey_left(d: &Path) {
+    let left: Vec<_> = std::fs::read_dir(d)
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(left.len(), 1, "{left:?}");
+    let _ = std::fs::remove_dir_all(d);
+}
+
 fn pile(points: usize, seed: u64, pattern: ScanPattern) -> PointCloud {
     generate_pile(&PileParams {
         points,
@@ -131,12 +142,7 @@ fn tiles_keep_what_the_whole_cloud_keeps_bit_for_bit() {
     );
     check_against_whole(&whole, &params, &got, &cleaned);
     // Nothing left in the work folder but the survey itself.
-    let left: Vec<_> = std::fs::read_dir(&d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "{left:?}");
-    let _ = std::fs::remove_dir_all(&d);
+    only_the_survey_left(&d);
 }
 
 #[test]
@@ -279,12 +285,7 @@ fn a_tile_over_the_memory_limit_is_refused_naming_it_and_leaves_nothing() {
         msg.contains("tile (0, 0)") && msg.contains("--tile-size"),
         "{msg}"
     );
-    let left: Vec<_> = std::fs::read_dir(&d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "{left:?}");
-    let _ = std::fs::remove_dir_all(&d);
+    only_the_survey_left(&d);
 }
 
 #[test]
@@ -467,12 +468,7 @@ fn tasks_sent_elsewhere_in_any_order_give_the_same_survey_bit_for_bit() {
         ["radius", "statistical", "statistical", "voxel", "smooth"]
     );
     assert!(exec.stages.iter().all(|s| s.1 >= 20), "{:?}", exec.stages);
-    let left: Vec<_> = std::fs::read_dir(&d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "{left:?}");
-    let _ = std::fs::remove_dir_all(&d);
+    only_the_survey_left(&d);
 }
 
 #[test]
@@ -514,10 +510,5 @@ fn a_lost_task_or_a_worker_that_cannot_see_the_folder_stops_the_run_saying_so() 
     );
     // Nothing left behind by either (the blind workers' own writes fail:
     // their folder does not exist).
-    let left: Vec<_> = std::fs::read_dir(&d)
-        .unwrap()
-        .map(|e| e.unwrap().file_name())
-        .collect();
-    assert_eq!(left.len(), 1, "{left:?}");
-    let _ = std::fs::remove_dir_all(&d);
+    only_the_survey_left(&d);
 }

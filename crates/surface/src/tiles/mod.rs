@@ -52,7 +52,7 @@
 //! **Anywhere.** Within a stage, tiles are independent: each is a
 //! [`TileTask`] (serialisable) that [`run_tile_task`] runs wherever the
 //! run's working folder can be seen, writing files no other task writes
-//! ([`store`]'s layout). [`perceive_tiled_with`] hands each stage's tasks to
+//! (the layout of `tiles/store.rs`). [`perceive_tiled_with`] hands each stage's tasks to
 //! a [`TileExecutor`] and waits for all of them before the next; the
 //! statistical filter is two rounds, the mean distances and then the cut,
 //! with the sums of [RS eq. 14] added in survey order by the driver
