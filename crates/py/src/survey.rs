@@ -73,7 +73,10 @@ impl Staged {
     fn new(target: PathBuf) -> PyResult<Self> {
         let made_target = !target.exists();
         std::fs::create_dir_all(&target).map_err(|e| os_err(&target, e))?;
-        let partial = target.join(format!(".partial-{}", std::process::id()));
+        let stamp = std::time::SystemTime::now()
+            .duration_since(std::time::UNIX_EPOCH)
+            .map_or(0, |d| d.as_nanos());
+        let partial = target.join(format!(".partial-{}-{stamp}", std::process::id()));
         std::fs::create_dir_all(&partial).map_err(|e| os_err(&partial, e))?;
         Ok(Self {
             target,
