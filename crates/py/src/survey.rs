@@ -227,12 +227,7 @@ fn perceive_survey<'py>(
 #[pyfunction]
 #[pyo3(signature = (task, threads=None))]
 fn run_tile_task(py: Python<'_>, task: &str, threads: Option<usize>) -> PyResult<String> {
-    let task: TileTask = serde_json::from_str(task).map_err(|e| {
-        bad_arg(
-            "run_tile_task",
-            format!("task {task:.80?} is not a tile task: {e}"),
-        )
-    })?;
+    let task = parse_task("run_tile_task", task)?;
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(threads.unwrap_or(0))
         .build()
@@ -247,13 +242,13 @@ fn run_tile_task(py: Python<'_>, task: &str, threads: Option<usize>) -> PyResult
 /// for an executor that balances tasks.
 #[pyfunction]
 fn tile_task_points(task: &str) -> PyResult<u64> {
-    let task: TileTask = serde_json::from_str(task).map_err(|e| {
-        bad_arg(
-            "tile_task_points",
-            format!("task {task:.80?} is not a tile task: {e}"),
-        )
-    })?;
-    Ok(task.points())
+    Ok(parse_task("tile_task_points", task)?.points())
+}
+
+/// A `TileTask` from its JSON text, or a `ValueError` naming `func`.
+fn parse_task(func: &str, text: &str) -> PyResult<TileTask> {
+    serde_json::from_str(text)
+        .map_err(|e| bad_arg(func, format!("task {text:.80?} is not a tile task: {e}")))
 }
 
 pub(crate) fn register(m: &Bound<'_, PyModule>) -> PyResult<()> {
