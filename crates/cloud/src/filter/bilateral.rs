@@ -132,7 +132,13 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
             let pf = p.map(f64::from);
             let (mut num, mut den) = (0.0_f64, 0.0_f64);
             for &q in found.iter().filter(|&&q| q as usize != i) {
-                let d = [0, 1, 2].map(|a| f64::from(current[q as usize][a]) - pf[a]);
+                // (written out: `[0, 1, 2].map` here was left a call a point)
+                let c = &current[q as usize];
+                let d = [
+                    f64::from(c[0]) - pf[0],
+                    f64::from(c[1]) - pf[1],
+                    f64::from(c[2]) - pf[2],
+                ];
                 let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
                 // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩), two

@@ -198,7 +198,11 @@ pub(crate) fn pca_normal(points: impl Iterator<Item = Point> + Clone) -> Option<
     let mean = mean.map(|m| m / count as f64);
     let mut cov = [[0.0_f64; 3]; 3];
     for p in points {
-        let d = [0, 1, 2].map(|a| f64::from(p[a]) - mean[a]);
+        let d = [
+            f64::from(p[0]) - mean[0],
+            f64::from(p[1]) - mean[1],
+            f64::from(p[2]) - mean[2],
+        ];
         for r in 0..3 {
             for c in 0..3 {
                 cov[r][c] += d[r] * d[c];
@@ -217,7 +221,10 @@ pub(crate) fn pca_normal(points: impl Iterator<Item = Point> + Clone) -> Option<
 }
 
 /// Eigenvalues (ascending) and eigenvectors (as columns, in the same order)
-/// of a symmetric 3 × 3 matrix, by cyclic Jacobi rotations.
+/// of a symmetric 3 × 3 matrix, by cyclic Jacobi rotations, each applied in
+/// place to the two rows and columns it changes (Numerical Recipes'
+/// `jacobi`; by hand: nalgebra's general solver costs more for a 3 × 3 than
+/// the whole neighbourhood sum on a smoothing's 100-point neighbourhoods).
 pub(crate) fn symmetric_eigen3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]) {
     let mut v = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
     for _sweep in 0..50 {
@@ -226,25 +233,32 @@ pub(crate) fn symmetric_eigen3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]
         if off <= f64::EPSILON * 1e-3 * diag || off == 0.0 {
             break;
         }
-        for (p, q) in [(0, 1), (0, 2), (1, 2)] {
-            if a[p][q] == 0.0 {
+        for (p, q, r) in [(0, 1, 2), (0, 2, 1), (1, 2, 0)] {
+            let apq = a[p][q];
+            if apq == 0.0 {
                 continue;
             }
-            // The rotation in the (p, q) plane that zeroes a[p][q]
-            // (Numerical Recipes' `jacobi`, with A' = Jᵀ A J, V' = V J).
-            let theta = (a[q][q] - a[p][p]) / (2.0 * a[p][q]);
+            // The rotation J in the (p, q) plane that zeroes a[p][q]
+            // (J_pp = J_qq = c, J_pq = s, J_qp = −s; A' = Jᵀ A J, V' = V J).
+            let theta = (a[q][q] - a[p][p]) / (2.0 * apq);
             let t = theta.signum() / (theta.abs() + (theta * theta + 1.0).sqrt());
             let c = 1.0 / (t * t + 1.0).sqrt();
             let s = t * c;
-            let mut j = [[1.0, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 1.0]];
-            j[p][p] = c;
-            j[q][q] = c;
-            j[p][q] = s;
-            j[q][p] = -s;
-            a = mul(&transpose(&j), &mul(&a, &j));
+            let tau = s / (1.0 + c);
+            a[p][p] -= t * apq;
+            a[q][q] += t * apq;
             a[p][q] = 0.0;
             a[q][p] = 0.0;
-            v = mul(&v, &j);
+            let (g, h) = (a[r][p], a[r][q]);
+            a[r][p] = g - s * (h + g * tau);
+            a[r][q] = h + s * (g - h * tau);
+            a[p][r] = a[r][p];
+            a[q][r] = a[r][q];
+            for row in &mut v {
+                let (g, h) = (row[p], row[q]);
+                row[p] = g - s * (h + g * tau);
+                row[q] = h + s * (g - h * tau);
+            }
         }
     }
     let mut order = [0, 1, 2];
@@ -254,23 +268,45 @@ pub(crate) fn symmetric_eigen3(mut a: [[f64; 3]; 3]) -> ([f64; 3], [[f64; 3]; 3]
     (values, vectors)
 }
 
-fn mul(x: &[[f64; 3]; 3], y: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    let mut out = [[0.0; 3]; 3];
-    for (r, row) in out.iter_mut().enumerate() {
-        for (c, cell) in row.iter_mut().enumerate() {
-            *cell = (0..3).map(|k| x[r][k] * y[k][c]).sum();
-        }
-    }
-    out
-}
-
-fn transpose(x: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
-    [0, 1, 2].map(|r| [0, 1, 2].map(|c| x[c][r]))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    fn mul(x: &[[f64; 3]; 3], y: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        [0, 1, 2].map(|r| [0, 1, 2].map(|c| (0..3).map(|k| x[r][k] * y[k][c]).sum()))
+    }
+
+    fn transpose(x: &[[f64; 3]; 3]) -> [[f64; 3]; 3] {
+        [0, 1, 2].map(|r| [0, 1, 2].map(|c| x[c][r]))
+    }
+
+    #[test]
+    fn jacobi_gives_orthonormal_eigenvectors_of_any_symmetric_matrix() {
+        // A V = V diag(λ), Vᵀ V = I, λ ascending, for covariance-like
+        // matrices (a flat neighbourhood, a repeated eigenvalue, a random one).
+        let mut u = super::super::common::uniform(7);
+        let mut cases = vec![
+            [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 1e-6]],
+            [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 3.0]],
+        ];
+        for _ in 0..200 {
+            let b: [[f64; 3]; 3] = [0, 1, 2].map(|_| [0, 1, 2].map(|_| f64::from(u()) - 0.5));
+            cases.push(mul(&b, &transpose(&b)));
+        }
+        for a in cases {
+            let (values, vectors) = symmetric_eigen3(a);
+            assert!(values[0] <= values[1] && values[1] <= values[2]);
+            let av = mul(&a, &vectors);
+            let scale = values[2].abs().max(1e-300);
+            for r in 0..3 {
+                for c in 0..3 {
+                    assert!((av[r][c] - vectors[r][c] * values[c]).abs() <= 1e-12 * scale);
+                    let vtv: f64 = (0..3).map(|k| vectors[k][r] * vectors[k][c]).sum();
+                    assert!((vtv - f64::from(u8::from(r == c))).abs() <= 1e-12);
+                }
+            }
+        }
+    }
 
     #[test]
     fn jacobi_recovers_a_rotated_diagonal() {
