@@ -10,8 +10,10 @@
 //! `h / 2` whose first positions are stored; points are queried in that
 //! order. A k-nearest query takes the k-th distance of the point before
 //! it, a little more, as a radius r; the columns that meet the box q ± r
-//! give, by two look-ups each, the run of points whose height may be
-//! within r, and one pass of plain arithmetic over those contiguous runs
+//! give the runs of points whose height may be within r (a row of a
+//! block's columns, numbered in a run, as one run where their heights lie
+//! within the box's, as on a surface; else each column by two look-ups in
+//! its slabs), and one pass of plain arithmetic over those contiguous runs
 //! (which the compiler vectorises) gives their squared distances. If k of
 //! them lie within r, they hold the k nearest; otherwise r grows (by the
 //! count found, as on a surface) and the query is repeated. A point far
@@ -229,29 +231,49 @@ impl Grid {
         if f64::from(hi32) < z_hi {
             hi32 = hi32.next_up();
         }
-        // The query's own column first (a count may stop there), then the rest.
-        let own = (column(qx, 0, self.nx - 1), column(qy, 1, self.ny - 1));
-        let cells = std::iter::once(own).chain(
-            (y0..=y1)
-                .flat_map(|cy| (x0..=x1).map(move |cx| (cx, cy)))
-                .filter(|&c| c != own),
-        );
-        for (cx, cy) in cells {
-            let c = block_index(cx, cy, self.nx);
-            if self.start[c] == self.start[c + 1] {
-                continue;
-            }
-            // The slabs that hold heights lo32..=hi32 (a slab's number
-            // grows with height, so none between is missed).
-            let slabs = &self.slabs[c];
-            let (a, b) = (slabs.of(lo32), slabs.of(hi32));
-            let first = slabs.first as usize;
-            let (s, e) = (
-                self.slab_start[first + a] as usize,
-                self.slab_start[first + b + 1] as usize,
-            );
-            if s < e && !visit(s, e) {
-                return;
+        // Row by row, the query's own row first (a count may stop there).
+        // The columns of a row within one block are numbered in a run, so
+        // their points lie in one run of positions: where each of them
+        // lies within the box's heights (widened by r: a surface, not a
+        // wall) they are taken as one run, else column by column, each by
+        // its slabs.
+        let (pad_lo, pad_hi) = (lo32 - wide as f32, hi32 + wide as f32);
+        let own_y = column(qy, 1, self.ny - 1);
+        let rows = std::iter::once(own_y).chain((y0..=y1).filter(|&cy| cy != own_y));
+        for cy in rows {
+            let mut cx = x0;
+            while cx <= x1 {
+                let last = ((cx / BLOCK + 1) * BLOCK - 1).min(x1);
+                let c0 = block_index(cx, cy, self.nx);
+                let c1 = c0 + (last - cx);
+                cx = last + 1;
+                let columns = &self.slabs[c0..=c1];
+                let whole = columns
+                    .iter()
+                    .all(|s| s.count == 0 || (s.base >= pad_lo && s.top <= pad_hi));
+                if whole {
+                    let (s, e) = (self.start[c0] as usize, self.start[c1 + 1] as usize);
+                    if s < e && !visit(s, e) {
+                        return;
+                    }
+                    continue;
+                }
+                for slabs in columns {
+                    if slabs.count == 0 {
+                        continue;
+                    }
+                    // The slabs that hold heights lo32..=hi32 (a slab's
+                    // number grows with height, so none between is missed).
+                    let (a, b) = (slabs.of(lo32), slabs.of(hi32));
+                    let first = slabs.first as usize;
+                    let (s, e) = (
+                        self.slab_start[first + a] as usize,
+                        self.slab_start[first + b + 1] as usize,
+                    );
+                    if s < e && !visit(s, e) {
+                        return;
+                    }
+                }
             }
         }
     }
@@ -525,12 +547,13 @@ const SLABS_PER_POINT: usize = 4;
 /// `slab_start[first + s] .. slab_start[first + s + 1]`.
 #[derive(Debug, Clone, Copy, Default)]
 struct Slabs {
-    /// The lowest height and the slabs a unit of height.
+    /// The lowest and highest heights, and the slabs a unit of height.
     base: f32,
+    top: f32,
     per_unit: f32,
     /// Index of the column's first entry in `slab_start`.
     first: u32,
-    /// Number of slabs.
+    /// Number of slabs (0 for an empty column).
     count: u32,
 }
 
@@ -566,6 +589,7 @@ fn slab_index(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
         };
         let column = Slabs {
             base: low,
+            top: high,
             per_unit,
             first: slab_start.len() as u32,
             count: count as u32,
