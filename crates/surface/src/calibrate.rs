@@ -94,7 +94,8 @@ pub fn angles_from_normal(normal: [f64; 3]) -> Option<(f64, f64)> {
 
 /// Apply a rotation to every point (f64 arithmetic, f32 storage).
 pub(crate) fn rotate(cloud: &[Point], r: &Matrix3<f64>) -> PointCloud {
-    let points = cloud.iter().map(|p| rotate_point(r, p)).collect();
+    use rayon::prelude::*;
+    let points = cloud.par_iter().map(|p| rotate_point(r, p)).collect();
     PointCloud { points }
 }
 

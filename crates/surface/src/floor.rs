@@ -250,7 +250,7 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
 
     // Refine on every point, away from where the ground rises.
     let all: Vec<[f64; 3]> = cloud.points.par_iter().map(to_f64).collect();
-    let all_grid = Grid::with_cell(&all, RISE_CELL * threshold);
+    let all_grid = Grid::with_cell(&all, RISE_CELL * threshold, false);
     let mut inliers = inliers_of(&all, &plane, threshold);
     for _ in 0..r.refine_rounds {
         let flat = all_grid.away_from_rises(&all, &plane, threshold, &inliers);
@@ -314,20 +314,63 @@ fn grow(
 }
 
 /// The points bucketed on an x–y grid, for drawing triples from one
-/// neighbourhood and for finding where the ground rises: cells numbered in
-/// the order first met, found by a hash map of their keys (a scan's
-/// footprint is sparse), the points of each listed by a counting sort.
+/// neighbourhood and for finding where the ground rises: cells numbered
+/// densely over the box of their keys when it is not much larger than the
+/// points (a scan's footprint at these cell sizes), else in the order first
+/// met through a hash map of their keys (points kilometres apart); the
+/// points of each cell listed by a counting sort, in point order.
 /// foldhash's fixed hasher: hashing a million keys with the standard
 /// library's SipHash took a third of the levelling; a fixed seed keeps
 /// every run alike.
 struct Grid {
     cell_m: f64,
-    index: HashMap<(i64, i64), u32, foldhash::fast::FixedState>,
+    cells: Cells,
     /// Each point's cell.
     of: Vec<u32>,
-    /// The points of cell `c`: `members[start[c]..start[c + 1]]`.
+    /// The points of cell `c`: `members[start[c]..start[c + 1]]` (empty
+    /// when not listed).
     start: Vec<u32>,
     members: Vec<u32>,
+}
+
+/// How a grid's cells are numbered (see [`Grid`]).
+enum Cells {
+    /// Cell (x, y) is `(y − y0) · nx + (x − x0)`, over the keys' box.
+    Dense { x0: i64, y0: i64, nx: i64, ny: i64 },
+    /// In the order first met.
+    Hashed(HashMap<(i64, i64), u32, foldhash::fast::FixedState>),
+}
+
+/// Dense cells allowed per point before a grid hashes its keys instead.
+const DENSE_CELLS_PER_POINT: i128 = 4;
+
+impl Cells {
+    /// The number of the cell with key `k`, if the grid has it.
+    fn id(&self, k: (i64, i64)) -> Option<u32> {
+        match self {
+            Cells::Dense { x0, y0, nx, ny } => {
+                let (x, y) = (k.0.checked_sub(*x0)?, k.1.checked_sub(*y0)?);
+                ((0..*nx).contains(&x) && (0..*ny).contains(&y)).then(|| (y * nx + x) as u32)
+            }
+            Cells::Hashed(index) => index.get(&k).copied(),
+        }
+    }
+
+    /// Every cell's key and number.
+    fn each(&self, mut f: impl FnMut((i64, i64), usize)) {
+        match self {
+            Cells::Dense { x0, y0, nx, ny } => {
+                for c in 0..(nx * ny) {
+                    f((x0 + c % nx, y0 + c / nx), c as usize);
+                }
+            }
+            Cells::Hashed(index) => {
+                for (&key, &c) in index {
+                    f(key, c as usize);
+                }
+            }
+        }
+    }
 }
 
 impl Grid {
@@ -346,36 +389,82 @@ impl Grid {
         } else {
             1.0
         };
-        Self::with_cell(points, cell_m)
+        Self::with_cell(points, cell_m, true)
     }
 
-    fn with_cell(points: &[[f64; 3]], cell_m: f64) -> Self {
+    /// Cells of side `cell_m`; with each cell's points listed when
+    /// `listed` (for drawing triples; finding rises needs only counts).
+    fn with_cell(points: &[[f64; 3]], cell_m: f64, listed: bool) -> Self {
         let keys: Vec<(i64, i64)> = points.par_iter().map(|p| Self::key(cell_m, p)).collect();
-        let mut index: HashMap<(i64, i64), u32, foldhash::fast::FixedState> =
-            HashMap::with_hasher(foldhash::fast::FixedState::default());
-        let of: Vec<u32> = keys
-            .iter()
-            .map(|k| {
-                let next = index.len() as u32;
-                *index.entry(*k).or_insert(next)
-            })
-            .collect();
-        let mut start = vec![0u32; index.len() + 1];
+        let (lo, hi) = keys
+            .par_iter()
+            .fold(
+                || ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)),
+                |(lo, hi), k| {
+                    (
+                        (lo.0.min(k.0), lo.1.min(k.1)),
+                        (hi.0.max(k.0), hi.1.max(k.1)),
+                    )
+                },
+            )
+            .reduce(
+                || ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)),
+                |(l1, h1), (l2, h2)| {
+                    (
+                        (l1.0.min(l2.0), l1.1.min(l2.1)),
+                        (h1.0.max(h2.0), h1.1.max(h2.1)),
+                    )
+                },
+            );
+        let span = |a: i64, b: i64| i128::from(b) - i128::from(a) + 1;
+        let dense = !keys.is_empty()
+            && span(lo.0, hi.0) * span(lo.1, hi.1)
+                <= DENSE_CELLS_PER_POINT * keys.len() as i128 + 1024;
+        let (cells, of, count) = if dense {
+            let (nx, ny) = (span(lo.0, hi.0) as i64, span(lo.1, hi.1) as i64);
+            let of: Vec<u32> = keys
+                .par_iter()
+                .map(|k| ((k.1 - lo.1) * nx + (k.0 - lo.0)) as u32)
+                .collect();
+            let cells = Cells::Dense {
+                x0: lo.0,
+                y0: lo.1,
+                nx,
+                ny,
+            };
+            (cells, of, (nx * ny) as usize)
+        } else {
+            let mut index: HashMap<(i64, i64), u32, foldhash::fast::FixedState> =
+                HashMap::with_hasher(foldhash::fast::FixedState::default());
+            let of: Vec<u32> = keys
+                .iter()
+                .map(|k| {
+                    let next = index.len() as u32;
+                    *index.entry(*k).or_insert(next)
+                })
+                .collect();
+            let count = index.len();
+            (Cells::Hashed(index), of, count)
+        };
+        let mut start = vec![0u32; count + 1];
         for &c in &of {
             start[c as usize + 1] += 1;
         }
-        for c in 0..index.len() {
+        for c in 0..count {
             start[c + 1] += start[c];
         }
-        let mut next = start.clone();
-        let mut members = vec![0u32; of.len()];
-        for (i, &c) in of.iter().enumerate() {
-            members[next[c as usize] as usize] = i as u32;
-            next[c as usize] += 1;
+        let mut members = Vec::new();
+        if listed {
+            let mut next = start.clone();
+            members = vec![0u32; of.len()];
+            for (i, &c) in of.iter().enumerate() {
+                members[next[c as usize] as usize] = i as u32;
+                next[c as usize] += 1;
+            }
         }
         Self {
             cell_m,
-            index,
+            cells,
             of,
             start,
             members,
@@ -384,8 +473,8 @@ impl Grid {
 
     /// The points of the cell with key `k` (none if it has none).
     fn cell(&self, k: (i64, i64)) -> &[u32] {
-        match self.index.get(&k) {
-            Some(&c) => {
+        match self.cells.id(k) {
+            Some(c) => {
                 let c = c as usize;
                 &self.members[self.start[c] as usize..self.start[c + 1] as usize]
             }
@@ -408,32 +497,37 @@ impl Grid {
         threshold: f64,
         inliers: &[usize],
     ) -> Vec<usize> {
-        // Points just above the band, and all points, per cell.
+        // Points just above the band, per cell (they are few: found in
+        // parallel, counted after).
         let cells = self.start.len() - 1;
+        let rising: Vec<u32> = points
+            .par_iter()
+            .zip(&self.of)
+            .filter_map(|(p, &c)| {
+                let d = plane.signed_distance(*p);
+                (d > threshold && d <= RISE_BAND * threshold).then_some(c)
+            })
+            .collect();
         let mut above = vec![0u32; cells];
-        for (p, &c) in points.iter().zip(&self.of) {
-            let d = plane.signed_distance(*p);
-            if d > threshold && d <= RISE_BAND * threshold {
-                above[c as usize] += 1;
-            }
+        for c in rising {
+            above[c as usize] += 1;
         }
         // Every cell next to (or at) a rising one.
         let mut near = vec![false; cells];
-        for (key, &c) in &self.index {
-            let c = c as usize;
+        self.cells.each(|key, c| {
             let (above, all) = (above[c], self.start[c + 1] - self.start[c]);
             if above >= 3 && 10 * above > all {
                 for dx in -1..=1 {
                     for dy in -1..=1 {
-                        if let Some(&n) = self.index.get(&(key.0 + dx, key.1 + dy)) {
+                        if let Some(n) = self.cells.id((key.0 + dx, key.1 + dy)) {
                             near[n as usize] = true;
                         }
                     }
                 }
             }
-        }
+        });
         inliers
-            .iter()
+            .par_iter()
             .copied()
             .filter(|&i| !near[self.of[i] as usize])
             .collect()
@@ -484,6 +578,33 @@ mod tests {
     use super::*;
     use crate::calibrate::{level, tilt};
     use approx::assert_relative_eq;
+
+    #[test]
+    fn cells_list_their_points_numbered_densely_or_hashed() {
+        // One patch (dense numbering), and the same with a second patch
+        // 10 km away (too many cells between: hashed); each cell lists
+        // exactly the points whose key is its own, in point order.
+        let patch: Vec<[f64; 3]> = (0..500)
+            .map(|i| [f64::from(i % 23) * 0.37, f64::from(i / 23) * 0.29, 0.0])
+            .collect();
+        let mut far = patch.clone();
+        far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 1.0]));
+        for (points, dense) in [(patch, true), (far, false)] {
+            let grid = Grid::with_cell(&points, 0.5, true);
+            assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
+            let mut seen = 0;
+            grid.cells.each(|key, c| {
+                let want: Vec<u32> = (0..points.len() as u32)
+                    .filter(|&i| Grid::key(0.5, &points[i as usize]) == key)
+                    .collect();
+                assert_eq!(grid.cell(key), &want[..]);
+                assert!(want.iter().all(|&i| grid.of[i as usize] as usize == c));
+                seen += want.len();
+            });
+            assert_eq!(seen, points.len());
+            assert!(grid.cell((-7, 99)).is_empty());
+        }
+    }
 
     /// A level floor z = −2 (20 × 20 grid) and a wall of points above it.
     fn floor_and_wall() -> PointCloud {
