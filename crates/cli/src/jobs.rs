@@ -178,7 +178,7 @@ pub fn drive(
     stop: &'static std::sync::atomic::AtomicBool,
 ) -> Result<Job<autoshovel_link::drive::DriveSummary>> {
     use autoshovel_link::drive::{DriveSummary, LinkSummary};
-    use autoshovel_link::{DriveOptions, Link, RunLog};
+    use autoshovel_link::DriveOptions;
     use autoshovel_track::{ControllerRun, Tracking};
     use std::sync::atomic::Ordering;
     if let Some(dir) = log_path.parent().filter(|d| !d.as_os_str().is_empty()) {
@@ -186,8 +186,16 @@ pub fn drive(
     }
     let mut ctl = controller.build(&scenario.controllers);
     let t0 = std::time::Instant::now();
-    let got = rt.block_on(async {
+    let metadata = [
+        ("job", "drive".to_string()),
+        ("scenario", scenario.name.clone()),
+        ("endpoint", params.endpoint.clone()),
+        ("controller", format!("{controller:?}")),
+        ("seed", scenario.setup.rtk.seed.to_string()),
+    ];
+    let (run, log_path) = rt.block_on(async {
         let opts = DriveOptions::new(&scenario.setup, params);
+        // Ctrl-C (the binary's flag) reaches the drive's own stop switch.
         let flag = opts.stop.clone();
         let watcher = tokio::spawn(async move {
             loop {
@@ -197,48 +205,28 @@ pub fn drive(
                 tokio::time::sleep(std::time::Duration::from_millis(5)).await;
             }
         });
-        let link = Link::open(params).await?;
-        // The log starts once the link is up: it is the record of a run.
-        let mut log = match RunLog::create(
+        let got = autoshovel_link::drive_logged(
+            params,
+            &scenario.setup,
+            ctl.as_mut(),
+            &opts,
             log_path,
-            &[
-                ("job", "drive".to_string()),
-                ("scenario", scenario.name.clone()),
-                ("endpoint", params.endpoint.clone()),
-                ("controller", format!("{controller:?}")),
-                ("seed", scenario.setup.rtk.seed.to_string()),
-            ],
+            &metadata,
             overwrite_log,
-        ) {
-            Ok(l) => l,
-            Err(e) => {
-                link.close().await;
-                return Err(e);
-            }
-        };
-        let r = autoshovel_link::drive(&link, &scenario.setup, ctl.as_mut(), &opts, Some(&mut log))
-            .await;
-        link.close().await;
+        )
+        .await;
         watcher.abort();
-        // The log is kept whatever happened.
-        let logged = log.finish();
-        let run = r?;
-        Ok::<_, autoshovel_link::LinkError>((run, logged?))
-    });
-    let (run, log_path) = got?;
+        got
+    })?;
     let mut link = LinkSummary::of(&run, params);
     link.log = Some(log_path.display().to_string());
-    let tracking = Tracking {
-        runs: vec![ControllerRun {
-            kind: controller,
-            name: ctl.name(),
-            gains: ctl.gains(),
-            run: run.run,
-            sim_time_ms: t0.elapsed().as_secs_f64() * 1e3,
-        }],
-        main: 0,
-        compare: false,
-    };
+    let tracking = Tracking::single(ControllerRun {
+        kind: controller,
+        name: ctl.name(),
+        gains: ctl.gains(),
+        run: run.run,
+        sim_time_ms: t0.elapsed().as_secs_f64() * 1e3,
+    });
     let mut track = tracking.summary(scenario);
     track.job = "drive";
     Job::finish(DriveSummary { track, link }, out, |dir, written| {

@@ -87,17 +87,15 @@ impl SecurityArgs {
 
 /// Makes the PKI folder on first use (when it does not exist at all).
 fn first_use(root: &Path) -> Result<()> {
-    if root.exists() {
-        return Ok(());
+    if let Some(r) = pki::init_if_absent(root)? {
+        eprintln!(
+            "made {}: plc and workstation certificates, each trusting the other{}",
+            root.display(),
+            r.password_file
+                .map(|p| format!("; the operator's password in {}", p.display()))
+                .unwrap_or_default()
+        );
     }
-    let r = pki::init(root, &[])?;
-    eprintln!(
-        "made {}: plc and workstation certificates, each trusting the other{}",
-        root.display(),
-        r.password_file
-            .map(|p| format!("; the operator's password in {}", p.display()))
-            .unwrap_or_default()
-    );
     Ok(())
 }
 
@@ -258,26 +256,13 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
                 break;
             }
         }
-        let s = {
-            let p = server.plc.lock().unwrap_or_else(|e| e.into_inner());
-            serde_json::json!({
-                "job": "plc-sim",
-                "scenario": scenario.name,
-                "seed": args.seed,
-                "endpoint": server.endpoint(),
-                "machine_time_s": p.machine.time_s(),
-                "travelled_m": p.machine.travelled_m(),
-                "fault": p.fault.as_ref().map(|f| f.1.clone()),
-                "faults_latched": p.stops.len(),
-            "setpoints_zeroed_at_s": p.zeroed_at,
-                "moved_while_faulted": p.moved_while_faulted(),
-                "events": p.events,
-                "success": !p.moved_while_faulted(),
-            })
-        };
-        let mut s = s;
+        let mut s = server
+            .plc
+            .lock()
+            .unwrap_or_else(|e| e.into_inner())
+            .summary(&scenario.name, args.seed, &server.endpoint());
         if let Some(done) = server.stop().await {
-            s["log"] = serde_json::json!(done?.display().to_string());
+            s.log = Some(done?.display().to_string());
         }
         Ok::<_, anyhow::Error>(s)
     })?;
@@ -545,17 +530,13 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         sc
     });
     let summary = r.summary();
-    let tracking = Tracking {
-        runs: vec![ControllerRun {
-            kind: ControllerKind::Fuzzy,
-            name: "replay",
-            gains: ControllerKind::Fuzzy.build(&Default::default()).gains(),
-            run: r.run,
-            sim_time_ms: 0.0,
-        }],
-        main: 0,
-        compare: false,
-    };
+    let tracking = Tracking::single(ControllerRun {
+        kind: ControllerKind::Fuzzy,
+        name: "replay",
+        gains: ControllerKind::Fuzzy.build(&Default::default()).gains(),
+        run: r.run,
+        sim_time_ms: 0.0,
+    });
     let job = Job::finish(summary, out.as_ref(), |dir, written| {
         autoshovel_figures::track::write(dir, &scenario, &tracking, written)
             .context("writing the replay figures")

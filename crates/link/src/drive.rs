@@ -674,6 +674,35 @@ impl DriveOptions {
     }
 }
 
+/// A whole drive as `autoshovel drive` runs it: the link to `params`
+/// opened, the run log begun at `log_path` once it is up (the record of a
+/// run, with `metadata`), `setup`'s legs driven with `controller`, then the
+/// link closed and the log finished whatever happened (the setpoints are
+/// zero at every end of [`drive`]). Returns the run and the log's path.
+pub async fn drive_logged(
+    params: &LinkParams,
+    setup: &Setup,
+    controller: &mut dyn Controller,
+    opts: &DriveOptions,
+    log_path: &std::path::Path,
+    metadata: &[(&str, String)],
+    overwrite_log: bool,
+) -> Result<(DriveRun, PathBuf), LinkError> {
+    let link = Link::open(params).await?;
+    let mut log = match RunLog::create(log_path, metadata, overwrite_log) {
+        Ok(log) => log,
+        Err(e) => {
+            link.close().await;
+            return Err(e);
+        }
+    };
+    let run = drive(&link, setup, controller, opts, Some(&mut log)).await;
+    link.close().await;
+    // The log is kept whatever happened.
+    let logged = log.finish();
+    Ok((run?, logged?))
+}
+
 /// Drives `setup`'s legs on the PLC behind `link` with `controller`,
 /// logging to `log` when given; `opts.stop` set (Ctrl-C) zeroes the
 /// setpoints and ends the run.

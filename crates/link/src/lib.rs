@@ -18,8 +18,8 @@ pub mod relay;
 pub mod replay;
 pub mod server;
 
-pub use drive::{drive, DriveOptions, DriveRun, Link, LinkEvent, LinkParams, Policy};
+pub use drive::{drive, drive_logged, DriveOptions, DriveRun, Link, LinkEvent, LinkParams, Policy};
 pub use error::LinkError;
 pub use log::RunLog;
-pub use plc::{Clock, FaultKind, Plc, PlcParams, HEARTBEAT_TIMEOUT};
+pub use plc::{Clock, FaultKind, Plc, PlcParams, PlcSimSummary, HEARTBEAT_TIMEOUT};
 pub use server::{PlcServer, ServeParams};

@@ -141,6 +141,14 @@ pub struct InitReport {
     pub password_file: Option<PathBuf>,
 }
 
+/// [`init`] when `root` does not exist at all (first use), else nothing.
+pub fn init_if_absent(root: &Path) -> Result<Option<InitReport>, LinkError> {
+    if root.exists() {
+        return Ok(None);
+    }
+    init(root, &[]).map(Some)
+}
+
 /// Makes both applications' certificates under `root` (keeping any that
 /// exist), has each trust the other, and makes the operator's password
 /// file (mode 0600) unless it exists.

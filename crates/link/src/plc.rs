@@ -143,6 +143,38 @@ impl MotorReadings {
     }
 }
 
+/// The summary of a simulated PLC's session ([`Plc::summary`]).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct PlcSimSummary {
+    /// `plc-sim`.
+    pub job: &'static str,
+    /// The scenario whose machine was simulated.
+    pub scenario: String,
+    /// The seed of its sensor noise.
+    pub seed: u64,
+    /// Where the PLC listened.
+    pub endpoint: String,
+    /// Machine time at the end [s].
+    pub machine_time_s: f64,
+    /// Distance the crawler travelled [m].
+    pub travelled_m: f64,
+    /// The fault latched at the end, if any.
+    pub fault: Option<String>,
+    /// How many faults latched.
+    pub faults_latched: usize,
+    /// Machine times [s] at which the workstation brought the setpoints to zero.
+    pub setpoints_zeroed_at_s: Vec<f64>,
+    /// Whether the motors sped up while a fault was latched (must never happen).
+    pub moved_while_faulted: bool,
+    /// Everything the PLC did.
+    pub events: Vec<PlcEvent>,
+    /// The machine never moved while a fault was latched.
+    pub success: bool,
+    /// The MCAP run log, once finished.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub log: Option<String>,
+}
+
 /// Something the PLC did, on both clocks.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlcEvent {
@@ -334,6 +366,27 @@ impl Plc {
     /// Whether the motors ever sped up while a fault was latched (must never happen).
     pub fn moved_while_faulted(&self) -> bool {
         self.moved_while_faulted
+    }
+
+    /// What `autoshovel plc-sim` reports when it stops: the PLC's state,
+    /// its events, and success (the machine never moved while a fault
+    /// was latched).
+    pub fn summary(&self, scenario: &str, seed: u64, endpoint: &str) -> PlcSimSummary {
+        PlcSimSummary {
+            job: "plc-sim",
+            scenario: scenario.to_string(),
+            seed,
+            endpoint: endpoint.to_string(),
+            machine_time_s: self.machine.time_s(),
+            travelled_m: self.machine.travelled_m(),
+            fault: self.fault.as_ref().map(|f| f.1.clone()),
+            faults_latched: self.stops.len(),
+            setpoints_zeroed_at_s: self.zeroed_at.clone(),
+            moved_while_faulted: self.moved_while_faulted,
+            events: self.events.clone(),
+            success: !self.moved_while_faulted,
+            log: None,
+        }
     }
 
     /// A setpoint write (`right` selects the motor): refused when not
@@ -579,8 +632,16 @@ mod tests {
             p.run_to(t);
         }
         assert!(p.machine.at_rest() && p.fault.is_some() && !p.moved_while_faulted());
+        // The summary reads the same state: one fault latched and held,
+        // the crawler moved, then stopped, never while faulted.
+        let s = p.summary("fig9a", 7, "opc.tcp://here:1/");
+        assert_eq!((s.faults_latched, s.seed, s.success), (1, 7, true));
+        assert_eq!(s.fault, p.fault.as_ref().map(|f| f.1.clone()));
+        assert!(s.travelled_m > 0.0 && s.machine_time_s >= t - 1e-9);
+        assert_eq!(s.events, p.events);
         p.acknowledge().unwrap();
         assert!(p.fault.is_none() && p.setpoints() == TrackCommand::STOP);
+        assert_eq!(p.summary("fig9a", 7, "").fault, None);
     }
 
     #[test]

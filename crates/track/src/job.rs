@@ -75,6 +75,15 @@ pub fn track(scenario: &TrackScenario, controller: ControllerKind, compare: bool
 }
 
 impl Tracking {
+    /// One run alone (a drive on a PLC, a replayed log): the job's main run.
+    pub fn single(run: ControllerRun) -> Self {
+        Tracking {
+            runs: vec![run],
+            main: 0,
+            compare: false,
+        }
+    }
+
     /// The chosen controller's run.
     pub fn main(&self) -> &ControllerRun {
         &self.runs[self.main]
