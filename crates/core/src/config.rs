@@ -23,7 +23,7 @@ pub enum ConfigError {
         source: std::io::Error,
     },
     /// Not valid TOML, or unknown, missing or mistyped keys.
-    #[error("{file}:{line}:{column}: {message}")]
+    #[error("{}: {message}", at(file, *line, *column))]
     Parse {
         /// The file (or `<builtin …>`).
         file: String,
@@ -31,11 +31,14 @@ pub enum ConfigError {
         line: usize,
         /// 1-based column (0 when unknown).
         column: usize,
+        /// The entry at fault as written, under its table
+        /// (`[statistical] mean_k = "many"`), when the error is on one.
+        entry: Option<String>,
         /// What is wrong.
         message: String,
     },
     /// A value out of range or contradicting another.
-    #[error("{file}:{line}: {key} = {value} is invalid: expected {expected}")]
+    #[error("{}: {key} = {value} is invalid: expected {expected}", at(file, *line, 0))]
     Invalid {
         /// The file (or `<builtin …>`).
         file: String,
@@ -119,6 +122,36 @@ pub fn read(path: &Path) -> Result<String, ConfigError> {
     })
 }
 
+/// `file:line:column`, `file:line` without a column, `file` alone when the
+/// line is unknown (0).
+fn at(file: &str, line: usize, column: usize) -> String {
+    match (line, column) {
+        (0, _) => file.to_string(),
+        (_, 0) => format!("{file}:{line}"),
+        _ => format!("{file}:{line}:{column}"),
+    }
+}
+
+/// The entry on the line holding byte `offset` of `text`, under the
+/// table it belongs to (`[table] key = value`), if that line is an entry.
+fn entry_at(text: &str, offset: usize) -> Option<String> {
+    let (line, _) = line_col(text, offset);
+    let lines: Vec<&str> = text.lines().collect();
+    let own = lines.get(line.checked_sub(1)?)?.trim();
+    if own.starts_with('[') || !own.contains('=') {
+        return None;
+    }
+    let table = lines[..line - 1]
+        .iter()
+        .rev()
+        .map(|l| l.trim())
+        .find(|l| l.starts_with('['));
+    Some(match table {
+        Some(t) => format!("{t} {own}"),
+        None => own.to_string(),
+    })
+}
+
 /// Deserialise `text` (named `file` in errors); a TOML error becomes
 /// [`ConfigError::Parse`] at the line and column of its span.
 pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T, ConfigError> {
@@ -128,6 +161,7 @@ pub fn parse<T: serde::de::DeserializeOwned>(text: &str, file: &str) -> Result<T
             file: file.to_string(),
             line,
             column,
+            entry: e.span().and_then(|s| entry_at(text, s.start)),
             message: short_floats(e.message().trim()),
         }
     })
@@ -338,6 +372,38 @@ mod tests {
         assert_eq!(line_of_key(text, "obstacle", 1, "missing"), 6);
         assert_eq!(line_of_key(text, "nothing", 0, "x"), 0);
         assert_eq!(line_col("ab\ncd", 4), (2, 2));
+    }
+
+    #[test]
+    fn a_parse_error_names_its_entry_and_table() {
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct S {
+            top: u32,
+            inner: Inner,
+        }
+        #[derive(Debug, serde::Deserialize)]
+        #[allow(dead_code)]
+        struct Inner {
+            k: usize,
+        }
+        let e = parse::<S>("top = 1\n[inner]\n  k = \"many\"\n", "f.toml").unwrap_err();
+        let ConfigError::Parse { line, entry, .. } = &e else {
+            panic!("{e}")
+        };
+        assert_eq!((*line, entry.as_deref()), (3, Some("[inner] k = \"many\"")));
+        assert!(e.to_string().starts_with("f.toml:3:"), "{e}");
+        let e = parse::<S>("top = -1\n[inner]\nk = 1\n", "f.toml").unwrap_err();
+        assert!(matches!(&e, ConfigError::Parse { entry: Some(x), .. } if x == "top = -1"));
+        // Unknown location: the file alone.
+        let e = ConfigError::Invalid {
+            file: "g".into(),
+            line: 0,
+            key: "[a] b".into(),
+            value: "0".into(),
+            expected: "more".into(),
+        };
+        assert_eq!(e.to_string(), "g: [a] b = 0 is invalid: expected more");
         assert_eq!(line_col("é", 1), (1, 1));
     }
 

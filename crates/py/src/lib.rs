@@ -208,39 +208,23 @@ where
         Some(path) => format!("{path} with {func}()'s keyword arguments"),
         None => format!("{func}()'s keyword arguments"),
     };
-    T::from_toml(&text, &source)
-        .map_err(|e| AutoshovelError::new_err(at_key(&message(&e), &source, &text)))
-}
-
-/// A settings error located by line (and column) in the merged text the
-/// caller never sees, located instead by its table and key:
-/// `f()'s keyword arguments:31:10: invalid type…` becomes
-/// `f()'s keyword arguments: [statistical] mean_k = "many": invalid type…`.
-fn at_key(msg: &str, source: &str, text: &str) -> String {
-    let Some(rest) = msg.strip_prefix(source).and_then(|r| r.strip_prefix(':')) else {
-        return msg.to_string();
-    };
-    // "31:10: why" or "31: why".
-    let Some(line) = rest.split(':').next().and_then(|l| l.parse::<usize>().ok()) else {
-        return msg.to_string();
-    };
-    let tail = rest.split_once(": ").map_or(rest, |x| x.1).trim();
-    let lines: Vec<&str> = text.lines().collect();
-    let Some(own) = line.checked_sub(1).and_then(|i| lines.get(i)) else {
-        return format!("{source}: {tail}");
-    };
-    let table = lines[..line - 1]
-        .iter()
-        .rev()
-        .find(|l| l.trim_start().starts_with('['))
-        .map(|l| format!("{} ", l.trim()));
-    let entry = own.trim();
-    let key = entry.split('=').next().unwrap_or("").trim();
-    if !key.is_empty() && tail.contains(key) {
-        format!("{source}: {tail}")
-    } else {
-        format!("{source}: {}{entry}: {tail}", table.unwrap_or_default())
-    }
+    // The merged text is the binding's, never the caller's: errors name
+    // the entry at fault by table and key, not by a line of that text
+    // (parsed here to read the entry; checked without the text, so that
+    // no line is given).
+    let value: T = autoshovel_core::config::parse(&text, &source).map_err(|e| match e {
+        autoshovel_core::config::ConfigError::Parse {
+            entry: Some(entry),
+            message,
+            ..
+        } => AutoshovelError::new_err(format!("{source}: {entry}: {message}")),
+        autoshovel_core::config::ConfigError::Parse { message, .. } => {
+            AutoshovelError::new_err(format!("{source}: {message}"))
+        }
+        other => lib_err(other),
+    })?;
+    value.check("", &source).map_err(lib_err)?;
+    Ok(value)
 }
 
 /// Lays the keywords of `d` over `table` (a nested dict over a table).
