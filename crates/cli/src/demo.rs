@@ -92,33 +92,22 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
         ));
         summaries.insert(key, summary);
     }
-    // Every run uses the fuzzy tracker; the last compares all three.
+    // Every run uses the fuzzy tracker; the last compares all three. The
+    // paths, starts, speeds and noise are said from the scenarios themselves.
     let track_runs: [(&str, bool, &str); 6] = [
-        (
-            "fig9a",
-            false,
-            "Fig. 9a: path (0,0)→(30,30), start (2,−2) at 2 m/s, noise off.",
-        ),
-        ("fig9b", false, "Fig. 9b: start (0,5) at 1 m/s, noise off."),
-        (
-            "straight",
-            false,
-            "§5.3 straight run at 0.5 m/s with RTK noise and slip.",
-        ),
-        (
-            "curve",
-            false,
-            "§5.3 curve round the truck and stockpile, RTK noise and slip.",
-        ),
+        ("fig9a", false, "Fig. 9a"),
+        ("fig9b", false, "Fig. 9b"),
+        ("straight", false, "§5.3 straight run"),
+        ("curve", false, "§5.3 curve round the truck and stockpile"),
         (
             "v-shape",
             false,
-            "§5.3 V-shape: reverse, stop at the cusp, forward; RTK noise and slip.",
+            "§5.3 V-shape: reverse, stop at the cusp, forward",
         ),
         (
             "curve",
             true,
-            "Every controller on the curve run, same seed (§5.4 compares fuzzy with PID).",
+            "Every controller on the curve run, same seed (§5.4 compares fuzzy with PID)",
         ),
     ];
     for (name, compare, description) in track_runs {
@@ -135,6 +124,8 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
             format!("track-{name}-fuzzy")
         };
         let dir = sub_out(&sub);
+        let description = format!("{description}: {}.", track_setting(&scenario));
+        let description = description.as_str();
         let job = crate::jobs::track(&scenario, ctl, compare, Some(&dir))?;
         if !json_only {
             let m = &job.summary.run.metrics;
@@ -269,12 +260,25 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
         if !json_only {
             let s = &job.summary;
             crate::say!(
-                "{key:40} roll {:.3} deg (true 3), pitch {:.3} deg (true -2), R² {:.4}, {} → {} points in {:.0} ms",
-                s.roll_deg, s.pitch_deg, s.r2, s.input_points, s.output_points, s.total_ms
+                "{key:40} roll {:.3} deg (true {:.3}), pitch {:.3} deg (true {:.3}), R² {:.4}, {} → {} points in {:.0} ms",
+                s.roll_deg,
+                params.roll_rad.to_degrees(),
+                s.pitch_deg,
+                params.pitch_rad.to_degrees(),
+                s.r2,
+                s.input_points,
+                s.output_points,
+                s.total_ms
             );
         }
         let summary = job.json()?;
-        let description = format!("A synthetic 200,000-point scan of a {} pile (Fig. 7) tilted by roll 3°, pitch −2°, then the §3 pipeline.", shape.name());
+        let description = format!(
+            "A synthetic {}-point scan of a {} pile (Fig. 7) tilted by roll {}°, pitch {}°, then the §3 pipeline.",
+            params.points,
+            shape.name(),
+            autoshovel_core::config::short(params.roll_rad.to_degrees()),
+            autoshovel_core::config::short(params.pitch_rad.to_degrees())
+        );
         sections.push(section(
             &key,
             &description,
@@ -509,6 +513,26 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
         crate::say!("report: {}", index.display());
     }
     Ok(())
+}
+
+/// A tracking scenario's path, start, speed and noise, from its values.
+fn track_setting(scenario: &autoshovel_track::scenario::TrackScenario) -> String {
+    let setup = &scenario.setup;
+    let xy = |p: autoshovel_core::Vec2| format!("({:.0}, {:.0})", p.x, p.y);
+    let path = match (
+        setup.legs.first().and_then(|l| l.points.first()),
+        setup.legs.last().and_then(|l| l.points.last()),
+    ) {
+        (Some(&a), Some(&b)) => format!("path {} → {}", xy(a), xy(b)),
+        _ => "no path".to_string(),
+    };
+    format!(
+        "{path} in {} leg(s), start {} at {} m/s, noise {}",
+        setup.legs.len(),
+        xy(autoshovel_core::Vec2::new(setup.start.x, setup.start.y)),
+        autoshovel_core::config::short(setup.sim.speed_mps),
+        scenario.noise.name()
+    )
 }
 
 fn section(
