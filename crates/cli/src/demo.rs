@@ -273,11 +273,11 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
         }
         let summary = job.json()?;
         let description = format!(
-            "A synthetic {}-point scan of a {} pile (Fig. 7) tilted by roll {}°, pitch {}°, then the §3 pipeline.",
+            "A synthetic {}-point scan of a {} pile (Fig. 7) tilted by roll {:.1}°, pitch {:.1}°, then the §3 pipeline.",
             params.points,
             shape.name(),
-            autoshovel_core::config::short(params.roll_rad.to_degrees()),
-            autoshovel_core::config::short(params.pitch_rad.to_degrees())
+            params.roll_rad.to_degrees(),
+            params.pitch_rad.to_degrees()
         );
         sections.push(section(
             &key,
