@@ -156,14 +156,7 @@ pub fn run(args: &Args) -> Result<()> {
         .par_iter()
         .enumerate()
         .map(|(i, path)| {
-            let offset_m = args.survey.map_or([0.0, 0.0], |[nx, _]| {
-                [(i % nx) as f64 * step[0], (i / nx) as f64 * step[1]]
-            });
-            let params = PileParams {
-                seed: params.seed.wrapping_add(i as u64),
-                offset_m,
-                ..params.clone()
-            };
+            let params = params.nth_scan(i, args.survey.map(|[nx, _]| nx));
             generate_one(&params, path, args)
         })
         .collect::<Result<_>>()?;

@@ -458,6 +458,25 @@ impl PileParams {
         self.scale * (self.toe_distance_m - self.toe_bow_m * (PI * y / w).cos())
     }
 
+    /// Scan `i` of a sequence made from these parameters: its own seed
+    /// (`seed + i`), and in a survey of `columns` scans a row the shift
+    /// of its place, column `i mod columns` and row `i div columns`, by
+    /// [`PileParams::survey_step_m`] (frames of one sequence stay put).
+    pub fn nth_scan(&self, i: usize, survey_columns: Option<usize>) -> PileParams {
+        let offset_m = survey_columns.map_or(self.offset_m, |nx| {
+            let step = self.survey_step_m();
+            [
+                self.offset_m[0] + (i % nx) as f64 * step[0],
+                self.offset_m[1] + (i / nx) as f64 * step[1],
+            ]
+        });
+        PileParams {
+            seed: self.seed.wrapping_add(i as u64),
+            offset_m,
+            ..self.clone()
+        }
+    }
+
     /// The shift from one scan of a survey to the next along x and y [m]:
     /// the scan window's extent less 5 %, so that neighbouring scans
     /// overlap a little, as a survey's passes do.
@@ -712,8 +731,27 @@ fn visible(params: &PileParams, p: &Vector3<f64>) -> bool {
 #[cfg(test)]
 mod tests {
     use super::*;
+
     use crate::calibrate::level;
     use approx::assert_relative_eq;
+
+    #[test]
+    fn the_nth_scan_has_its_own_seed_and_its_place_in_a_survey() {
+        let base = PileParams {
+            seed: u64::MAX - 1,
+            ..PileParams::default()
+        };
+        let step = base.survey_step_m();
+        // Frames: seeds go on (wrapping), the place stays.
+        let frame = base.nth_scan(3, None);
+        assert_eq!((frame.seed, frame.offset_m), (1, base.offset_m));
+        // A survey of 4 columns: scan 6 is column 2 of row 1.
+        let tile = base.nth_scan(6, Some(4));
+        assert_eq!(tile.seed, 4);
+        assert_relative_eq!(tile.offset_m[0], 2.0 * step[0]);
+        assert_relative_eq!(tile.offset_m[1], step[1]);
+        assert_eq!(base.nth_scan(0, Some(4)), base);
+    }
 
     #[test]
     fn profiles_run_from_floor_to_top_and_rise() {
