@@ -100,6 +100,14 @@ struct Report {
     summaries: serde_json::Map<String, Value>,
 }
 
+impl Report {
+    /// A job's section of the report and its summary under `key`.
+    fn add(&mut self, key: &str, section: Section, summary: Value) {
+        self.sections.push(section);
+        self.summaries.insert(key.to_string(), summary);
+    }
+}
+
 /// Potential-field walks on the built-in scenarios, improved and classic.
 fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
     let runs: [(&str, FieldKind, &str); 6] = [
@@ -140,15 +148,18 @@ fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
             );
         }
         let summary = job.json()?;
-        r.sections.push(section(
+        r.add(
             &key,
-            description,
-            &summary,
-            &sub,
-            &job.written.plots,
-            &job.written.files,
-        ));
-        r.summaries.insert(key, summary);
+            section(
+                &key,
+                description,
+                &summary,
+                &sub,
+                &job.written.plots,
+                &job.written.files,
+            ),
+            summary,
+        );
     }
     Ok(())
 }
@@ -202,15 +213,18 @@ fn tracking(p: &Place, r: &mut Report) -> Result<()> {
             );
         }
         let summary = job.json()?;
-        r.sections.push(section(
+        r.add(
             &key,
-            description,
-            &summary,
-            &sub,
-            &job.written.plots,
-            &job.written.files,
-        ));
-        r.summaries.insert(key, summary);
+            section(
+                &key,
+                description,
+                &summary,
+                &sub,
+                &job.written.plots,
+                &job.written.files,
+            ),
+            summary,
+        );
     }
     Ok(())
 }
@@ -286,15 +300,14 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
         let summary = job.json()?;
         let mut files = job.written.files.clone();
         files.push("drive.mcap".into());
-        r.sections.push(section(
+        r.add(&key, section(
             &key,
             "The walking paper's system (§5.1, Fig. 11) over a real network connection: `autoshovel plc-sim` (the crawler plant, RTK and a PLC's watchdog behind a secure OPC UA server, here in lockstep) driven by `autoshovel drive` on Fig. 9a's path. Lockstep makes the run repeat the in-process `track fig9a` exactly; `drive.mcap` is the run log (Foxglove opens it; `autoshovel replay drive-fig9a/drive.mcap` recomputes the metrics).",
             &summary,
             sub,
             &job.written.plots,
             &files,
-        ));
-        r.summaries.insert(key, summary);
+        ), summary);
     }
     Ok(())
 }
@@ -352,15 +365,18 @@ fn perception(p: &Place, r: &mut Report) -> Result<()> {
             params.roll_rad.to_degrees(),
             params.pitch_rad.to_degrees()
         );
-        r.sections.push(section(
+        r.add(
             &key,
-            &description,
-            &summary,
-            &sub,
-            &written.plots,
-            &written.files,
-        ));
-        r.summaries.insert(key, summary);
+            section(
+                &key,
+                &description,
+                &summary,
+                &sub,
+                &written.plots,
+                &written.files,
+            ),
+            summary,
+        );
     }
     Ok(())
 }
@@ -401,15 +417,14 @@ fn dig(p: &Place, r: &mut Report) -> Result<()> {
             }
         }
     }
-    r.sections.push(section(
+    r.add(key, section(
         key,
         &format!("The rope-shovel paper's §4 on its typical 40° pile at the 1:30 scale: a 6th-order tooth path chosen by the Grey Wolf Optimizer ({} wolves, {} iterations, {} start) to minimise {}·f1 + {}·f2 under c1–c18 (constraint values shown: ≤ 0 is met). The first plot draws the machine at the start and end of the dig: our reading of the paper's missing Fig. 2.", setup.gwo.population, setup.gwo.iterations, setup.gwo.init.name(), setup.profile.objective.k1, setup.profile.objective.k2),
         &shown,
         sub,
         &job.written.plots,
         &job.written.files,
-    ));
-    r.summaries.insert(key.into(), summary);
+    ), summary);
     let sub = "plan-dig-all-surfaces";
     let dir = p.dir(sub);
     let job = crate::jobs::plan_dig_all_surfaces(&setup, Some(&dir), |_| {})?;
@@ -429,26 +444,29 @@ fn dig(p: &Place, r: &mut Report) -> Result<()> {
         "The four piles of Fig. 7 in Table 5's order, each planned with the same profile and seed, beside the paper's Tables 4–5 (paper values and the relative difference of m_dig and f). The profile's digging resistance is calibrated on the {} pile (SPEC §4.2); the other three piles are predictions. Each pile's full outputs are in its own folder.",
         calibrated.join(", ")
     );
-    r.sections.push(section(
+    r.add(
         key,
-        &description,
-        &serde_json::to_value(autoshovel_dig::table_summary(&job.summary))?,
-        sub,
-        // The comparison and each pile's path; the other plots are in the pile folders.
-        &job.written
-            .plots
-            .iter()
-            .filter(|p| p.ends_with("paths.svg") || p.ends_with("dig_path.svg"))
-            .cloned()
-            .collect::<Vec<_>>(),
-        &job.written
-            .files
-            .iter()
-            .filter(|f| !f.contains('/') || f.ends_with("summary.json"))
-            .cloned()
-            .collect::<Vec<_>>(),
-    ));
-    r.summaries.insert(key.into(), job.json()?);
+        section(
+            key,
+            &description,
+            &serde_json::to_value(autoshovel_dig::table_summary(&job.summary))?,
+            sub,
+            // The comparison and each pile's path; the other plots are in the pile folders.
+            &job.written
+                .plots
+                .iter()
+                .filter(|p| p.ends_with("paths.svg") || p.ends_with("dig_path.svg"))
+                .cloned()
+                .collect::<Vec<_>>(),
+            &job.written
+                .files
+                .iter()
+                .filter(|f| !f.contains('/') || f.ends_with("summary.json"))
+                .cloned()
+                .collect::<Vec<_>>(),
+        ),
+        job.json()?,
+    );
     Ok(())
 }
 
@@ -502,15 +520,18 @@ fn excavation(p: &Place, r: &mut Report) -> Result<()> {
         if let Some(o) = shown.as_object_mut() {
             o.remove("segments");
         }
-        r.sections.push(section(
+        r.add(
             &key,
-            &description,
-            &shown,
-            &sub,
-            &job.written.plots,
-            &job.written.files,
-        ));
-        r.summaries.insert(key, summary);
+            section(
+                &key,
+                &description,
+                &shown,
+                &sub,
+                &job.written.plots,
+                &job.written.files,
+            ),
+            summary,
+        );
     }
     Ok(())
 }
@@ -556,15 +577,14 @@ fn shift(p: &Place, r: &mut Report) -> Result<()> {
         })
         .cloned()
         .collect();
-    r.sections.push(section(
+    r.add("shift", section(
         "shift (45 minutes of the built-in bench)",
         "The whole machine (SPEC §9): the rope shovel at full size (the paper's 1:30 model by Froude similarity, λ = 30) scans the face, perceives it, plans each dig with the warm start of the last, digs, swings, dumps into a truck and returns; when no feasible dig remains it chooses the next stand from its scans, plans the walk on a map built from them (a V-move to the side) and drives it with slip and RTK noise. The pit is a height grid the dipper cuts; the mass balance compares its loss with the trucks' load. animation.html replays the shift. The full shift: autoshovel shift --out DIR.",
         &summary,
         sub,
         &shown_plots,
         &job.written.files,
-    ));
-    r.summaries.insert("shift".into(), summary);
+    ), summary);
     Ok(())
 }
 
@@ -584,15 +604,14 @@ fn study(p: &Place, r: &mut Report) -> Result<()> {
         );
     }
     let summary = job.json()?;
-    r.sections.push(section(
+    r.add("study-paths", section(
         "study-paths (100 maps)",
         "Seeded random haul roads with 3–12 obstacles: classic APF, improved APF and the Theta* reference. The full study: autoshovel study-paths --maps 500.",
         &summary,
         sub,
         &job.written.plots,
         &job.written.files,
-    ));
-    r.summaries.insert("study-paths".into(), summary);
+    ), summary);
     Ok(())
 }
 
