@@ -11,7 +11,7 @@ use serde_json::{json, Value};
 
 use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{print_json, OutDir};
+use crate::output::{print_json, OutDir, Written};
 
 /// Runs the demo into `out`.
 ///
@@ -106,6 +106,27 @@ impl Report {
         self.sections.push(section);
         self.summaries.insert(key.to_string(), summary);
     }
+
+    /// [`Report::add`] for a job shown whole under its key, with every
+    /// plot and file it wrote.
+    fn add_job(
+        &mut self,
+        key: &str,
+        description: &str,
+        summary: Value,
+        sub: &str,
+        written: &Written,
+    ) {
+        let shown = section(
+            key,
+            description,
+            &summary,
+            sub,
+            &written.plots,
+            &written.files,
+        );
+        self.add(key, shown, summary);
+    }
 }
 
 /// Potential-field walks on the built-in scenarios, improved and classic.
@@ -148,18 +169,7 @@ fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
             );
         }
         let summary = job.json()?;
-        r.add(
-            &key,
-            section(
-                &key,
-                description,
-                &summary,
-                &sub,
-                &job.written.plots,
-                &job.written.files,
-            ),
-            summary,
-        );
+        r.add_job(&key, description, summary, &sub, &job.written);
     }
     Ok(())
 }
@@ -213,18 +223,7 @@ fn tracking(p: &Place, r: &mut Report) -> Result<()> {
             );
         }
         let summary = job.json()?;
-        r.add(
-            &key,
-            section(
-                &key,
-                description,
-                &summary,
-                &sub,
-                &job.written.plots,
-                &job.written.files,
-            ),
-            summary,
-        );
+        r.add_job(&key, description, summary, &sub, &job.written);
     }
     Ok(())
 }
@@ -365,18 +364,7 @@ fn perception(p: &Place, r: &mut Report) -> Result<()> {
             params.roll_rad.to_degrees(),
             params.pitch_rad.to_degrees()
         );
-        r.add(
-            &key,
-            section(
-                &key,
-                &description,
-                &summary,
-                &sub,
-                &written.plots,
-                &written.files,
-            ),
-            summary,
-        );
+        r.add_job(&key, &description, summary, &sub, &written);
     }
     Ok(())
 }
