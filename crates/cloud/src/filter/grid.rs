@@ -13,8 +13,8 @@
 //! give the runs of points whose height may be within r (a row of a
 //! block's columns, numbered in a run, as one run where their heights lie
 //! within the box's, as on a surface; else each column by two look-ups in
-//! its slabs), and one pass of plain arithmetic over those contiguous runs
-//! (which the compiler vectorises) gives their squared distances. If k of
+//! its slabs), and one vector pass over those contiguous runs
+//! (`within.rs`) gives their squared distances and keeps those within r. If k of
 //! them lie within r, they hold the k nearest; otherwise r grows (by the
 //! count found, as on a surface) and the query is repeated. A point far
 //! from the rest (an outlier above the scan, whose box would sweep many
@@ -35,6 +35,7 @@
 use rayon::prelude::*;
 
 use super::kdtree::{KdTree, Nearest};
+use super::within::{self, Isa, Run};
 
 use crate::Point;
 
@@ -66,6 +67,8 @@ pub(crate) struct Grid {
     z: Vec<f32>,
     /// Input index of each sorted position.
     ids: Vec<u32>,
+    /// The search loop's instruction set.
+    isa: Isa,
 }
 
 impl Grid {
@@ -202,6 +205,7 @@ impl Grid {
             y: coordinate(1),
             z,
             ids,
+            isa: Isa::best(),
         })
     }
 
@@ -278,37 +282,23 @@ impl Grid {
         }
     }
 
-    /// The squared distances of positions `s..e` from `q` as ordered bits
-    /// (squared distances are ≥ +0, whose bits order as the numbers), in
-    /// one pass of arithmetic alone, which the compiler vectorises
-    /// (FLANN's order, as `squared_distance`).
-    fn distances(&self, q: [f32; 3], s: usize, e: usize, out: &mut Vec<u32>) {
-        let [qx, qy, qz] = q;
-        out.clear();
-        let coords = self.x[s..e].iter().zip(&self.y[s..e]).zip(&self.z[s..e]);
-        out.extend(coords.map(|((x, y), z)| {
-            let (dx, dy, dz) = (qx - x, qy - y, qz - z);
-            (dx * dx + dy * dy + dz * dz).to_bits()
-        }));
+    /// The run of sorted positions `s..e`.
+    fn run(&self, s: usize, e: usize) -> Run<'_> {
+        Run {
+            x: &self.x[s..e],
+            y: &self.y[s..e],
+            z: &self.z[s..e],
+        }
     }
 
-    /// The squared distances (as ordered bits) from `q` to every point
-    /// within `r` of it, into `bits`; `dist` is scratch.
-    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>, dist: &mut Vec<u32>) {
+    /// The squared distances (as ordered bits: squared distances are
+    /// ≥ +0, whose bits order as the numbers) from `q` to every point
+    /// within `r` of it, into `bits`.
+    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>) {
         bits.clear();
-        let cap = ((r * r) as f32).to_bits();
+        let cap = (r * r) as f32;
         self.runs(q, r, |s, e| {
-            self.distances(q, s, e, dist);
-            // Those within r kept.
-            let base = bits.len();
-            bits.resize(base + dist.len(), 0);
-            let out = &mut bits[base..];
-            let mut kept = 0;
-            for &b in dist.iter() {
-                out[kept] = b;
-                kept += usize::from(b <= cap);
-            }
-            bits.truncate(base + kept);
+            within::keep_distances(self.isa, q, self.run(s, e), cap, bits);
             true
         });
     }
@@ -316,12 +306,10 @@ impl Grid {
     /// Whether at least `wanted` points (`q` itself counted) lie within
     /// squared distance `r2` of `q`, inclusive; stops at a run that
     /// brings the count there.
-    fn has_within(&self, q: [f32; 3], r2: f32, wanted: usize, dist: &mut Vec<u32>) -> bool {
-        let cap = r2.to_bits();
+    fn has_within(&self, q: [f32; 3], r2: f32, wanted: usize) -> bool {
         let mut count = 0;
         self.runs(q, f64::from(r2).sqrt(), |s, e| {
-            self.distances(q, s, e, dist);
-            count += dist.iter().filter(|&&b| b <= cap).count();
+            count += within::count(self.isa, q, self.run(s, e), r2);
             count < wanted
         });
         count >= wanted
@@ -331,9 +319,10 @@ impl Grid {
     /// within squared distance `r2`, in input order (radius outlier
     /// removal, [RS eq. 13]).
     pub(crate) fn map_has_within(&self, r2: f32, wanted: usize) -> Vec<bool> {
-        self.map_sorted(Vec::new, |dist, p| {
-            self.has_within([self.x[p], self.y[p], self.z[p]], r2, wanted, dist)
-        })
+        self.map_sorted(
+            || (),
+            |(), p| self.has_within([self.x[p], self.y[p], self.z[p]], r2, wanted),
+        )
     }
 
     /// `f(scratch, i, found)` for every point `i` of the input, `found` the
@@ -345,22 +334,15 @@ impl Grid {
         I: Fn() -> S + Sync + Send,
         F: Fn(&mut S, usize, &[u32]) -> T + Sync + Send,
     {
-        let cap = r2.to_bits();
         let r = f64::from(r2).sqrt();
         self.map_sorted(
-            || (init(), Vec::new(), Vec::new()),
-            |(scratch, dist, found), p| {
+            || (init(), Vec::new()),
+            |(scratch, found), p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
                 found.clear();
                 self.runs(q, r, |s, e| {
-                    self.distances(q, s, e, dist);
-                    let ids = &self.ids[s..e];
-                    found.extend(
-                        dist.iter()
-                            .zip(ids)
-                            .filter(|(&b, _)| b <= cap)
-                            .map(|(_, &id)| id),
-                    );
+                    let (run, ids) = (self.run(s, e), &self.ids[s..e]);
+                    within::keep_payload(self.isa, q, run, ids, r2, found);
                     true
                 });
                 found.sort_unstable();
@@ -411,7 +393,7 @@ impl Grid {
     ) -> Option<f32> {
         let mut r = guess;
         loop {
-            self.within(q, r, &mut scratch.bits, &mut scratch.dist);
+            self.within(q, r, &mut scratch.bits);
             let found = scratch.bits.len();
             if found >= k {
                 let bits = &mut scratch.bits;
@@ -665,7 +647,6 @@ impl Columns {
 #[derive(Default)]
 struct Scratch {
     bits: Vec<u32>,
-    dist: Vec<u32>,
     nearest: Vec<f32>,
     knn: Option<Nearest>,
 }

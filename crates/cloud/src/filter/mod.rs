@@ -34,6 +34,7 @@ mod pass_through;
 mod radius_outlier;
 mod statistical_outlier;
 mod voxel_grid;
+mod within;
 
 pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};

@@ -1,0 +1,473 @@
+//! The inner loop of every grid search (`grid.rs`): the squared distances
+//! from a query to a run of points, and which of them lie within a cap —
+//! kept (the distances themselves, or a payload such as the points'
+//! indices) or counted.
+//!
+//! Why written by hand: the loop is most of a search's time, and its two
+//! halves pull apart in plain Rust. The distances vectorise, but keeping
+//! those within the cap is a loop-carried store (`out[kept] = d; kept +=
+//! d ≤ cap`) that the compiler leaves scalar, and fused into one loop the
+//! distances stop vectorising too (1.15× slower, measured). A vector
+//! "left-pack" does both at once: AVX-512's `vpcompressd` (from a register;
+//! its store form is slow on AMD's Zen 4), or on AVX2 a permutation looked
+//! up by the comparison's mask. `std::simd` is not stable, and no kept
+//! crate offers a compress. The instruction set is found at run time, so
+//! one build serves every x86-64 machine, and other targets take the
+//! portable loop.
+//!
+//! Every path computes `dx·dx + dy·dy + dz·dz` in f32, in that order, with
+//! no fused multiply-add (FLANN's arithmetic, as `kdtree.rs`), so each
+//! gives the same bits as the portable loop; the tests hold them to it.
+
+use std::sync::OnceLock;
+
+/// A run of points by axis (equal lengths).
+#[derive(Debug, Clone, Copy)]
+pub(super) struct Run<'a> {
+    pub x: &'a [f32],
+    pub y: &'a [f32],
+    pub z: &'a [f32],
+}
+
+impl Run<'_> {
+    /// The points from position `i` on.
+    fn from(self, i: usize) -> Self {
+        Run {
+            x: &self.x[i..],
+            y: &self.y[i..],
+            z: &self.z[i..],
+        }
+    }
+}
+
+/// The instruction sets with a path of their own.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub(super) enum Isa {
+    Portable,
+    #[cfg(target_arch = "x86_64")]
+    Avx2,
+    #[cfg(target_arch = "x86_64")]
+    Avx512,
+}
+
+impl Isa {
+    /// The widest this machine runs (found once).
+    pub(super) fn best() -> Self {
+        static BEST: OnceLock<Isa> = OnceLock::new();
+        *BEST.get_or_init(|| {
+            #[cfg(target_arch = "x86_64")]
+            {
+                if std::arch::is_x86_feature_detected!("avx512f") {
+                    return Isa::Avx512;
+                }
+                if std::arch::is_x86_feature_detected!("avx2") {
+                    return Isa::Avx2;
+                }
+            }
+            Isa::Portable
+        })
+    }
+
+    /// Every path this machine runs, the portable one first (for tests).
+    #[cfg(test)]
+    pub(super) fn available() -> Vec<Self> {
+        let mut all = vec![Isa::Portable];
+        #[cfg(target_arch = "x86_64")]
+        {
+            if std::arch::is_x86_feature_detected!("avx2") {
+                all.push(Isa::Avx2);
+            }
+            if std::arch::is_x86_feature_detected!("avx512f") {
+                all.push(Isa::Avx512);
+            }
+        }
+        all
+    }
+}
+
+/// Appends to `out` the squared distances from `q` (as bits) of the run's
+/// points within squared distance `cap` (inclusive), in run order.
+#[inline]
+pub(super) fn keep_distances(isa: Isa, q: [f32; 3], run: Run, cap: f32, out: &mut Vec<u32>) {
+    keep::<false>(isa, q, run, &[], cap, out);
+}
+
+/// Appends to `out` `payload[i]` for each point `i` of the run within
+/// squared distance `cap` of `q` (inclusive), in run order.
+#[inline]
+pub(super) fn keep_payload(
+    isa: Isa,
+    q: [f32; 3],
+    run: Run,
+    payload: &[u32],
+    cap: f32,
+    out: &mut Vec<u32>,
+) {
+    assert_eq!(payload.len(), run.x.len(), "a payload a point");
+    keep::<true>(isa, q, run, payload, cap, out);
+}
+
+/// How many of the run's points lie within squared distance `cap` of `q`
+/// (inclusive).
+#[inline]
+pub(super) fn count(isa: Isa, q: [f32; 3], run: Run, cap: f32) -> usize {
+    check(run);
+    match isa {
+        Isa::Portable => portable::count(q, run, cap),
+        // SAFETY: `Isa::best` and `Isa::available` give these only where
+        // the machine has the instruction set; `check` made the lengths equal.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { avx2::count(q, run, cap) },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { avx512::count(q, run, cap) },
+    }
+}
+
+fn keep<const PAYLOAD: bool>(
+    isa: Isa,
+    q: [f32; 3],
+    run: Run,
+    payload: &[u32],
+    cap: f32,
+    out: &mut Vec<u32>,
+) {
+    check(run);
+    match isa {
+        Isa::Portable => portable::keep::<PAYLOAD>(q, run, payload, cap, out),
+        // SAFETY: as in `count`; `payload` is as long as the run when
+        // `PAYLOAD` (asserted by `keep_payload`).
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx2 => unsafe { avx2::keep::<PAYLOAD>(q, run, payload, cap, out) },
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { avx512::keep::<PAYLOAD>(q, run, payload, cap, out) },
+    }
+}
+
+fn check(run: Run) {
+    assert!(
+        run.x.len() == run.y.len() && run.x.len() == run.z.len(),
+        "a run's axes differ in length"
+    );
+}
+
+/// The squared distance in FLANN's order.
+#[inline(always)]
+fn squared(q: [f32; 3], x: f32, y: f32, z: f32) -> f32 {
+    let (dx, dy, dz) = (q[0] - x, q[1] - y, q[2] - z);
+    dx * dx + dy * dy + dz * dz
+}
+
+mod portable {
+    use super::{squared, Run};
+
+    pub(super) fn keep<const PAYLOAD: bool>(
+        q: [f32; 3],
+        run: Run,
+        payload: &[u32],
+        cap: f32,
+        out: &mut Vec<u32>,
+    ) {
+        let points = run.x.iter().zip(run.y).zip(run.z);
+        for (i, ((&x, &y), &z)) in points.enumerate() {
+            let d = squared(q, x, y, z);
+            if d <= cap {
+                out.push(if PAYLOAD { payload[i] } else { d.to_bits() });
+            }
+        }
+    }
+
+    pub(super) fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
+        let points = run.x.iter().zip(run.y).zip(run.z);
+        points
+            .filter(|&((&x, &y), &z)| squared(q, x, y, z) <= cap)
+            .count()
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
+
+    use super::{portable, Run};
+
+    /// For each 8-bit mask, the lanes it selects, first to last, then
+    /// zeros: the permutation that packs the selected lanes to the front.
+    static PACK: [[u32; 8]; 256] = {
+        let mut table = [[0u32; 8]; 256];
+        let mut mask = 0;
+        while mask < 256 {
+            let (mut lane, mut next) = (0, 0);
+            while lane < 8 {
+                if mask >> lane & 1 == 1 {
+                    table[mask][next] = lane as u32;
+                    next += 1;
+                }
+                lane += 1;
+            }
+            mask += 1;
+        }
+        table
+    };
+
+    /// Squared distances of the 8 points from position `i`.
+    ///
+    /// # Safety
+    /// AVX2; `i + 8 <= run.x.len()` and the axes equally long.
+    #[inline]
+    #[target_feature(enable = "avx2")]
+    unsafe fn eight(q: [__m256; 3], run: Run, i: usize) -> __m256 {
+        // SAFETY: the caller's bounds.
+        let (x, y, z) = unsafe {
+            (
+                _mm256_loadu_ps(run.x.as_ptr().add(i)),
+                _mm256_loadu_ps(run.y.as_ptr().add(i)),
+                _mm256_loadu_ps(run.z.as_ptr().add(i)),
+            )
+        };
+        let (dx, dy, dz) = (
+            _mm256_sub_ps(q[0], x),
+            _mm256_sub_ps(q[1], y),
+            _mm256_sub_ps(q[2], z),
+        );
+        _mm256_add_ps(
+            _mm256_add_ps(_mm256_mul_ps(dx, dx), _mm256_mul_ps(dy, dy)),
+            _mm256_mul_ps(dz, dz),
+        )
+    }
+
+    fn splat(q: [f32; 3]) -> [__m256; 3] {
+        // SAFETY: AVX is implied by the callers' AVX2.
+        unsafe { q.map(|c| _mm256_set1_ps(c)) }
+    }
+
+    /// # Safety
+    /// AVX2; equal axes; `payload` as long as the run when `PAYLOAD`.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn keep<const PAYLOAD: bool>(
+        q: [f32; 3],
+        run: Run,
+        payload: &[u32],
+        cap: f32,
+        out: &mut Vec<u32>,
+    ) {
+        let n = run.x.len();
+        let (qv, capv) = (splat(q), _mm256_set1_ps(cap));
+        // Each step stores 8 lanes at the end and keeps some of them.
+        out.reserve(n + 8);
+        let base = out.len();
+        let dst = out.as_mut_ptr();
+        let (mut kept, mut i) = (0, 0);
+        while i + 8 <= n {
+            // SAFETY: i + 8 <= n; the store lies within the reserve (kept ≤ i).
+            unsafe {
+                let d = eight(qv, run, i);
+                let mask = _mm256_movemask_ps(_mm256_cmp_ps(d, capv, _CMP_LE_OQ)) as usize;
+                let lanes = if PAYLOAD {
+                    _mm256_loadu_si256(payload.as_ptr().add(i).cast())
+                } else {
+                    _mm256_castps_si256(d)
+                };
+                let order = _mm256_loadu_si256(PACK[mask].as_ptr().cast());
+                let packed = _mm256_permutevar8x32_epi32(lanes, order);
+                _mm256_storeu_si256(dst.add(base + kept).cast(), packed);
+                kept += mask.count_ones() as usize;
+            }
+            i += 8;
+        }
+        // SAFETY: the first `base + kept` are written.
+        unsafe { out.set_len(base + kept) };
+        let rest = if PAYLOAD { &payload[i..] } else { payload };
+        portable::keep::<PAYLOAD>(q, run.from(i), rest, cap, out);
+    }
+
+    /// # Safety
+    /// AVX2; equal axes.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
+        let n = run.x.len();
+        let (qv, capv) = (splat(q), _mm256_set1_ps(cap));
+        let (mut found, mut i) = (0, 0);
+        while i + 8 <= n {
+            // SAFETY: i + 8 <= n.
+            let d = unsafe { eight(qv, run, i) };
+            found += _mm256_movemask_ps(_mm256_cmp_ps(d, capv, _CMP_LE_OQ)).count_ones() as usize;
+            i += 8;
+        }
+        found + portable::count(q, run.from(i), cap)
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use super::Run;
+
+    /// Squared distances of the points from position `i` that `lanes`
+    /// selects (the others read as zero).
+    ///
+    /// # Safety
+    /// AVX-512F; the selected lanes lie within the run, whose axes are equally long.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    unsafe fn sixteen(q: [__m512; 3], run: Run, i: usize, lanes: __mmask16) -> __m512 {
+        // SAFETY: masked loads touch only the selected lanes.
+        let (x, y, z) = unsafe {
+            (
+                _mm512_maskz_loadu_ps(lanes, run.x.as_ptr().add(i)),
+                _mm512_maskz_loadu_ps(lanes, run.y.as_ptr().add(i)),
+                _mm512_maskz_loadu_ps(lanes, run.z.as_ptr().add(i)),
+            )
+        };
+        let (dx, dy, dz) = (
+            _mm512_sub_ps(q[0], x),
+            _mm512_sub_ps(q[1], y),
+            _mm512_sub_ps(q[2], z),
+        );
+        _mm512_add_ps(
+            _mm512_add_ps(_mm512_mul_ps(dx, dx), _mm512_mul_ps(dy, dy)),
+            _mm512_mul_ps(dz, dz),
+        )
+    }
+
+    /// The lanes of a step from `i` that lie within `n`.
+    fn lanes(i: usize, n: usize) -> __mmask16 {
+        if n - i >= 16 {
+            u16::MAX
+        } else {
+            (1u16 << (n - i)) - 1
+        }
+    }
+
+    fn splat(q: [f32; 3]) -> [__m512; 3] {
+        // SAFETY: called only from AVX-512F functions.
+        unsafe { q.map(|c| _mm512_set1_ps(c)) }
+    }
+
+    /// # Safety
+    /// AVX-512F; equal axes; `payload` as long as the run when `PAYLOAD`.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn keep<const PAYLOAD: bool>(
+        q: [f32; 3],
+        run: Run,
+        payload: &[u32],
+        cap: f32,
+        out: &mut Vec<u32>,
+    ) {
+        let n = run.x.len();
+        let (qv, capv) = (splat(q), _mm512_set1_ps(cap));
+        // Each step stores 16 lanes at the end and keeps some of them.
+        out.reserve(n + 16);
+        let base = out.len();
+        let dst = out.as_mut_ptr();
+        let (mut kept, mut i) = (0, 0);
+        while i < n {
+            let step = lanes(i, n);
+            // SAFETY: loads masked to the run; the store lies within the
+            // reserve (kept ≤ i < n).
+            unsafe {
+                let d = sixteen(qv, run, i, step);
+                let within = _mm512_mask_cmp_ps_mask(step, d, capv, _CMP_LE_OQ);
+                let lanes = if PAYLOAD {
+                    _mm512_maskz_loadu_epi32(step, payload.as_ptr().add(i).cast())
+                } else {
+                    _mm512_castps_si512(d)
+                };
+                let packed = _mm512_maskz_compress_epi32(within, lanes);
+                _mm512_storeu_si512(dst.add(base + kept).cast(), packed);
+                kept += within.count_ones() as usize;
+            }
+            i += 16;
+        }
+        // SAFETY: the first `base + kept` are written.
+        unsafe { out.set_len(base + kept) };
+    }
+
+    /// # Safety
+    /// AVX-512F; equal axes.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
+        let n = run.x.len();
+        let (qv, capv) = (splat(q), _mm512_set1_ps(cap));
+        let (mut found, mut i) = (0, 0);
+        while i < n {
+            let step = lanes(i, n);
+            // SAFETY: loads masked to the run.
+            let d = unsafe { sixteen(qv, run, i, step) };
+            found += _mm512_mask_cmp_ps_mask(step, d, capv, _CMP_LE_OQ).count_ones() as usize;
+            i += 16;
+        }
+        found
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A small deterministic generator (the crate's tests avoid a rand dependency here).
+    fn runs(seed: u64) -> impl Iterator<Item = (Vec<f32>, Vec<f32>, Vec<f32>, [f32; 3], f32)> {
+        let mut s = seed;
+        let mut next = move || {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            ((s >> 40) as f32 / (1u64 << 24) as f32) * 2.0 - 1.0
+        };
+        (0..400).map(move |t| {
+            let n = t % 70;
+            let scale = [1e-3f32, 1.0, 1e3, 1e30][t % 4];
+            let mut axis = || (0..n).map(|_| next() * scale).collect::<Vec<f32>>();
+            let (x, y, z) = (axis(), axis(), axis());
+            let q = [next() * scale, next() * scale, next() * scale];
+            // Caps from none kept to all, and exactly a point's distance.
+            let cap = match t % 5 {
+                0 => 0.0,
+                1 => f32::INFINITY,
+                2 if n > 0 => squared(q, x[0], y[0], z[0]),
+                _ => (next().abs() * scale).powi(2),
+            };
+            (x, y, z, q, cap)
+        })
+    }
+
+    #[test]
+    fn every_path_keeps_and_counts_what_the_definition_does() {
+        for isa in Isa::available() {
+            for (x, y, z, q, cap) in runs(7) {
+                let run = Run {
+                    x: &x,
+                    y: &y,
+                    z: &z,
+                };
+                let payload: Vec<u32> = (0..x.len() as u32).map(|i| i * 3 + 1).collect();
+                // The definition, independent of every path.
+                let within: Vec<usize> = (0..x.len())
+                    .filter(|&i| {
+                        let (dx, dy, dz) = (q[0] - x[i], q[1] - y[i], q[2] - z[i]);
+                        dx * dx + dy * dy + dz * dz <= cap
+                    })
+                    .collect();
+                let bits: Vec<u32> = within
+                    .iter()
+                    .map(|&i| squared(q, x[i], y[i], z[i]).to_bits())
+                    .collect();
+                let ids: Vec<u32> = within.iter().map(|&i| payload[i]).collect();
+                // Appended after what the buffer holds.
+                let mut out = vec![99];
+                keep_distances(isa, q, run, cap, &mut out);
+                assert_eq!(out[0], 99, "{isa:?}");
+                assert_eq!(out[1..], bits[..], "{isa:?} distances, {} points", x.len());
+                let mut out = Vec::new();
+                keep_payload(isa, q, run, &payload, cap, &mut out);
+                assert_eq!(out, ids, "{isa:?} payload");
+                assert_eq!(count(isa, q, run, cap), within.len(), "{isa:?} count");
+            }
+        }
+    }
+
+    #[test]
+    fn the_best_path_is_one_this_machine_runs() {
+        assert!(Isa::available().contains(&Isa::best()));
+    }
+}
