@@ -18,8 +18,9 @@
 //! them lie within r, they hold the k nearest; otherwise r grows (by the
 //! count found, as on a surface) and the query is repeated. A point far
 //! from the rest (an outlier above the scan, whose box would sweep many
-//! columns) is answered after the others: by a k-d tree when such points
-//! are many, else on the grid. In place of the tree's walk with a branch a
+//! columns) is answered after the others: the columns nearest its own
+//! bound its k-th distance, and the search within that bound passes over
+//! columns whose boxes lie beyond it. In place of the tree's walk with a branch a
 //! node, a query costs a few look-ups and about four times k distances:
 //! the statistical filter on the 1 M-point bench pile fell from 2.15 s
 //! (the tree alone) to 0.64–0.79 s (BENCHMARKS.md, 2026-12-03). A cloud
@@ -34,7 +35,6 @@
 
 use rayon::prelude::*;
 
-use super::kdtree::{KdTree, Nearest};
 use super::within::{self, Isa, Run};
 
 use crate::Point;
@@ -61,6 +61,9 @@ pub(crate) struct Grid {
     /// The first sorted position of each slab, per column (from
     /// `Slabs::first`), and one past the column's last point.
     slab_start: Vec<u32>,
+    /// The lowest and highest height of each block of columns (infinite,
+    /// the wrong way round, for an empty one).
+    block_heights: Vec<(f32, f32)>,
     /// Coordinates in sorted order.
     x: Vec<f32>,
     y: Vec<f32>,
@@ -193,6 +196,15 @@ impl Grid {
         let coordinate = |a: usize| -> Vec<f32> { sorted.par_iter().map(|p| p[a]).collect() };
         let z = coordinate(2);
         let (slabs, slab_start) = slab_index(&start, &z, h);
+        let block_heights = slabs
+            .chunks(BLOCK * BLOCK)
+            .map(|block| {
+                let filled = block.iter().filter(|s| s.count > 0);
+                filled.fold((f32::INFINITY, f32::NEG_INFINITY), |(l, t), s| {
+                    (l.min(s.base), t.max(s.top))
+                })
+            })
+            .collect();
         Some(Self {
             origin: lo,
             h,
@@ -201,6 +213,7 @@ impl Grid {
             start,
             slabs,
             slab_start,
+            block_heights,
             x: coordinate(0),
             y: coordinate(1),
             z,
@@ -240,30 +253,62 @@ impl Grid {
         // their points lie in one run of positions: where each of them
         // lies within the box's heights (widened by r: a surface, not a
         // wall) they are taken as one run, else column by column, each by
-        // its slabs.
+        // its slabs. A run or column whose box (its span of x and y, its
+        // points' heights) lies farther than r from q is passed over: the
+        // corners of a near query's box, and most of a far query's.
         let (pad_lo, pad_hi) = (lo32 - wide as f32, hi32 + wide as f32);
+        let wide2 = wide * wide;
+        let qz = f64::from(q[2]);
+        // The distance from v to the span lo..=hi (0 within), and to a
+        // column's span along an axis, widened by far more than the
+        // rounding of the division that filed the points.
+        let gap = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
+        let margin = self.h * 1e-6;
+        let span = |c: usize, to: usize, a: usize| {
+            (
+                self.origin[a] + c as f64 * self.h - margin,
+                self.origin[a] + (to + 1) as f64 * self.h + margin,
+            )
+        };
         let own_y = column(qy, 1, self.ny - 1);
         let rows = std::iter::once(own_y).chain((y0..=y1).filter(|&cy| cy != own_y));
         for cy in rows {
+            let (ylo, yhi) = span(cy, cy, 1);
+            let dy2 = gap(qy, ylo, yhi).powi(2);
             let mut cx = x0;
             while cx <= x1 {
-                let last = ((cx / BLOCK + 1) * BLOCK - 1).min(x1);
+                let (first_x, last) = (cx, ((cx / BLOCK + 1) * BLOCK - 1).min(x1));
                 let c0 = block_index(cx, cy, self.nx);
                 let c1 = c0 + (last - cx);
                 cx = last + 1;
                 let columns = &self.slabs[c0..=c1];
-                let whole = columns
-                    .iter()
-                    .all(|s| s.count == 0 || (s.base >= pad_lo && s.top <= pad_hi));
-                if whole {
+                let (mut low, mut top) = (f32::INFINITY, f32::NEG_INFINITY);
+                for s in columns.iter().filter(|s| s.count > 0) {
+                    low = low.min(s.base);
+                    top = top.max(s.top);
+                }
+                if low > top {
+                    continue;
+                }
+                let (xlo, xhi) = span(first_x, last, 0);
+                let dz = gap(qz, f64::from(low), f64::from(top));
+                if gap(qx, xlo, xhi).powi(2) + dy2 + dz * dz > wide2 {
+                    continue;
+                }
+                if low >= pad_lo && top <= pad_hi {
                     let (s, e) = (self.start[c0] as usize, self.start[c1 + 1] as usize);
                     if s < e && !visit(s, e) {
                         return;
                     }
                     continue;
                 }
-                for slabs in columns {
+                for (i, slabs) in columns.iter().enumerate() {
                     if slabs.count == 0 {
+                        continue;
+                    }
+                    let (xlo, xhi) = span(first_x + i, first_x + i, 0);
+                    let dz = gap(qz, f64::from(slabs.base), f64::from(slabs.top));
+                    if gap(qx, xlo, xhi).powi(2) + dy2 + dz * dz > wide2 {
                         continue;
                     }
                     // The slabs that hold heights lo32..=hi32 (a slab's
@@ -412,24 +457,135 @@ impl Grid {
         }
     }
 
-    /// The k nearest squared distances of `q` from the tree, as `k_nearest`.
-    fn by_tree(&self, tree: &KdTree, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
-        let knn = scratch.knn.get_or_insert_with(|| Nearest::new(k));
-        tree.nearest(&q, knn);
-        scratch.bits.clear();
-        scratch
-            .bits
-            .extend(knn.distances().iter().map(|d| d.to_bits()));
-        knn.distances()[k - 1]
+    /// The k nearest squared distances of a point far from the rest, as
+    /// `k_nearest`: blocks of columns, then their columns, are searched
+    /// nearest first by the distance from q to their boxes (their span of
+    /// x and y, their points' heights), blocks ring by ring round q's as
+    /// they are needed, keeping the k nearest so far, until the next box
+    /// lies beyond the k-th. For a point high above the scan that is the
+    /// few columns below it; a radius grown until it holds k would
+    /// overshoot, and a ball of a little more than the k-th distance cuts
+    /// deep into the surface beneath (thousands of points where k are
+    /// wanted).
+    fn far_k_nearest(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
+        use std::cmp::Reverse;
+        let (qx, qy, qz) = (f64::from(q[0]), f64::from(q[1]), f64::from(q[2]));
+        let at = |v: f64, a: usize, last: usize| {
+            (((v - self.origin[a]) / self.h).max(0.0) as usize).min(last)
+        };
+        let (bx, by) = (
+            at(qx, 0, self.nx - 1) / BLOCK,
+            at(qy, 1, self.ny - 1) / BLOCK,
+        );
+        let (blocks_x, blocks_y) = (self.nx.div_ceil(BLOCK), self.ny.div_ceil(BLOCK));
+        let gap = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
+        let margin = self.h * 1e-6;
+        // The edge of column c along axis a.
+        let edge = |c: usize, a: usize| self.origin[a] + c as f64 * self.h;
+        // The squared distance from q to the box of columns x0..x1, y0..y1
+        // (past the last) whose heights are `low..=top`.
+        let reach = |x0: usize, x1: usize, y0: usize, y1: usize, (low, top): (f32, f32)| {
+            let dx = gap(qx, edge(x0, 0) - margin, edge(x1, 0) + margin);
+            let dy = gap(qy, edge(y0, 1) - margin, edge(y1, 1) + margin);
+            let dz = gap(qz, f64::from(low), f64::from(top));
+            dx * dx + dy * dy + dz * dz
+        };
+        // Boxes waiting, nearest first (squared distances ≥ 0 order as
+        // their bits): a block (true) or a column (false) by index.
+        let mut waiting: std::collections::BinaryHeap<Reverse<(u64, bool, usize)>> =
+            std::collections::BinaryHeap::new();
+        let (bits, best) = (&mut scratch.bits, &mut scratch.best);
+        best.clear();
+        let mut cap = f32::INFINITY;
+        let mut ring = 0;
+        loop {
+            let limit = f64::from(cap) * (1.0 + SLACK);
+            // Beyond the rings of blocks so far (0 to ring − 1), every
+            // box lies at least `outside` from q (no side: the grid's edge).
+            let sides = [
+                (bx >= ring).then(|| qx - edge((bx + 1 - ring) * BLOCK, 0)),
+                (bx + ring < blocks_x).then(|| edge((bx + ring) * BLOCK, 0) - qx),
+                (by >= ring).then(|| qy - edge((by + 1 - ring) * BLOCK, 1)),
+                (by + ring < blocks_y).then(|| edge((by + ring) * BLOCK, 1) - qy),
+            ];
+            let outside = sides.iter().flatten().fold(f64::INFINITY, |m, &d| m.min(d)) - margin;
+            let outside = outside.max(0.0).powi(2);
+            let next = waiting.peek().map(|Reverse((d, _, _))| f64::from_bits(*d));
+            if outside.is_finite() && outside <= limit && next.is_none_or(|d| outside < d) {
+                // The next ring of blocks round q's.
+                let (x0, x1) = (bx.saturating_sub(ring), (bx + ring).min(blocks_x - 1));
+                let (y0, y1) = (by.saturating_sub(ring), (by + ring).min(blocks_y - 1));
+                for y in y0..=y1 {
+                    let row_edge = y + ring == by || y == by + ring;
+                    for x in x0..=x1 {
+                        if !(row_edge || x + ring == bx || x == bx + ring) {
+                            continue;
+                        }
+                        let b = y * blocks_x + x;
+                        let heights = self.block_heights[b];
+                        if heights.0 > heights.1 {
+                            continue;
+                        }
+                        let (cx, cy) = (x * BLOCK, y * BLOCK);
+                        let d = reach(cx, cx + BLOCK, cy, cy + BLOCK, heights);
+                        if d <= limit {
+                            waiting.push(Reverse((d.to_bits(), true, b)));
+                        }
+                    }
+                }
+                ring += 1;
+                continue;
+            }
+            let Some(d) = next.filter(|&d| d <= limit) else {
+                break;
+            };
+            let Some(Reverse((_, block, i))) = waiting.pop() else {
+                unreachable!("peeked at {d}")
+            };
+            if block {
+                // Its columns (numbered in a run, see `block_index`).
+                let (x0, y0) = ((i % blocks_x) * BLOCK, (i / blocks_x) * BLOCK);
+                for j in 0..BLOCK * BLOCK {
+                    let (x, y) = (x0 + j % BLOCK, y0 + j / BLOCK);
+                    let c = i * BLOCK * BLOCK + j;
+                    if x >= self.nx || y >= self.ny || self.slabs[c].count == 0 {
+                        continue;
+                    }
+                    let slabs = &self.slabs[c];
+                    let d = reach(x, x + 1, y, y + 1, (slabs.base, slabs.top));
+                    if d <= limit {
+                        waiting.push(Reverse((d.to_bits(), false, c)));
+                    }
+                }
+                continue;
+            }
+            // Its points nearer than the k-th so far replace it.
+            let (s, e) = (self.start[i] as usize, self.start[i + 1] as usize);
+            bits.clear();
+            within::keep_distances(self.isa, q, self.run(s, e), cap, bits);
+            for &d in bits.iter() {
+                if best.len() < k {
+                    best.push(d);
+                } else if let Some(mut kth) = best.peek_mut().filter(|kth| d < **kth) {
+                    *kth = d;
+                }
+            }
+            if best.len() == k {
+                cap = f32::from_bits(*best.peek().expect("k > 0"));
+            }
+        }
+        // The k (the grid holds more than k points), the k-th last.
+        bits.clear();
+        let kth = best.pop().expect("k > 0");
+        bits.extend(best.drain());
+        bits.push(kth);
+        cap
     }
 
     /// `f` of the k nearest squared distances (the point itself counted;
     /// in any order, the k-th last) of every point, in input order; runs of
-    /// sorted positions in parallel. Points far from the rest are answered
-    /// after the others: by a k-d tree when they are many (outliers of a
-    /// noisy scan: each would sweep a wide box of the grid), else on the
-    /// grid (a tree over a 20 M-point scan for a few hundred of them would
-    /// cost more than it saves).
+    /// sorted positions in parallel. Points far from the rest (outliers of
+    /// a noisy scan) are answered after the others, by `far_k_nearest`.
     pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
     where
         T: Send + Sync + Clone + Default,
@@ -458,24 +614,11 @@ impl Grid {
         let far: Vec<usize> = (0..self.ids.len())
             .filter(|&p| out[self.ids[p] as usize].is_none())
             .collect();
-        let tree = (far.len() * TREE_WORTH > self.ids.len()).then(|| {
-            let points: Vec<Point> = (0..self.ids.len())
-                .map(|p| [self.x[p], self.y[p], self.z[p]])
-                .collect();
-            KdTree::new(&points)
-        });
         let late: Vec<(usize, T)> = far
             .par_iter()
             .map_init(Scratch::default, |scratch, &p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
-                match &tree {
-                    Some(tree) => {
-                        self.by_tree(tree, q, k, scratch);
-                    }
-                    None => {
-                        self.k_nearest(q, FAR * self.h, k, scratch, true);
-                    }
-                }
+                self.far_k_nearest(q, k, scratch);
                 (self.ids[p] as usize, answer(scratch))
             })
             .collect();
@@ -485,11 +628,6 @@ impl Grid {
         out.into_iter().map(|v| v.unwrap_or_default()).collect()
     }
 }
-
-/// Far points per point above which they are answered by a k-d tree (a
-/// tree costs about 0.1 µs a point to build, a far point on the grid about
-/// 100 µs).
-const TREE_WORTH: usize = 1000;
 
 /// Columns a side of a block (see [`block_index`]).
 const BLOCK: usize = 8;
@@ -648,7 +786,8 @@ impl Columns {
 struct Scratch {
     bits: Vec<u32>,
     nearest: Vec<f32>,
-    knn: Option<Nearest>,
+    /// The k nearest so far of `far_k_nearest`, farthest on top.
+    best: std::collections::BinaryHeap<u32>,
 }
 
 /// The cloud's bounding box, in f64.
