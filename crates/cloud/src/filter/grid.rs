@@ -868,6 +868,35 @@ mod tests {
     }
 
     #[test]
+    fn points_far_from_a_sloped_scan_on_every_side_agree_too() {
+        // A scan on a 35° slope with 3 % of its points moved far off it
+        // (above, below, beside it, past its end, into an empty corner of
+        // the box): answered nearest box first, as `far_k_nearest`.
+        let mut u = super::super::common::uniform(11);
+        let mut points: Vec<Point> = (0..30_000)
+            .map(|_| {
+                let (x, y) = (u() * 30.0, u() * 12.0);
+                [x, y, 0.7 * x + 0.02 * u()]
+            })
+            .collect();
+        for i in 0..900 {
+            let p = &mut points[i * 31 + 7];
+            let far = 0.5 + 6.0 * u();
+            match i % 5 {
+                0 => p[2] += far,
+                1 => p[2] -= far,
+                2 => p[1] = -far,
+                3 => p[0] = 30.0 + far,
+                _ => *p = [u() * 3.0, 12.0 - u(), 20.0 + u() * 3.0],
+            }
+        }
+        for k in [6, 21, 51] {
+            let (grid, tree) = both(&points, k);
+            assert_eq!(grid, tree, "k {k}");
+        }
+    }
+
+    #[test]
     fn a_flat_or_vertical_cloud_and_far_clusters_agree_too() {
         // All in one plane (one slab), all in one column, and two
         // clusters far apart (the grid grows its cells or is declined).
