@@ -13,7 +13,8 @@
 //! up by the comparison's mask. `std::simd` is not stable, and no kept
 //! crate offers a compress. The instruction set is found at run time, so
 //! one build serves every x86-64 machine, and other targets take the
-//! portable loop.
+//! portable loop; `AUTOSHOVEL_ISA=avx2` or `=portable` in the environment
+//! holds a run to a narrower path (BENCHMARKS.md compares them).
 //!
 //! Every path computes `dx·dx + dy·dy + dz·dz` in f32, in that order, with
 //! no fused multiply-add (FLANN's arithmetic, as `kdtree.rs`), so each
@@ -51,25 +52,24 @@ pub(super) enum Isa {
 }
 
 impl Isa {
-    /// The widest this machine runs (found once).
+    /// The widest this machine runs (found once), or a narrower one named
+    /// by the environment variable `AUTOSHOVEL_ISA` (`portable`, `avx2`):
+    /// to measure the paths side by side, or to rule one out.
     pub(super) fn best() -> Self {
         static BEST: OnceLock<Isa> = OnceLock::new();
         *BEST.get_or_init(|| {
-            #[cfg(target_arch = "x86_64")]
-            {
-                if std::arch::is_x86_feature_detected!("avx512f") {
-                    return Isa::Avx512;
-                }
-                if std::arch::is_x86_feature_detected!("avx2") {
-                    return Isa::Avx2;
-                }
+            let all = Self::available();
+            let widest = *all.last().expect("the portable path");
+            match std::env::var("AUTOSHOVEL_ISA").as_deref() {
+                Ok("portable") => Isa::Portable,
+                #[cfg(target_arch = "x86_64")]
+                Ok("avx2") if all.contains(&Isa::Avx2) => Isa::Avx2,
+                _ => widest,
             }
-            Isa::Portable
         })
     }
 
-    /// Every path this machine runs, the portable one first (for tests).
-    #[cfg(test)]
+    /// Every path this machine runs, the portable one first.
     pub(super) fn available() -> Vec<Self> {
         let mut all = vec![Isa::Portable];
         #[cfg(target_arch = "x86_64")]
@@ -167,12 +167,26 @@ mod portable {
         cap: f32,
         out: &mut Vec<u32>,
     ) {
-        let points = run.x.iter().zip(run.y).zip(run.z);
-        for (i, ((&x, &y), &z)) in points.enumerate() {
-            let d = squared(q, x, y, z);
-            if d <= cap {
-                out.push(if PAYLOAD { payload[i] } else { d.to_bits() });
+        // In chunks: the distances in a loop of arithmetic alone (which
+        // the compiler vectorises for the target), then a branch-free keep
+        // (a branch a point mispredicts at every other point: 2× slower).
+        const CHUNK: usize = 64;
+        let mut d = [0f32; CHUNK];
+        for s in (0..run.x.len()).step_by(CHUNK) {
+            let chunk = run.from(s);
+            let m = chunk.x.len().min(CHUNK);
+            let points = chunk.x[..m].iter().zip(&chunk.y[..m]).zip(&chunk.z[..m]);
+            for (d, ((&x, &y), &z)) in d.iter_mut().zip(points) {
+                *d = squared(q, x, y, z);
             }
+            let base = out.len();
+            out.resize(base + m, 0);
+            let mut kept = 0;
+            for (i, &d) in d[..m].iter().enumerate() {
+                out[base + kept] = if PAYLOAD { payload[s + i] } else { d.to_bits() };
+                kept += usize::from(d <= cap);
+            }
+            out.truncate(base + kept);
         }
     }
 
