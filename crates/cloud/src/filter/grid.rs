@@ -442,7 +442,14 @@ impl Grid {
             let found = scratch.bits.len();
             if found >= k {
                 let bits = &mut scratch.bits;
-                bits.select_nth_unstable(k - 1);
+                // A few dozen are sorted faster than selected (the
+                // standard sort's networks for small slices: 79 against
+                // 125 ns for 27 of them, k = 21).
+                if found <= SORT_BELOW {
+                    bits.sort_unstable();
+                } else {
+                    bits.select_nth_unstable(k - 1);
+                }
                 return Some(f32::from_bits(bits[k - 1]));
             }
             // Too few within r: on a surface the count grows as r², so
@@ -628,6 +635,9 @@ impl Grid {
         out.into_iter().map(|v| v.unwrap_or_default()).collect()
     }
 }
+
+/// Found distances up to which a query sorts them rather than selects.
+const SORT_BELOW: usize = 32;
 
 /// Columns a side of a block (see [`block_index`]).
 const BLOCK: usize = 8;
