@@ -249,9 +249,14 @@ mod avx2 {
         )
     }
 
+    #[inline]
+    #[target_feature(enable = "avx2")]
     fn splat(q: [f32; 3]) -> [__m256; 3] {
-        // SAFETY: AVX is implied by the callers' AVX2.
-        unsafe { q.map(|c| _mm256_set1_ps(c)) }
+        [
+            _mm256_set1_ps(q[0]),
+            _mm256_set1_ps(q[1]),
+            _mm256_set1_ps(q[2]),
+        ]
     }
 
     /// # Safety
@@ -353,9 +358,14 @@ mod avx512 {
         }
     }
 
+    #[inline]
+    #[target_feature(enable = "avx512f")]
     fn splat(q: [f32; 3]) -> [__m512; 3] {
-        // SAFETY: called only from AVX-512F functions.
-        unsafe { q.map(|c| _mm512_set1_ps(c)) }
+        [
+            _mm512_set1_ps(q[0]),
+            _mm512_set1_ps(q[1]),
+            _mm512_set1_ps(q[2]),
+        ]
     }
 
     /// # Safety
