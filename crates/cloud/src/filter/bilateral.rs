@@ -156,7 +156,7 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
             }
         };
         // On a grid of columns as wide as the radius when the cloud suits
-        // one (`grid.rs`), else on the k-d tree: the same neighbours.
+        // one (`grid/`), else on the k-d tree: the same neighbours.
         points = match Grid::for_radius(current, radius) {
             Some(grid) => grid.map_within(r2, || (), |_, i, found| smooth(i, found)),
             None => {

@@ -20,7 +20,7 @@
 //! what to change. Non-finite points are dropped by every filter, as PCL's
 //! tools do. Neighbour searches build one index per call and query it in
 //! parallel with rayon: a grid of height-sorted columns for a dense scan
-//! (`grid.rs`: statistical and radius removal, smoothing), a k-d tree for
+//! (`grid/`: statistical and radius removal, smoothing), a k-d tree for
 //! normals and for clouds too sparse for a grid (`kdtree.rs`, which says why
 //! it is not `kiddo`); both find the same neighbours, and results never
 //! depend on the number of threads.

@@ -136,7 +136,7 @@ fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<us
     let r2 = f32_at_most(params.radius_m * params.radius_m);
     // The wanted-th nearest is within the radius exactly when at least
     // `wanted` points are: count them, stopping at `wanted` (on a grid of
-    // columns as wide as the radius when the cloud suits one, `grid.rs`;
+    // columns as wide as the radius when the cloud suits one, `grid/`;
     // else on the k-d tree: the same counts).
     let keep: Vec<bool> = match Grid::for_radius(points, f64::from(r2).sqrt()) {
         Some(grid) => grid.map_has_within(r2, wanted),

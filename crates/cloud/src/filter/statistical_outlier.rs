@@ -166,7 +166,7 @@ pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f
 
 /// `f` of every point's k nearest squared distances (the point itself
 /// counted; in any order, the k-th last), in input order: on the grid of columns when the
-/// cloud suits one (`grid.rs`), else on the k-d tree; the same bits either way.
+/// cloud suits one (`grid/`), else on the k-d tree; the same bits either way.
 fn k_nearest_distances<T, F>(points: &[Point], k: usize, f: F) -> Vec<T>
 where
     T: Send + Sync + Clone + Default,

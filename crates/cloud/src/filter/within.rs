@@ -1,4 +1,4 @@
-//! The inner loop of every grid search (`grid.rs`): the squared distances
+//! The inner loop of every grid search (`grid/`): the squared distances
 //! from a query to a run of points, and which of them lie within a cap —
 //! kept (the distances themselves, or a payload such as the points'
 //! indices) or counted.

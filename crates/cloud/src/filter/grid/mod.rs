@@ -35,6 +35,8 @@
 
 use rayon::prelude::*;
 
+mod far;
+
 use super::kdtree::{KdTree, Nearest};
 use super::within::{self, Isa, Run};
 
@@ -467,131 +469,6 @@ impl Grid {
                 return None;
             }
         }
-    }
-
-    /// The k nearest squared distances of a point far from the rest, as
-    /// `k_nearest`: blocks of columns, then their columns, are searched
-    /// nearest first by the distance from q to their boxes (their span of
-    /// x and y, their points' heights), blocks ring by ring round q's as
-    /// they are needed, keeping the k nearest so far, until the next box
-    /// lies beyond the k-th. For a point high above the scan that is the
-    /// few columns below it; a radius grown until it holds k would
-    /// overshoot, and a ball of a little more than the k-th distance cuts
-    /// deep into the surface beneath (thousands of points where k are
-    /// wanted).
-    fn far_k_nearest(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
-        use std::cmp::Reverse;
-        let (qx, qy, qz) = (f64::from(q[0]), f64::from(q[1]), f64::from(q[2]));
-        let at = |v: f64, a: usize, last: usize| {
-            (((v - self.origin[a]) / self.h).max(0.0) as usize).min(last)
-        };
-        let (bx, by) = (
-            at(qx, 0, self.nx - 1) / BLOCK,
-            at(qy, 1, self.ny - 1) / BLOCK,
-        );
-        let (blocks_x, blocks_y) = (self.nx.div_ceil(BLOCK), self.ny.div_ceil(BLOCK));
-        let gap = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
-        let margin = self.h * 1e-6;
-        // The edge of column c along axis a.
-        let edge = |c: usize, a: usize| self.origin[a] + c as f64 * self.h;
-        // The squared distance from q to the box of columns x0..x1, y0..y1
-        // (past the last) whose heights are `low..=top`.
-        let reach = |x0: usize, x1: usize, y0: usize, y1: usize, (low, top): (f32, f32)| {
-            let dx = gap(qx, edge(x0, 0) - margin, edge(x1, 0) + margin);
-            let dy = gap(qy, edge(y0, 1) - margin, edge(y1, 1) + margin);
-            let dz = gap(qz, f64::from(low), f64::from(top));
-            dx * dx + dy * dy + dz * dz
-        };
-        // Boxes waiting, nearest first (squared distances ≥ 0 order as
-        // their bits): a block (true) or a column (false) by index.
-        let mut waiting: std::collections::BinaryHeap<Reverse<(u64, bool, usize)>> =
-            std::collections::BinaryHeap::new();
-        let (bits, best) = (&mut scratch.bits, &mut scratch.best);
-        best.clear();
-        let mut cap = f32::INFINITY;
-        let mut ring = 0;
-        loop {
-            let limit = f64::from(cap) * (1.0 + SLACK);
-            // Beyond the rings of blocks so far (0 to ring − 1), every
-            // box lies at least `outside` from q (no side: the grid's edge).
-            let sides = [
-                (bx >= ring).then(|| qx - edge((bx + 1 - ring) * BLOCK, 0)),
-                (bx + ring < blocks_x).then(|| edge((bx + ring) * BLOCK, 0) - qx),
-                (by >= ring).then(|| qy - edge((by + 1 - ring) * BLOCK, 1)),
-                (by + ring < blocks_y).then(|| edge((by + ring) * BLOCK, 1) - qy),
-            ];
-            let outside = sides.iter().flatten().fold(f64::INFINITY, |m, &d| m.min(d)) - margin;
-            let outside = outside.max(0.0).powi(2);
-            let next = waiting.peek().map(|Reverse((d, _, _))| f64::from_bits(*d));
-            if outside.is_finite() && outside <= limit && next.is_none_or(|d| outside < d) {
-                // The next ring of blocks round q's.
-                let (x0, x1) = (bx.saturating_sub(ring), (bx + ring).min(blocks_x - 1));
-                let (y0, y1) = (by.saturating_sub(ring), (by + ring).min(blocks_y - 1));
-                for y in y0..=y1 {
-                    let row_edge = y + ring == by || y == by + ring;
-                    for x in x0..=x1 {
-                        if !(row_edge || x + ring == bx || x == bx + ring) {
-                            continue;
-                        }
-                        let b = y * blocks_x + x;
-                        let heights = self.block_heights[b];
-                        if heights.0 > heights.1 {
-                            continue;
-                        }
-                        let (cx, cy) = (x * BLOCK, y * BLOCK);
-                        let d = reach(cx, cx + BLOCK, cy, cy + BLOCK, heights);
-                        if d <= limit {
-                            waiting.push(Reverse((d.to_bits(), true, b)));
-                        }
-                    }
-                }
-                ring += 1;
-                continue;
-            }
-            let Some(d) = next.filter(|&d| d <= limit) else {
-                break;
-            };
-            let Some(Reverse((_, block, i))) = waiting.pop() else {
-                unreachable!("peeked at {d}")
-            };
-            if block {
-                // Its columns (numbered in a run, see `block_index`).
-                let (x0, y0) = ((i % blocks_x) * BLOCK, (i / blocks_x) * BLOCK);
-                for j in 0..BLOCK * BLOCK {
-                    let (x, y) = (x0 + j % BLOCK, y0 + j / BLOCK);
-                    let c = i * BLOCK * BLOCK + j;
-                    if x >= self.nx || y >= self.ny || self.slabs[c].count == 0 {
-                        continue;
-                    }
-                    let slabs = &self.slabs[c];
-                    let d = reach(x, x + 1, y, y + 1, (slabs.base, slabs.top));
-                    if d <= limit {
-                        waiting.push(Reverse((d.to_bits(), false, c)));
-                    }
-                }
-                continue;
-            }
-            // Its points nearer than the k-th so far replace it.
-            let (s, e) = (self.start[i] as usize, self.start[i + 1] as usize);
-            bits.clear();
-            within::keep_distances(self.isa, q, self.run(s, e), cap, bits);
-            for &d in bits.iter() {
-                if best.len() < k {
-                    best.push(d);
-                } else if let Some(mut kth) = best.peek_mut().filter(|kth| d < **kth) {
-                    *kth = d;
-                }
-            }
-            if best.len() == k {
-                cap = f32::from_bits(*best.peek().expect("k > 0"));
-            }
-        }
-        // The k (the grid holds more than k points), the k-th last.
-        bits.clear();
-        let kth = best.pop().expect("k > 0");
-        bits.extend(best.drain());
-        bits.push(kth);
-        cap
     }
 
     /// `f` of the k nearest squared distances (the point itself counted;
