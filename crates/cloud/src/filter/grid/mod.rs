@@ -14,14 +14,15 @@
 //! block's columns, numbered in a run, as one run where their heights lie
 //! within the box's, as on a surface; else each column by two look-ups in
 //! its slabs), and one vector pass over those contiguous runs
-//! (`within.rs`) gives their squared distances and keeps those within r. If k of
-//! them lie within r, they hold the k nearest; otherwise r grows (by the
-//! count found, as on a surface) and the query is repeated. A point far
-//! from the rest (an outlier above the scan, whose box would sweep many
-//! columns) is answered after the others: blocks of columns and columns
-//! searched nearest box first, or on a large cloud with many of them a k-d
-//! tree (the columns such a search opens grow with the density). In place of the tree's walk with a branch a
-//! node, a query costs a few look-ups and about four times k distances:
+//! (`within.rs`) gives their squared distances and keeps those within r.
+//! If k of them lie within r, they hold the k nearest; otherwise r grows
+//! (by the count found, as on a surface) and the query is repeated. A
+//! point far from the rest (an outlier above the scan, whose box would
+//! sweep many columns) is answered after the others (`far.rs`): blocks of
+//! columns and columns searched nearest box first, or on a large cloud
+//! with many such points a k-d tree (the columns that search opens grow
+//! with the density). In place of the tree's walk with a branch a node, a
+//! query costs a few look-ups and some six times k distances:
 //! the statistical filter on the 1 M-point bench pile fell from 2.15 s
 //! (the tree alone) to 0.64–0.79 s (BENCHMARKS.md, 2026-12-03). A cloud
 //! whose grid would need far more columns than points (two scans
