@@ -77,7 +77,10 @@ impl Isa {
             if std::arch::is_x86_feature_detected!("avx2") {
                 all.push(Isa::Avx2);
             }
-            if std::arch::is_x86_feature_detected!("avx512f") {
+            // (every AVX-512 machine has AVX2; the other paths rely on it)
+            if std::arch::is_x86_feature_detected!("avx512f")
+                && std::arch::is_x86_feature_detected!("avx2")
+            {
                 all.push(Isa::Avx512);
             }
         }
