@@ -3,7 +3,7 @@
 //! columns searched nearest box first.
 
 use super::within;
-use super::{Grid, Scratch, BLOCK, SLACK};
+use super::{gap, Grid, Scratch, BLOCK, MARGIN, SLACK};
 
 impl Grid {
     /// The k nearest squared distances of a point far from the rest, as
@@ -19,31 +19,22 @@ impl Grid {
     pub(super) fn far_k_nearest(&self, q: [f32; 3], k: usize, scratch: &mut Scratch) -> f32 {
         use std::cmp::Reverse;
         let (qx, qy, qz) = (f64::from(q[0]), f64::from(q[1]), f64::from(q[2]));
-        let at = |v: f64, a: usize, last: usize| {
-            (((v - self.origin[a]) / self.h).max(0.0) as usize).min(last)
-        };
-        let (bx, by) = (
-            at(qx, 0, self.nx - 1) / BLOCK,
-            at(qy, 1, self.ny - 1) / BLOCK,
-        );
+        let (bx, by) = (self.column_at(qx, 0) / BLOCK, self.column_at(qy, 1) / BLOCK);
         let (blocks_x, blocks_y) = (self.nx.div_ceil(BLOCK), self.ny.div_ceil(BLOCK));
-        let gap = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
-        let margin = self.h * 1e-6;
-        // The edge of column c along axis a.
-        let edge = |c: usize, a: usize| self.origin[a] + c as f64 * self.h;
+        let margin = self.h * MARGIN;
+        let edge = |c: usize, a: usize| self.edge(c, a);
         // The squared distance from q to the box of columns x0..x1, y0..y1
         // (past the last) whose heights are `low..=top`.
         let reach = |x0: usize, x1: usize, y0: usize, y1: usize, (low, top): (f32, f32)| {
-            let dx = gap(qx, edge(x0, 0) - margin, edge(x1, 0) + margin);
-            let dy = gap(qy, edge(y0, 1) - margin, edge(y1, 1) + margin);
+            let dx = self.off_columns(qx, x0, x1, 0);
+            let dy = self.off_columns(qy, y0, y1, 1);
             let dz = gap(qz, f64::from(low), f64::from(top));
             dx * dx + dy * dy + dz * dz
         };
         // Boxes waiting, nearest first (squared distances ≥ 0 order as
         // their bits): a block (true) or a column (false) by index.
-        let mut waiting: std::collections::BinaryHeap<Reverse<(u64, bool, usize)>> =
-            std::collections::BinaryHeap::new();
-        let (bits, best) = (&mut scratch.bits, &mut scratch.best);
+        let (waiting, bits, best) = (&mut scratch.waiting, &mut scratch.bits, &mut scratch.best);
+        waiting.clear();
         best.clear();
         let mut cap = f32::INFINITY;
         let mut ring = 0;

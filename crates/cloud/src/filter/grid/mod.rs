@@ -49,6 +49,14 @@ const COLUMNS_PER_POINT: usize = 8;
 /// Relative widening of the box (see the module docs).
 const SLACK: f64 = 1e-4;
 
+/// A column's span widened by this share of its side (see `Grid::off_columns`).
+const MARGIN: f64 = 1e-6;
+
+/// The distance from `v` to the span `lo..=hi` (0 within).
+fn gap(v: f64, lo: f64, hi: f64) -> f64 {
+    (lo - v).max(v - hi).max(0.0)
+}
+
 /// Points filed by column (numbered in blocks, see `block_index`), each column by height.
 pub(crate) struct Grid {
     /// Corner of the grid (the cloud's minimum) and cell side.
@@ -230,23 +238,34 @@ impl Grid {
         })
     }
 
+    /// The column holding coordinate `v` along axis `a` (0: x, 1: y),
+    /// clamped to the grid.
+    fn column_at(&self, v: f64, a: usize) -> usize {
+        let last = [self.nx, self.ny][a] - 1;
+        (((v - self.origin[a]) / self.h).max(0.0) as usize).min(last)
+    }
+
+    /// Where column `c` begins along axis `a`.
+    fn edge(&self, c: usize, a: usize) -> f64 {
+        self.origin[a] + c as f64 * self.h
+    }
+
+    /// How far `v` lies along axis `a` from columns `from..to`, their span
+    /// widened by far more than the rounding of the division that filed
+    /// the points (0 within it).
+    fn off_columns(&self, v: f64, from: usize, to: usize, a: usize) -> f64 {
+        let margin = self.h * MARGIN;
+        gap(v, self.edge(from, a) - margin, self.edge(to, a) + margin)
+    }
+
     /// Calls `visit` with each run of sorted positions that may hold points
     /// within `r` of `q` (all such points are in some run), until it
     /// returns `false`.
     fn runs(&self, q: [f32; 3], r: f64, mut visit: impl FnMut(usize, usize) -> bool) {
         let wide = r * (1.0 + SLACK);
-        let column = |c: f64, a: usize, last: usize| {
-            (((c - self.origin[a]) / self.h).max(0.0) as usize).min(last)
-        };
         let (qx, qy) = (f64::from(q[0]), f64::from(q[1]));
-        let (x0, x1) = (
-            column(qx - wide, 0, self.nx - 1),
-            column(qx + wide, 0, self.nx - 1),
-        );
-        let (y0, y1) = (
-            column(qy - wide, 1, self.ny - 1),
-            column(qy + wide, 1, self.ny - 1),
-        );
+        let (x0, x1) = (self.column_at(qx - wide, 0), self.column_at(qx + wide, 0));
+        let (y0, y1) = (self.column_at(qy - wide, 1), self.column_at(qy + wide, 1));
         // Heights rounded outwards to f32.
         let (z_lo, z_hi) = (f64::from(q[2]) - wide, f64::from(q[2]) + wide);
         let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
@@ -267,22 +286,10 @@ impl Grid {
         let (pad_lo, pad_hi) = (lo32 - wide as f32, hi32 + wide as f32);
         let wide2 = wide * wide;
         let qz = f64::from(q[2]);
-        // The distance from v to the span lo..=hi (0 within), and to a
-        // column's span along an axis, widened by far more than the
-        // rounding of the division that filed the points.
-        let gap = |v: f64, lo: f64, hi: f64| (lo - v).max(v - hi).max(0.0);
-        let margin = self.h * 1e-6;
-        let span = |c: usize, to: usize, a: usize| {
-            (
-                self.origin[a] + c as f64 * self.h - margin,
-                self.origin[a] + (to + 1) as f64 * self.h + margin,
-            )
-        };
-        let own_y = column(qy, 1, self.ny - 1);
+        let own_y = self.column_at(qy, 1);
         let rows = std::iter::once(own_y).chain((y0..=y1).filter(|&cy| cy != own_y));
         for cy in rows {
-            let (ylo, yhi) = span(cy, cy, 1);
-            let dy2 = gap(qy, ylo, yhi).powi(2);
+            let dy2 = self.off_columns(qy, cy, cy + 1, 1).powi(2);
             let mut cx = x0;
             while cx <= x1 {
                 let (first_x, last) = (cx, ((cx / BLOCK + 1) * BLOCK - 1).min(x1));
@@ -298,9 +305,9 @@ impl Grid {
                 if low > top {
                     continue;
                 }
-                let (xlo, xhi) = span(first_x, last, 0);
+                let dx = self.off_columns(qx, first_x, last + 1, 0);
                 let dz = gap(qz, f64::from(low), f64::from(top));
-                if gap(qx, xlo, xhi).powi(2) + dy2 + dz * dz > wide2 {
+                if dx * dx + dy2 + dz * dz > wide2 {
                     continue;
                 }
                 if low >= pad_lo && top <= pad_hi {
@@ -314,9 +321,9 @@ impl Grid {
                     if slabs.count == 0 {
                         continue;
                     }
-                    let (xlo, xhi) = span(first_x + i, first_x + i, 0);
+                    let dx = self.off_columns(qx, first_x + i, first_x + i + 1, 0);
                     let dz = gap(qz, f64::from(slabs.base), f64::from(slabs.top));
-                    if gap(qx, xlo, xhi).powi(2) + dy2 + dz * dz > wide2 {
+                    if dx * dx + dy2 + dz * dz > wide2 {
                         continue;
                     }
                     // The slabs that hold heights lo32..=hi32 (a slab's
@@ -711,6 +718,8 @@ struct Scratch {
     knn: Option<Nearest>,
     /// The k nearest so far of `far_k_nearest`, farthest on top.
     best: std::collections::BinaryHeap<u32>,
+    /// The boxes `far_k_nearest` has still to open, nearest first.
+    waiting: std::collections::BinaryHeap<std::cmp::Reverse<(u64, bool, usize)>>,
 }
 
 /// The cloud's bounding box, in f64.
