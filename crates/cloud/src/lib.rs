@@ -15,7 +15,6 @@ mod cloud;
 mod error;
 pub mod filter;
 pub mod io;
-pub mod pages;
 
 pub use cloud::{Point, PointCloud};
 pub use error::{CloudError, Result};

@@ -161,57 +161,35 @@ pub fn pass_through(cloud: &[Point], params: &PassThroughParams) -> Result<Point
 /// Points per task of [`compact`].
 const CHUNK: usize = 1 << 15;
 
-/// Points a task keeps in a block on its stack before copying them out.
-const BLOCK: usize = 256;
-
 /// `out(i, p)` for the points `p` (at index `i`) that pass `keep`, in input
-/// order. A first parallel pass counts each chunk's survivors, so that the
-/// output is allocated at its final size (on huge pages when large: a fresh
-/// output's page faults were a third of the filter's time at 5 M points)
-/// and each task writes its chunk's survivors straight to their place,
-/// branch-free through a small block on its stack.
+/// order. Each task writes its chunk's survivors, branch-free, to the start
+/// of the chunk's own range of the output; the ranges are then closed up in
+/// order.
 fn compact<T, K, O>(points: &[Point], keep: K, out: O) -> Vec<T>
 where
     T: Copy + Default + Send + Sync,
     K: Fn(&Point) -> bool + Sync,
     O: Fn(usize, &Point) -> T + Sync,
 {
-    let counts: Vec<usize> = points
-        .par_chunks(CHUNK)
-        .map(|src| src.iter().map(|p| usize::from(keep(p))).sum())
-        .collect();
-    let total = counts.iter().sum();
-    let mut result: Vec<T> = crate::pages::vec_with_capacity(total);
-    let mut rest = &mut result.spare_capacity_mut()[..total];
-    let mut targets = Vec::with_capacity(counts.len());
-    for &count in &counts {
-        let (dst, tail) = rest.split_at_mut(count);
-        targets.push(dst);
-        rest = tail;
-    }
-    targets
-        .into_par_iter()
+    let mut result = vec![T::default(); points.len()];
+    let counts: Vec<usize> = result
+        .par_chunks_mut(CHUNK)
         .zip(points.par_chunks(CHUNK))
         .enumerate()
-        .for_each(|(chunk, (dst, src))| {
-            let mut block = [T::default(); BLOCK];
-            let mut written = 0;
-            for (b, part) in src.chunks(BLOCK).enumerate() {
-                let mut n = 0;
-                for (j, p) in part.iter().enumerate() {
-                    block[n] = out(chunk * CHUNK + b * BLOCK + j, p);
-                    n += usize::from(keep(p));
-                }
-                for (d, &v) in dst[written..written + n].iter_mut().zip(&block[..n]) {
-                    d.write(v);
-                }
-                written += n;
+        .map(|(chunk, (dst, src))| {
+            let mut n = 0;
+            for (j, p) in src.iter().enumerate() {
+                dst[n] = out(chunk * CHUNK + j, p);
+                n += usize::from(keep(p));
             }
-            assert_eq!(written, dst.len(), "a chunk kept as many points as counted");
-        });
-    // SAFETY: the chunks' targets tile [0, total) and each task wrote all
-    // of its target: its survivors, counted by the same `keep` in the first
-    // pass, are exactly as many.
-    unsafe { result.set_len(total) };
+            n
+        })
+        .collect();
+    let mut kept = 0;
+    for (chunk, &count) in counts.iter().enumerate() {
+        result.copy_within(chunk * CHUNK..chunk * CHUNK + count, kept);
+        kept += count;
+    }
+    result.truncate(kept);
     result
 }
