@@ -134,34 +134,45 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
         }
         Ok(c)
     };
-    // Bounds in voxels ([RS eq. 17]), in one parallel pass.
-    let none = || ([i64::MAX; 3], [i64::MIN; 3]);
-    let (lo, hi) = points
+    // Bounds in voxels ([RS eq. 17]), in one parallel pass over the
+    // scaled coordinates (min and max vectorise; ⌊·⌋ is monotonic, so the
+    // bounds' voxels are the voxels' bounds), checked once at the end.
+    let scaled = |p: &Point| [0, 1, 2].map(|a| p[a] * inv[a]);
+    let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    let (vlo, vhi) = points
         .par_chunks(1 << 14)
         .map(|chunk| {
-            let (mut lo, mut hi) = ([i64::MAX; 3], [i64::MIN; 3]);
+            let (mut lo, mut hi) = none();
             for p in chunk.iter().filter(|p| is_finite(p)) {
-                let c = cell(p)?;
+                let v = scaled(p);
                 for a in 0..3 {
-                    lo[a] = lo[a].min(c[a]);
-                    hi[a] = hi[a].max(c[a]);
+                    lo[a] = lo[a].min(v[a]);
+                    hi[a] = hi[a].max(v[a]);
                 }
             }
-            Ok((lo, hi))
+            (lo, hi)
         })
-        .try_reduce(none, |(l1, h1), (l2, h2)| {
-            Ok((
+        .reduce(none, |(l1, h1), (l2, h2)| {
+            (
                 [0, 1, 2].map(|a| l1[a].min(l2[a])),
                 [0, 1, 2].map(|a| h1[a].max(h2[a])),
-            ))
-        })?;
-    if lo[0] > hi[0] {
+            )
+        });
+    if vlo[0] > vhi[0] {
         return Err(super::common::emptied(
             FILTER,
             cloud.len(),
             "every point has a non-finite coordinate",
         ));
     }
+    let in_range = |v: f32| v.is_finite() && v.abs() < MAX_CELL;
+    if !(0..3).all(|a| in_range(vlo[a]) && in_range(vhi[a])) {
+        // Name the first point at fault.
+        for p in points.iter().filter(|p| is_finite(p)) {
+            cell(p)?;
+        }
+    }
+    let (lo, hi) = (vlo.map(floor_i64), vhi.map(floor_i64));
     let extent = [0, 1, 2].map(|a| (hi[a] - lo[a]) as u128 + 1);
     // Each extent is below 8e18, so the product of all three may pass
     // u128 (fuzzing the settings found it): saturate, which only selects
