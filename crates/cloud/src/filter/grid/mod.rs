@@ -53,8 +53,21 @@ const SLACK: f64 = 1e-4;
 const MARGIN: f64 = 1e-6;
 
 /// The distance from `v` to the span `lo..=hi` (0 within).
+#[inline]
 fn gap(v: f64, lo: f64, hi: f64) -> f64 {
-    (lo - v).max(v - hi).max(0.0)
+    larger(larger(lo - v, v - hi), 0.0)
+}
+
+/// The larger of two numbers that are not NaN (coordinates, distances):
+/// one instruction, where `f64::max` must also order a NaN (three more, in
+/// the search's innermost bookkeeping).
+#[inline(always)]
+fn larger(a: f64, b: f64) -> f64 {
+    if a > b {
+        a
+    } else {
+        b
+    }
 }
 
 /// Points filed by column (numbered in blocks, see `block_index`), each column by height.
@@ -242,7 +255,8 @@ impl Grid {
     /// clamped to the grid.
     fn column_at(&self, v: f64, a: usize) -> usize {
         let last = [self.nx, self.ny][a] - 1;
-        (((v - self.origin[a]) / self.h).max(0.0) as usize).min(last)
+        // `as` saturates: below the grid (and NaN) is column 0.
+        (((v - self.origin[a]) / self.h) as usize).min(last)
     }
 
     /// Where column `c` begins along axis `a`.
@@ -299,8 +313,9 @@ impl Grid {
                 let columns = &self.slabs[c0..=c1];
                 let (mut low, mut top) = (f32::INFINITY, f32::NEG_INFINITY);
                 for s in columns.iter().filter(|s| s.count > 0) {
-                    low = low.min(s.base);
-                    top = top.max(s.top);
+                    // Heights are finite: plain comparisons (see `larger`).
+                    low = if s.base < low { s.base } else { low };
+                    top = if s.top > top { s.top } else { top };
                 }
                 if low > top {
                     continue;
@@ -611,8 +626,8 @@ impl Slabs {
     /// a lower slab.
     #[inline]
     fn of(&self, z: f32) -> usize {
-        let s = ((z - self.base) * self.per_unit).max(0.0);
-        (s as usize).min(self.count as usize - 1)
+        // `as` saturates: below the base is slab 0.
+        (((z - self.base) * self.per_unit) as usize).min(self.count as usize - 1)
     }
 }
 
