@@ -113,31 +113,29 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
         return Err(empty_input(FILTER));
     }
     let points = cloud;
+    // A point's coordinates in leaves, and whether a voxel index from them
+    // is exact: |floor(v)| < 4e18 exactly when |v| < 4e18 at f32's spacing
+    // there (2³⁹).
+    let scaled = |p: &Point| [0, 1, 2].map(|a| p[a] * inv[a]);
+    let in_range = |v: f32| v.is_finite() && v.abs() < MAX_CELL;
     // The voxel of a finite point ([RS eq. 18] per point), checked.
     let cell = |p: &Point| -> Result<[i64; 3]> {
-        let mut c = [0_i64; 3];
-        for a in 0..3 {
-            let v = p[a] * inv[a];
-            // |floor(v)| < 4e18 exactly when |v| < 4e18 at f32's spacing
-            // there (2³⁹).
-            if !v.is_finite() || v.abs() >= MAX_CELL {
-                return Err(bad(
-                    FILTER,
-                    format!(
-                        "leaf_m[{a}] = {} is too small for the coordinate {} (voxel index beyond 4e18)",
-                        short(params.leaf_m[a]),
-                        p[a]
-                    ),
-                ));
-            }
-            c[a] = floor_i64(v);
+        let v = scaled(p);
+        if let Some(a) = (0..3).find(|&a| !in_range(v[a])) {
+            return Err(bad(
+                FILTER,
+                format!(
+                    "leaf_m[{a}] = {} is too small for the coordinate {} (voxel index beyond 4e18)",
+                    short(params.leaf_m[a]),
+                    p[a]
+                ),
+            ));
         }
-        Ok(c)
+        Ok(v.map(floor_i64))
     };
     // Bounds in voxels ([RS eq. 17]), in one parallel pass over the
     // scaled coordinates (min and max vectorise; ⌊·⌋ is monotonic, so the
     // bounds' voxels are the voxels' bounds), checked once at the end.
-    let scaled = |p: &Point| [0, 1, 2].map(|a| p[a] * inv[a]);
     let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
     let (vlo, vhi) = points
         .par_chunks(1 << 14)
@@ -165,7 +163,6 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
             "every point has a non-finite coordinate",
         ));
     }
-    let in_range = |v: f32| v.is_finite() && v.abs() < MAX_CELL;
     if !(0..3).all(|a| in_range(vlo[a]) && in_range(vhi[a])) {
         // Name the first point at fault.
         for p in points.iter().filter(|p| is_finite(p)) {
@@ -184,7 +181,8 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
     // valid: the bounds pass checked every finite point).
     let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
     let linear = |p: &Point| {
-        let c = [0, 1, 2].map(|a| (floor_i64(p[a] * inv[a]) - lo[a]) as u64);
+        let v = scaled(p);
+        let c = [0, 1, 2].map(|a| (floor_i64(v[a]) - lo[a]) as u64);
         c[0] + c[1] * ex + c[2] * exy
     };
     let centroids = if voxels <= 1 << 32 && points.len() <= 1 << 32 {
@@ -207,7 +205,7 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
             .enumerate()
             .filter(|(_, p)| is_finite(p))
             .map(|(i, p)| {
-                let c = [0, 1, 2].map(|a| floor_i64(p[a] * inv[a]));
+                let c = scaled(p).map(floor_i64);
                 ([c[2], c[1], c[0]], i)
             })
             .collect();

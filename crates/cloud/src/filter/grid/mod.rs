@@ -62,8 +62,18 @@ fn gap(v: f64, lo: f64, hi: f64) -> f64 {
 /// one instruction, where `f64::max` must also order a NaN (three more, in
 /// the search's innermost bookkeeping).
 #[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
+fn larger<T: PartialOrd>(a: T, b: T) -> T {
     if a > b {
+        a
+    } else {
+        b
+    }
+}
+
+/// The smaller of two numbers that are not NaN (see [`larger`]).
+#[inline(always)]
+fn smaller<T: PartialOrd>(a: T, b: T) -> T {
+    if a < b {
         a
     } else {
         b
@@ -313,9 +323,8 @@ impl Grid {
                 let columns = &self.slabs[c0..=c1];
                 let (mut low, mut top) = (f32::INFINITY, f32::NEG_INFINITY);
                 for s in columns.iter().filter(|s| s.count > 0) {
-                    // Heights are finite: plain comparisons (see `larger`).
-                    low = if s.base < low { s.base } else { low };
-                    top = if s.top > top { s.top } else { top };
+                    low = smaller(s.base, low);
+                    top = larger(s.top, top);
                 }
                 if low > top {
                     continue;
