@@ -96,7 +96,6 @@ pub struct Args {
     /// input of `perceive --input FOLDER`.
     #[arg(long, default_value_t = 1)]
     pub frames: usize,
-    /// PCD/PLY encoding (default binary).
     /// Write a survey of NX × NY scans instead of one (e.g. `10,10`): piles
     /// side by side, each scan shifted by the scan window less 5 % (so
     /// neighbours overlap), all in one frame (tilted by --roll and
@@ -104,6 +103,7 @@ pub struct Args {
     /// `perceive --tiles --input FOLDER`.
     #[arg(long, value_parser = parse_survey)]
     pub survey: Option<[usize; 2]>,
+    /// PCD/PLY encoding (default binary).
     #[arg(long, value_enum)]
     pub encoding: Option<EncodingArg>,
     /// Replace an existing file at --out.
@@ -207,7 +207,6 @@ pub fn run(args: &Args) -> Result<()> {
     Ok(())
 }
 
-/// Generates one scan with `params` and writes it to `path`.
 /// `NX,NY` of `--survey`.
 fn parse_survey(s: &str) -> std::result::Result<[usize; 2], String> {
     let bad =
@@ -225,6 +224,7 @@ fn parse_survey(s: &str) -> std::result::Result<[usize; 2], String> {
     }
 }
 
+/// Generates one scan with `params` and writes it to `path`.
 fn generate_one(params: &PileParams, path: &Path, args: &Args) -> Result<GeneratePileSummary> {
     let t0 = std::time::Instant::now();
     // The library names its fields; the user wrote flags.
