@@ -481,14 +481,7 @@ impl Grid {
             let found = scratch.bits.len();
             if found >= k {
                 let bits = &mut scratch.bits;
-                // A few dozen are sorted faster than selected (the
-                // standard sort's networks for small slices: 79 against
-                // 125 ns for 27 of them, k = 21).
-                if found <= SORT_BELOW {
-                    bits.sort_unstable();
-                } else {
-                    bits.select_nth_unstable(k - 1);
-                }
+                within::smallest(self.isa, bits, k);
                 return Some(f32::from_bits(bits[k - 1]));
             }
             // Too few within r: on a surface the count grows as r², so
@@ -577,9 +570,6 @@ impl Grid {
 /// answered by a k-d tree (see `map_k_nearest_distances`).
 const TREE_FROM: usize = 2_000_000;
 const TREE_WORTH: usize = 1000;
-
-/// Found distances up to which a query sorts them rather than selects.
-const SORT_BELOW: usize = 32;
 
 /// Columns a side of a block (see [`block_index`]).
 const BLOCK: usize = 8;
