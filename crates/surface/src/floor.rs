@@ -44,7 +44,7 @@ use rayon::prelude::*;
 
 use crate::calibrate::angles_from_normal;
 use crate::error::{Result, SurfaceError};
-use crate::ransac::{inliers_of, least_squares_plane, Plane, RansacParams};
+use crate::ransac::{inliers_of, least_squares_plane, plane_through, Plane, RansacParams};
 
 /// Largest tilt of the floor in the sensor's frame by default [deg]: a
 /// sensor is mounted within a few degrees of level, and a muck pile's face
@@ -189,7 +189,6 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
     }
     let r = &params.ransac;
     let mut rng = ChaCha8Rng::seed_from_u64(r.seed);
-    let to_f64 = |p: &[f32; 3]| [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])];
     let mut subset: Vec<usize> = if n > r.max_scored_points {
         sample(&mut rng, n, r.max_scored_points).into_vec()
     } else {
@@ -248,29 +247,32 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
         return Err(no_floor(0));
     };
 
-    // Refine on every point, away from where the ground rises.
-    let all: Vec<[f64; 3]> = cloud.points.par_iter().map(to_f64).collect();
-    let all_grid = Grid::with_cell(&all, RISE_CELL * threshold, false);
-    let mut inliers = inliers_of(&all, &plane, threshold);
+    // Refine on every point, away from where the ground rises: each plane
+    // in one pass over the cloud (its inliers, where the ground rises off
+    // it, the points below it), the f32 points widened as they are read.
+    let at = |i: usize| to_f64(&cloud.points[i]);
+    let all_grid = Grid::with_cell(&cloud.points, to_f64, RISE_CELL * threshold, false);
+    let mut split = Split::of(&cloud.points, &all_grid.of, &plane, threshold, below_m);
     for _ in 0..r.refine_rounds {
-        let flat = all_grid.away_from_rises(&all, &plane, threshold, &inliers);
-        let used = if flat.len() >= 3 { &flat } else { &inliers };
-        match least_squares_plane(&all, used) {
+        let flat = all_grid.away_from_rises(&split.rising, &split.inliers);
+        let used = if flat.len() >= 3 {
+            &flat
+        } else {
+            &split.inliers
+        };
+        match plane_through(used, at) {
             Some(refined) if refined.normal[2] >= min_nz => plane = refined,
             _ => break,
         }
-        inliers = inliers_of(&all, &plane, threshold);
+        split = Split::of(&cloud.points, &all_grid.of, &plane, threshold, below_m);
     }
+    let Split { inliers, below, .. } = split;
     if inliers.len() < required {
         return Err(no_floor(inliers.len()));
     }
-    let below = all
-        .iter()
-        .filter(|p| plane.signed_distance(**p) < -below_m)
-        .count();
     let rms_m = (inliers
         .iter()
-        .map(|&i| plane.signed_distance(all[i]).powi(2))
+        .map(|&i| plane.signed_distance(at(i)).powi(2))
         .sum::<f64>()
         / inliers.len() as f64)
         .sqrt();
@@ -287,6 +289,71 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
         rms_m,
         iterations,
     })
+}
+
+/// What one plane makes of the whole cloud, in one pass.
+struct Split {
+    /// The points within the threshold of it, ascending.
+    inliers: Vec<usize>,
+    /// The cell of each point just above the inlier band (up to
+    /// [`RISE_BAND`] thresholds above the plane), in no order.
+    rising: Vec<u32>,
+    /// The points more than the below margin under it.
+    below: usize,
+}
+
+impl Split {
+    /// The split of `points` (filed in the cells `of`) by `plane`.
+    fn of(points: &[[f32; 3]], of: &[u32], plane: &Plane, threshold: f64, below_m: f64) -> Self {
+        const CHUNK: usize = 1 << 16;
+        let parts: Vec<Split> = points
+            .par_chunks(CHUNK)
+            .zip(of.par_chunks(CHUNK))
+            .enumerate()
+            .map(|(c, (chunk, cells))| {
+                let base = c * CHUNK;
+                // The inliers kept without a branch (about a third of a
+                // scan's points, in no pattern a branch predicts), into
+                // room for every point of which only the kept are touched.
+                let mut inliers: Vec<usize> = Vec::with_capacity(chunk.len());
+                let room = inliers.spare_capacity_mut();
+                let (mut kept, mut rising, mut below) = (0, Vec::new(), 0);
+                for (j, (p, &cell)) in chunk.iter().zip(cells).enumerate() {
+                    let d = plane.signed_distance(to_f64(p));
+                    room[kept].write(base + j);
+                    kept += usize::from(d.abs() <= threshold);
+                    if d > threshold && d <= RISE_BAND * threshold {
+                        rising.push(cell);
+                    }
+                    below += usize::from(d < -below_m);
+                }
+                // SAFETY: the first `kept` were written (each slot before
+                // the count moved past it).
+                unsafe { inliers.set_len(kept) };
+                Split {
+                    inliers,
+                    rising,
+                    below,
+                }
+            })
+            .collect();
+        let mut all = Split {
+            inliers: Vec::with_capacity(parts.iter().map(|s| s.inliers.len()).sum()),
+            rising: Vec::new(),
+            below: 0,
+        };
+        for part in parts {
+            all.inliers.extend_from_slice(&part.inliers);
+            all.rising.extend_from_slice(&part.rising);
+            all.below += part.below;
+        }
+        all
+    }
+}
+
+/// A point widened to f64 (exactly).
+fn to_f64(p: &[f32; 3]) -> [f64; 3] {
+    [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
 }
 
 /// Grow a plane hypothesis: refit its inliers and gather them again until they
@@ -389,15 +456,24 @@ impl Grid {
         } else {
             1.0
         };
-        Self::with_cell(points, cell_m, true)
+        Self::with_cell(points, |p| *p, cell_m, true)
     }
 
-    /// Cells of side `cell_m`; with each cell's points listed when
-    /// `listed` (for drawing triples; finding rises needs only counts).
-    fn with_cell(points: &[[f64; 3]], cell_m: f64, listed: bool) -> Self {
-        let keys: Vec<(i64, i64)> = points.par_iter().map(|p| Self::key(cell_m, p)).collect();
-        let (lo, hi) = keys
+    /// Cells of side `cell_m` over the points `at(p)`; with each cell's
+    /// points listed when `listed` (for drawing triples; finding rises
+    /// needs only counts).
+    fn with_cell<P: Sync>(
+        points: &[P],
+        at: impl Fn(&P) -> [f64; 3] + Sync,
+        cell_m: f64,
+        listed: bool,
+    ) -> Self {
+        // The keys are computed where needed, not stored (16 bytes a
+        // point, most of this function's time when written out).
+        let key = |p: &P| Self::key(cell_m, &at(p));
+        let (lo, hi) = points
             .par_iter()
+            .map(key)
             .fold(
                 || ((i64::MAX, i64::MAX), (i64::MIN, i64::MIN)),
                 |(lo, hi), k| {
@@ -417,14 +493,17 @@ impl Grid {
                 },
             );
         let span = |a: i64, b: i64| i128::from(b) - i128::from(a) + 1;
-        let dense = !keys.is_empty()
+        let dense = !points.is_empty()
             && span(lo.0, hi.0) * span(lo.1, hi.1)
-                <= DENSE_CELLS_PER_POINT * keys.len() as i128 + 1024;
+                <= DENSE_CELLS_PER_POINT * points.len() as i128 + 1024;
         let (cells, of, count) = if dense {
             let (nx, ny) = (span(lo.0, hi.0) as i64, span(lo.1, hi.1) as i64);
-            let of: Vec<u32> = keys
+            let of: Vec<u32> = points
                 .par_iter()
-                .map(|k| ((k.1 - lo.1) * nx + (k.0 - lo.0)) as u32)
+                .map(|p| {
+                    let k = key(p);
+                    ((k.1 - lo.1) * nx + (k.0 - lo.0)) as u32
+                })
                 .collect();
             let cells = Cells::Dense {
                 x0: lo.0,
@@ -436,11 +515,11 @@ impl Grid {
         } else {
             let mut index: HashMap<(i64, i64), u32, foldhash::fast::FixedState> =
                 HashMap::with_hasher(foldhash::fast::FixedState::default());
-            let of: Vec<u32> = keys
+            let of: Vec<u32> = points
                 .iter()
-                .map(|k| {
+                .map(|p| {
                     let next = index.len() as u32;
-                    *index.entry(*k).or_insert(next)
+                    *index.entry(key(p)).or_insert(next)
                 })
                 .collect();
             let count = index.len();
@@ -482,34 +561,20 @@ impl Grid {
         }
     }
 
-    /// The inliers of `plane` none of whose 3 × 3 cells rises off it: a cell
-    /// rises when at least 3 of its points, and more than a tenth of them,
-    /// lie just above the inlier band (up to [`RISE_BAND`] thresholds above
+    /// The `inliers` of a plane none of whose 3 × 3 cells rises off it
+    /// (`rising`: the cells of the points just above its band, from
+    /// [`Split`]): a cell rises when at least 3 of its points, and more
+    /// than a tenth of them, lie just above the inlier band (up to [`RISE_BAND`] thresholds above
     /// the plane: the foot of a face; dust and spray higher up are not a
     /// rise). This leaves out the floor at the toe of a
     /// pile, where the bottom of the face lies inside the band and would tilt
     /// the plane towards the pile (a bias that grows as the floor's share
     /// of the scan falls).
-    fn away_from_rises(
-        &self,
-        points: &[[f64; 3]],
-        plane: &Plane,
-        threshold: f64,
-        inliers: &[usize],
-    ) -> Vec<usize> {
-        // Points just above the band, per cell (they are few: found in
-        // parallel, counted after).
+    fn away_from_rises(&self, rising: &[u32], inliers: &[usize]) -> Vec<usize> {
+        // Points just above the band (`rising`, their cells), per cell.
         let cells = self.start.len() - 1;
-        let rising: Vec<u32> = points
-            .par_iter()
-            .zip(&self.of)
-            .filter_map(|(p, &c)| {
-                let d = plane.signed_distance(*p);
-                (d > threshold && d <= RISE_BAND * threshold).then_some(c)
-            })
-            .collect();
         let mut above = vec![0u32; cells];
-        for c in rising {
+        for &c in rising {
             above[c as usize] += 1;
         }
         // Every cell next to (or at) a rising one.
@@ -590,7 +655,7 @@ mod tests {
         let mut far = patch.clone();
         far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 1.0]));
         for (points, dense) in [(patch, true), (far, false)] {
-            let grid = Grid::with_cell(&points, 0.5, true);
+            let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
             assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
             let mut seen = 0;
             grid.cells.each(|key, c| {

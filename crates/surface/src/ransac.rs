@@ -268,16 +268,22 @@ pub fn ransac_plane(points: &[[f64; 3]], params: &RansacParams) -> Result<PlaneF
 /// their centroid, normal = eigenvector of the smallest covariance eigenvalue.
 /// `None` for fewer than three points.
 pub fn least_squares_plane(points: &[[f64; 3]], indices: &[usize]) -> Option<Plane> {
+    plane_through(indices, |i| points[i])
+}
+
+/// [`least_squares_plane`] through the points `at(i)` for `i` in `indices`
+/// (a caller whose points are stored otherwise: as f32, converted exactly).
+pub(crate) fn plane_through(indices: &[usize], at: impl Fn(usize) -> [f64; 3]) -> Option<Plane> {
     if indices.len() < 3 {
         return None;
     }
     let m = indices.len() as f64;
     let centroid = indices
         .iter()
-        .fold(Vector3::zeros(), |s, &i| s + Vector3::from(points[i]))
+        .fold(Vector3::zeros(), |s, &i| s + Vector3::from(at(i)))
         / m;
     let cov = indices.iter().fold(Matrix3::zeros(), |s, &i| {
-        let d = Vector3::from(points[i]) - centroid;
+        let d = Vector3::from(at(i)) - centroid;
         s + d * d.transpose()
     }) / m;
     let eig = SymmetricEigen::new(cov);
