@@ -37,9 +37,11 @@
 use rayon::prelude::*;
 
 mod far;
+mod near;
 
 use super::kdtree::{KdTree, Nearest};
 use super::within::{self, Isa, Run};
+use near::Near;
 
 use crate::Point;
 
@@ -146,7 +148,7 @@ impl Grid {
             .map(|i| {
                 let p = i * n / probes;
                 let q = [first.x[p], first.y[p], first.z[p]];
-                let kth = first.k_nearest(q, first.h / SIDE, k, &mut scratch, true);
+                let kth = first.k_nearest(q, Some(p), first.h / SIDE, k, &mut scratch, true);
                 f64::from(kth.unwrap_or(0.0)).sqrt()
             })
             .collect();
@@ -166,7 +168,10 @@ impl Grid {
             return None;
         }
         let (lo, hi) = bounds(points);
-        Self::new(points, lo, hi, radius)
+        // A hair wider than the radius, so that a box of the radius
+        // (widened by `SLACK`) reaches no further than the columns next
+        // to its own (`near.rs`).
+        Self::new(points, lo, hi, radius * (1.0 + 2.0 * SLACK))
     }
 
     /// Files the points on columns of side about `wanted`.
@@ -378,21 +383,28 @@ impl Grid {
     /// The squared distances (as ordered bits: squared distances are
     /// ≥ +0, whose bits order as the numbers) from `q` to every point
     /// within `r` of it, into `bits`.
-    fn within(&self, q: [f32; 3], r: f64, bits: &mut Vec<u32>) {
+    /// `at`: the query's sorted position, when it is one of the grid's
+    /// points, and the columns round the last query's (`near.rs`).
+    fn within(&self, q: [f32; 3], at: Option<(usize, &mut Near)>, r: f64, bits: &mut Vec<u32>) {
         bits.clear();
         let cap = (r * r) as f32;
-        self.runs(q, r, |s, e| {
+        let keep = |s, e| {
             within::keep_distances(self.isa, q, self.run(s, e), cap, bits);
             true
-        });
+        };
+        match at {
+            Some((p, near)) => self.runs_near(near, p, q, r, keep),
+            None => self.runs(q, r, keep),
+        }
     }
 
-    /// Whether at least `wanted` points (`q` itself counted) lie within
-    /// squared distance `r2` of `q`, inclusive; stops at a run that
-    /// brings the count there.
-    fn has_within(&self, q: [f32; 3], r2: f32, wanted: usize) -> bool {
+    /// Whether at least `wanted` points (itself counted) lie within
+    /// squared distance `r2` of the point at sorted position `p`,
+    /// inclusive; stops at a run that brings the count there.
+    fn has_within(&self, p: usize, near: &mut Near, r2: f32, wanted: usize) -> bool {
+        let q = [self.x[p], self.y[p], self.z[p]];
         let mut count = 0;
-        self.runs(q, f64::from(r2).sqrt(), |s, e| {
+        self.runs_near(near, p, q, f64::from(r2).sqrt(), |s, e| {
             count += within::count(self.isa, q, self.run(s, e), r2);
             count < wanted
         });
@@ -403,10 +415,9 @@ impl Grid {
     /// within squared distance `r2`, in input order (radius outlier
     /// removal, [RS eq. 13]).
     pub(crate) fn map_has_within(&self, r2: f32, wanted: usize) -> Vec<bool> {
-        self.map_sorted(
-            || (),
-            |(), p| self.has_within([self.x[p], self.y[p], self.z[p]], r2, wanted),
-        )
+        self.map_sorted(Near::default, |near, p| {
+            self.has_within(p, near, r2, wanted)
+        })
     }
 
     /// `f(scratch, i, found)` for every point `i` of the input, `found` the
@@ -420,11 +431,11 @@ impl Grid {
     {
         let r = f64::from(r2).sqrt();
         self.map_sorted(
-            || (init(), Vec::new()),
-            |(scratch, found), p| {
+            || (init(), Vec::new(), Near::default()),
+            |(scratch, found, near), p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
                 found.clear();
-                self.runs(q, r, |s, e| {
+                self.runs_near(near, p, q, r, |s, e| {
                     let (run, ids) = (self.run(s, e), &self.ids[s..e]);
                     within::keep_payload(self.isa, q, run, ids, r2, found);
                     true
@@ -470,6 +481,7 @@ impl Grid {
     fn k_nearest(
         &self,
         q: [f32; 3],
+        at: Option<usize>,
         guess: f64,
         k: usize,
         scratch: &mut Scratch,
@@ -477,7 +489,8 @@ impl Grid {
     ) -> Option<f32> {
         let mut r = guess;
         loop {
-            self.within(q, r, &mut scratch.bits);
+            let near = at.map(|p| (p, &mut scratch.near));
+            self.within(q, near, r, &mut scratch.bits);
             let found = scratch.bits.len();
             if found >= k {
                 let bits = &mut scratch.bits;
@@ -516,7 +529,7 @@ impl Grid {
             || (Scratch::default(), self.h),
             |(scratch, guess), p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
-                let kth = self.k_nearest(q, *guess, k, scratch, false)?;
+                let kth = self.k_nearest(q, Some(p), *guess, k, scratch, false)?;
                 // The next point is near (same column, a little higher,
                 // mostly): its k-th distance is likely within a little
                 // more, and rarely far more than a column.
@@ -727,6 +740,8 @@ impl Columns {
 #[derive(Default)]
 struct Scratch {
     bits: Vec<u32>,
+    /// The columns round the last query's.
+    near: Near,
     nearest: Vec<f32>,
     /// The tree's search state, for far points.
     knn: Option<Nearest>,
