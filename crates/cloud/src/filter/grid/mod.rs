@@ -401,11 +401,26 @@ impl Grid {
     /// Whether at least `wanted` points (itself counted) lie within
     /// squared distance `r2` of the point at sorted position `p`,
     /// inclusive; stops at a run that brings the count there.
+    ///
+    /// The points filed next to it come first (its column's nearest in
+    /// height, mostly): on a dense scan they hold the few wanted, and the
+    /// columns round it are not read. The runs after leave them out.
     fn has_within(&self, p: usize, near: &mut Near, r2: f32, wanted: usize) -> bool {
         let q = [self.x[p], self.y[p], self.z[p]];
-        let mut count = 0;
+        let (first, last) = (
+            p.saturating_sub(FIRST / 2),
+            (p + FIRST / 2).min(self.ids.len()),
+        );
+        let mut count = within::count(self.isa, q, self.run(first, last), r2);
+        if count >= wanted {
+            return true;
+        }
         self.runs_near(near, p, q, f64::from(r2).sqrt(), |s, e| {
-            count += within::count(self.isa, q, self.run(s, e), r2);
+            for (a, b) in [(s, e.min(first)), (s.max(last), e)] {
+                if a < b {
+                    count += within::count(self.isa, q, self.run(a, b), r2);
+                }
+            }
             count < wanted
         });
         count >= wanted
@@ -599,6 +614,9 @@ fn block_index(cx: usize, cy: usize, nx: usize) -> usize {
 
 /// Points whose k-th distance checks a grid's side.
 const PROBES: usize = 256;
+
+/// Points filed round a radius query's own that it counts first.
+const FIRST: usize = 16;
 
 /// Points per parallel task.
 const RUN: usize = 4096;
