@@ -15,8 +15,14 @@
 //! within the box's, as on a surface; else each column by two look-ups in
 //! its slabs), and one vector pass over those contiguous runs
 //! (`within.rs`) gives their squared distances and keeps those within r.
-//! If k of them lie within r, they hold the k nearest; otherwise r grows
-//! (by the count found, as on a surface) and the query is repeated. A
+//! If k of them lie within r, they hold the k nearest (kept by rank,
+//! `within::smallest`); otherwise r grows
+//! (by the count found, as on a surface) and the query is repeated. The
+//! queries are the grid's own points, a column's after one another, so the
+//! 3 × 3 columns round a column are described once for its queries and a
+//! query whose radius is below a column's side takes its runs from them
+//! (`near.rs`); a radius count reads first the points filed round the
+//! query's own, which on a dense scan already hold the few it wants. A
 //! point far from the rest (an outlier above the scan, whose box would
 //! sweep many columns) is answered after the others (`far.rs`): blocks of
 //! columns and columns searched nearest box first, or on a large cloud
