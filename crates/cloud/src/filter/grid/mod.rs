@@ -152,9 +152,7 @@ impl Grid {
         let mut scratch = Scratch::default();
         let mut kth: Vec<f64> = (0..probes)
             .map(|i| {
-                let p = i * n / probes;
-                let q = [first.x[p], first.y[p], first.z[p]];
-                let kth = first.k_nearest(q, Some(p), first.h / SIDE, k, &mut scratch, true);
+                let kth = first.k_nearest(i * n / probes, first.h / SIDE, k, &mut scratch, true);
                 f64::from(kth.unwrap_or(0.0)).sqrt()
             })
             .collect();
@@ -387,21 +385,17 @@ impl Grid {
     }
 
     /// The squared distances (as ordered bits: squared distances are
-    /// ≥ +0, whose bits order as the numbers) from `q` to every point
-    /// within `r` of it, into `bits`.
-    /// `at`: the query's sorted position, when it is one of the grid's
-    /// points, and the columns round the last query's (`near.rs`).
-    fn within(&self, q: [f32; 3], at: Option<(usize, &mut Near)>, r: f64, bits: &mut Vec<u32>) {
+    /// ≥ +0, whose bits order as the numbers) from the point at sorted
+    /// position `p` to every point within `r` of it, into `bits`; `near`
+    /// the columns round the last query's (`near.rs`).
+    fn within(&self, p: usize, near: &mut Near, r: f64, bits: &mut Vec<u32>) {
         bits.clear();
+        let q = [self.x[p], self.y[p], self.z[p]];
         let cap = (r * r) as f32;
-        let keep = |s, e| {
+        self.runs_near(near, p, q, r, |s, e| {
             within::keep_distances(self.isa, q, self.run(s, e), cap, bits);
             true
-        };
-        match at {
-            Some((p, near)) => self.runs_near(near, p, q, r, keep),
-            None => self.runs(q, r, keep),
-        }
+        });
     }
 
     /// Whether at least `wanted` points (itself counted) lie within
@@ -494,15 +488,14 @@ impl Grid {
         result
     }
 
-    /// The k nearest squared distances of `q`, in any order but the k-th
-    /// last, left in `bits[..k]`, starting from the radius `guess` (which
-    /// may be too small or too large); returns the k-th, or `None` for a
-    /// point far from the rest (its radius grew past `FAR` columns) unless
-    /// `unbounded`.
+    /// The k nearest squared distances of the point at sorted position
+    /// `p`, in any order but the k-th last, left in `bits[..k]`, starting
+    /// from the radius `guess` (which may be too small or too large);
+    /// returns the k-th, or `None` for a point far from the rest (its
+    /// radius grew past `FAR` columns) unless `unbounded`.
     fn k_nearest(
         &self,
-        q: [f32; 3],
-        at: Option<usize>,
+        p: usize,
         guess: f64,
         k: usize,
         scratch: &mut Scratch,
@@ -510,8 +503,7 @@ impl Grid {
     ) -> Option<f32> {
         let mut r = guess;
         loop {
-            let near = at.map(|p| (p, &mut scratch.near));
-            self.within(q, near, r, &mut scratch.bits);
+            self.within(p, &mut scratch.near, r, &mut scratch.bits);
             let found = scratch.bits.len();
             if found >= k {
                 let bits = &mut scratch.bits;
@@ -549,8 +541,7 @@ impl Grid {
         let mut out: Vec<Option<T>> = self.map_sorted(
             || (Scratch::default(), self.h),
             |(scratch, guess), p| {
-                let q = [self.x[p], self.y[p], self.z[p]];
-                let kth = self.k_nearest(q, Some(p), *guess, k, scratch, false)?;
+                let kth = self.k_nearest(p, *guess, k, scratch, false)?;
                 // The next point is near (same column, a little higher,
                 // mostly): its k-th distance is likely within a little
                 // more, and rarely far more than a column.
