@@ -291,6 +291,18 @@ impl Grid {
         gap(v, self.edge(from, a) - margin, self.edge(to, a) + margin)
     }
 
+    /// The sorted positions of a column (its `slabs`) in the slabs that
+    /// hold heights `lo32..=hi32` (a slab's number grows with height, so
+    /// none between is missed).
+    fn slab_run(&self, slabs: &Slabs, lo32: f32, hi32: f32) -> (usize, usize) {
+        let (a, b) = (slabs.of(lo32), slabs.of(hi32));
+        let first = slabs.first as usize;
+        (
+            self.slab_start[first + a] as usize,
+            self.slab_start[first + b + 1] as usize,
+        )
+    }
+
     /// Calls `visit` with each run of sorted positions that may hold points
     /// within `r` of `q` (all such points are in some run), until it
     /// returns `false`.
@@ -299,15 +311,7 @@ impl Grid {
         let (qx, qy) = (f64::from(q[0]), f64::from(q[1]));
         let (x0, x1) = (self.column_at(qx - wide, 0), self.column_at(qx + wide, 0));
         let (y0, y1) = (self.column_at(qy - wide, 1), self.column_at(qy + wide, 1));
-        // Heights rounded outwards to f32.
-        let (z_lo, z_hi) = (f64::from(q[2]) - wide, f64::from(q[2]) + wide);
-        let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
-        if f64::from(lo32) > z_lo {
-            lo32 = lo32.next_down();
-        }
-        if f64::from(hi32) < z_hi {
-            hi32 = hi32.next_up();
-        }
+        let (lo32, hi32) = heights_within(q[2], wide);
         // Row by row, the query's own row first (a count may stop there).
         // The columns of a row within one block are numbered in a run, so
         // their points lie in one run of positions: where each of them
@@ -359,14 +363,7 @@ impl Grid {
                     if dx * dx + dy2 + dz * dz > wide2 {
                         continue;
                     }
-                    // The slabs that hold heights lo32..=hi32 (a slab's
-                    // number grows with height, so none between is missed).
-                    let (a, b) = (slabs.of(lo32), slabs.of(hi32));
-                    let first = slabs.first as usize;
-                    let (s, e) = (
-                        self.slab_start[first + a] as usize,
-                        self.slab_start[first + b + 1] as usize,
-                    );
+                    let (s, e) = self.slab_run(slabs, lo32, hi32);
                     if s < e && !visit(s, e) {
                         return;
                     }
@@ -764,6 +761,20 @@ struct Scratch {
     best: std::collections::BinaryHeap<u32>,
     /// The boxes `far_k_nearest` has still to open, nearest first.
     waiting: std::collections::BinaryHeap<std::cmp::Reverse<(u64, bool, usize)>>,
+}
+
+/// The heights within `wide` of `z`, rounded outwards to f32 (so that
+/// no f32 height within them falls outside).
+fn heights_within(z: f32, wide: f64) -> (f32, f32) {
+    let (z_lo, z_hi) = (f64::from(z) - wide, f64::from(z) + wide);
+    let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
+    if f64::from(lo32) > z_lo {
+        lo32 = lo32.next_down();
+    }
+    if f64::from(hi32) < z_hi {
+        hi32 = hi32.next_up();
+    }
+    (lo32, hi32)
 }
 
 /// The cloud's bounding box, in f64.

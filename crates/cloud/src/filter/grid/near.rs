@@ -18,23 +18,21 @@
 //! spot, a far point) goes to `Grid::runs`. Either way every point within
 //! the radius is in some run, so the results are the same, bit for bit.
 
-use super::{block_index, gap, Grid, BLOCK, MARGIN, SLACK};
+use super::{block_index, gap, heights_within, Grid, BLOCK, MARGIN, SLACK};
 
 /// A column is read whole when its heights span at most this many
 /// sides, else cut by its slabs.
 const WHOLE: f64 = 2.0;
 
 /// The 3 × 3 columns round one column (see the module docs).
-#[derive(Debug, Clone)]
+#[derive(Debug, Clone, Default)]
 pub(super) struct Near {
     /// The sorted positions of the column described (empty: none yet).
     own: (usize, usize),
-    /// Its column, and the grid's edges either side of it, widened by
-    /// the margin: a box reaches the left column when its low x is at or
-    /// below `left`, the right one when its high x is at or above `right`
-    /// (likewise in y with `down` and `up`).
-    cx: usize,
-    cy: usize,
+    /// The grid's edges either side of it, widened by the margin: a box
+    /// reaches the left column when its low x is at or below `left`, the
+    /// right one when its high x is at or above `right` (likewise in y
+    /// with `down` and `up`).
     left: f64,
     right: f64,
     down: f64,
@@ -54,22 +52,6 @@ struct Cell {
     low: f64,
     top: f64,
     whole: bool,
-}
-
-impl Default for Near {
-    fn default() -> Self {
-        Self {
-            own: (0, 0),
-            cx: 0,
-            cy: 0,
-            left: 0.0,
-            right: 0.0,
-            down: 0.0,
-            up: 0.0,
-            has: [false; 4],
-            cells: [[Cell::default(); 3]; 3],
-        }
-    }
 }
 
 impl Grid {
@@ -94,8 +76,6 @@ impl Grid {
         let (c, cx, cy) = self.column_of(p);
         let margin = self.h * MARGIN;
         near.own = (self.start[c] as usize, self.start[c + 1] as usize);
-        near.cx = cx;
-        near.cy = cy;
         near.left = self.edge(cx, 0) + margin;
         near.right = self.edge(cx + 1, 0) - margin;
         near.down = self.edge(cy, 1) + margin;
@@ -155,15 +135,8 @@ impl Grid {
         };
         let below = has_down && qy - wide <= near.down;
         let above = has_up && qy + wide >= near.up;
-        // Heights rounded outwards to f32, for the slabs of a tall column.
-        let (z_lo, z_hi) = (qz - wide, qz + wide);
-        let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
-        if f64::from(lo32) > z_lo {
-            lo32 = lo32.next_down();
-        }
-        if f64::from(hi32) < z_hi {
-            hi32 = hi32.next_up();
-        }
+        // For the slabs of a tall column.
+        let (lo32, hi32) = heights_within(q[2], wide);
         // The query's own row first (a count may stop there).
         let rows = [Some(1), below.then_some(0), above.then_some(2)];
         for row in rows.into_iter().flatten() {
@@ -176,13 +149,7 @@ impl Grid {
                 let (cs, ce) = if cell.whole {
                     cell.span
                 } else {
-                    let slabs = &self.slabs[cell.column];
-                    let (a, b) = (slabs.of(lo32), slabs.of(hi32));
-                    let first = slabs.first as usize;
-                    (
-                        self.slab_start[first + a] as usize,
-                        self.slab_start[first + b + 1] as usize,
-                    )
+                    self.slab_run(&self.slabs[cell.column], lo32, hi32)
                 };
                 if cs == e {
                     e = ce;
