@@ -193,6 +193,34 @@ fn non_finite_points_are_dropped_and_counted() {
 }
 
 #[test]
+fn non_finite_points_are_dropped_across_the_readers_chunks() {
+    // 200 k points (the binary PCD reader takes 1 MiB, 87 381 points, at a
+    // time), a non-finite one every 997th: the finite ones in order.
+    let dir = TempDir::new("nan-chunks");
+    let points: Vec<[f32; 3]> = (0..200_000)
+        .map(|i| {
+            let v = i as f32 * 0.001;
+            match i % 997 {
+                0 => [f32::NAN, v, v],
+                500 => [v, v, f32::NEG_INFINITY],
+                _ => [v, -v, 0.5 * v],
+            }
+        })
+        .collect();
+    let finite: Vec<[f32; 3]> = points
+        .iter()
+        .copied()
+        .filter(|p| p.iter().all(|c| c.is_finite()))
+        .collect();
+    let path = dir.0.join("chunks.pcd");
+    write(&path, &PointCloud::new(points.clone()), Encoding::Binary).unwrap();
+    let r = read(&path, &mut |_, _| {}).unwrap();
+    assert_eq!(r.format, "pcd binary");
+    assert_eq!(r.non_finite_dropped, points.len() - finite.len());
+    assert_eq!(r.cloud.points, finite);
+}
+
+#[test]
 fn encodings_parse_and_default_by_extension() {
     use std::path::Path;
     assert_eq!(

@@ -282,6 +282,26 @@ impl<'s> Points<'s> {
         self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32]);
     }
 
+    /// Drops the non-finite points from position `base` on (counting
+    /// them), keeping the others in order.
+    pub(crate) fn keep_finite_from(&mut self, base: usize) {
+        let finite = |p: &Point| p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
+        // One pass that vectorises, then the compaction only when needed.
+        let bad = self.points[base..].iter().filter(|p| !finite(p)).count();
+        if bad > 0 {
+            let mut kept = base;
+            for i in base..self.points.len() {
+                let p = self.points[i];
+                if finite(&p) {
+                    self.points[kept] = p;
+                    kept += 1;
+                }
+            }
+            self.points.truncate(kept);
+            self.non_finite += bad;
+        }
+    }
+
     /// Keeps a finite point, counts a non-finite one.
     #[inline]
     pub(crate) fn push(&mut self, p: Point) {

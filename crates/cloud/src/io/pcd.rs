@@ -453,9 +453,27 @@ fn read_binary<R: BufRead>(
     // The data is there: reserving the count is safe now.
     out.reserve_bounded(h.points, input.remaining(), step as u64);
     let per_chunk = (CHUNK / step.max(1)).max(1) as u64;
-    let mut buf = vec![0u8; (per_chunk.min(h.points) as usize) * step];
     let all_f32 = h.axes.iter().all(|a| a.scalar == Scalar::F32);
     let [ox, oy, oz] = [h.axes[0].offset, h.axes[1].offset, h.axes[2].offset];
+    if all_f32 && step == 12 && [ox, oy, oz] == [0, 4, 8] && cfg!(target_endian = "little") {
+        // Fields x y z as f32 and nothing else (a sensor's frames, PCL's
+        // PointXYZ): the records are the points' own bytes, read straight
+        // into their memory (no buffer, no copy, no per-value decoding).
+        let mut left = h.points;
+        while left > 0 {
+            let k = left.min(per_chunk) as usize;
+            let base = out.points.len();
+            out.points.resize(base + k, [0.0; 3]);
+            input.read_exact_or(
+                points_as_bytes(&mut out.points[base..]),
+                "binary point data",
+            )?;
+            out.keep_finite_from(base);
+            left -= k as u64;
+        }
+        return check_padding(input, extra);
+    }
+    let mut buf = vec![0u8; (per_chunk.min(h.points) as usize) * step];
     let mut left = h.points;
     while left > 0 {
         let k = left.min(per_chunk) as usize;
@@ -476,6 +494,19 @@ fn read_binary<R: BufRead>(
         left -= k as u64;
     }
     check_padding(input, extra)
+}
+
+/// The bytes of `points`, as a little-endian file lays out x y z as f32.
+fn points_as_bytes(points: &mut [Point]) -> &mut [u8] {
+    // SAFETY: `[f32; 3]` has no padding and every bit pattern is an f32,
+    // so its memory is 12 initialised bytes a point and any bytes written
+    // there make valid points; the length is the slice's size in bytes.
+    unsafe {
+        std::slice::from_raw_parts_mut(
+            points.as_mut_ptr().cast::<u8>(),
+            std::mem::size_of_val(points),
+        )
+    }
 }
 
 #[inline]
