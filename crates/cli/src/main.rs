@@ -16,6 +16,7 @@ pub(crate) use say;
 
 mod demo;
 mod filter;
+mod heap;
 mod jobs;
 mod link;
 mod output;
@@ -158,6 +159,7 @@ fn main() -> ExitCode {
     // The matches are kept: `filter` runs its stages in the order given.
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
+    heap::keep_freed_memory();
     // Ctrl-C stops any job at once; what it had staged in the output folder
     // goes with it, so nothing half-written is left there.
     let _ = ctrlc::set_handler(|| {
