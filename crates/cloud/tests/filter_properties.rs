@@ -118,6 +118,43 @@ proptest! {
         }
     }
 
+    /// The radius filter keeping its index for the statistical filter
+    /// keeps what the two filters keep one after the other, bit for bit
+    /// (errors alike), clumped clouds and flat ones, radii narrower and far
+    /// wider than the k nearest reach.
+    #[test]
+    fn radius_then_statistical_is_the_two_filters(
+        seed in any::<u64>(), n in 30usize..3000, flat in any::<bool>(),
+        radius in 0.005f64..0.5, min_pts in 0usize..6, k in 1usize..25, s in -0.5f64..2.5,
+    ) {
+        let mut cloud = lcg_cloud(n, 1.0, seed);
+        if flat {
+            // A surface: heights a gentle slope plus a little noise.
+            for p in &mut cloud.points {
+                p[2] = 0.3 * p[0] + 0.01 * p[2];
+            }
+        }
+        let radius = filter::RadiusOutlierParams { radius_m: radius, min_neighbors: min_pts };
+        let statistical = filter::StatisticalOutlierParams { mean_k: k, std_mul: s, ..Default::default() };
+        let apart = filter::radius_outlier_removal_indices(&cloud, &radius).map(|kept| {
+            let points: Vec<Point> = kept.iter().map(|&i| cloud.points[i]).collect();
+            (filter::statistical_outlier_removal_indices(&points, &statistical).map_err(|e| e.to_string()), kept)
+        });
+        let together = filter::radius_outlier_removal_then(&cloud, &radius, k).map(|first| {
+            let kept = first.kept.clone();
+            let points: Vec<Point> = kept.iter().map(|&i| cloud.points[i]).collect();
+            (first.statistical_indices(&points, &statistical).map_err(|e| e.to_string()), kept)
+        });
+        match (apart, together) {
+            (Ok((a, kept_a)), Ok((b, kept_b))) => {
+                prop_assert_eq!(kept_a, kept_b);
+                prop_assert_eq!(a, b);
+            }
+            (Err(a), Err(b)) => prop_assert_eq!(a.to_string(), b.to_string()),
+            (a, b) => prop_assert!(false, "{:?} against {:?}", a.map(|_| ()), b.map(|_| ())),
+        }
+    }
+
     #[test]
     fn voxel_grid_equals_a_map_of_voxels(seed in any::<u64>(), n in 1usize..400, leaf in 0.01f64..0.5) {
         let cloud = lcg_cloud(n, 1.0, seed);

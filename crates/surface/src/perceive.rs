@@ -35,9 +35,9 @@ use std::path::Path;
 use std::time::Instant;
 
 use autoshovel_cloud::filter::{
-    bilateral_normal_smoothing, pass_through, radius_outlier_removal, statistical_outlier_removal,
-    voxel_grid, BilateralParams, OutlierSides, PassThroughParams, RadiusOutlierParams,
-    StatisticalOutlierParams, VoxelGridParams,
+    bilateral_normal_smoothing, pass_through, radius_outlier_removal, radius_outlier_removal_then,
+    statistical_outlier_removal, voxel_grid, BilateralParams, OutlierSides, PassThroughParams,
+    RadiusKept, RadiusOutlierParams, StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_cloud::PointCloud;
 use autoshovel_core::config::{self, TomlFile};
@@ -870,8 +870,10 @@ pub fn perceive_after(
         points: cloud.len(),
         ms: elapsed_ms(t),
     });
-    // The filter stages, in the paper's order; each timed and counted.
+    // The filter stages, in the paper's order; each timed and counted. The
+    // radius stage hands its neighbour index to the statistical one.
     type Filter<'a> = Box<dyn Fn(&PointCloud) -> autoshovel_cloud::Result<PointCloud> + 'a>;
+    let after_radius = std::cell::RefCell::new(None::<RadiusKept>);
     let filters: [(&'static str, bool, Filter); 5] = [
         (
             "ground",
@@ -890,13 +892,18 @@ pub fn perceive_after(
             p.radius.enabled,
             // [RS eq. 13]
             Box::new(|c: &PointCloud| {
-                radius_outlier_removal(
-                    c,
-                    &RadiusOutlierParams {
-                        radius_m: p.radius.radius_spacings * spacing,
-                        min_neighbors: p.radius.min_neighbors,
-                    },
-                )
+                let params = RadiusOutlierParams {
+                    radius_m: p.radius.radius_spacings * spacing,
+                    min_neighbors: p.radius.min_neighbors,
+                };
+                if !p.statistical.enabled {
+                    return radius_outlier_removal(c, &params);
+                }
+                // The statistical stage searches the same index next.
+                let first = radius_outlier_removal_then(c, &params, p.statistical.mean_k)?;
+                let kept = PointCloud::new(first.kept.iter().map(|&i| c.points[i]).collect());
+                *after_radius.borrow_mut() = Some(first);
+                Ok(kept)
             }),
         ),
         (
@@ -904,14 +911,18 @@ pub fn perceive_after(
             p.statistical.enabled,
             // [RS eq. 14]–[RS eq. 16]
             Box::new(|c: &PointCloud| {
-                statistical_outlier_removal(
-                    c,
-                    &StatisticalOutlierParams {
-                        mean_k: p.statistical.mean_k,
-                        std_mul: p.statistical.std_mul,
-                        sides: p.statistical.sides,
-                    },
-                )
+                let params = StatisticalOutlierParams {
+                    mean_k: p.statistical.mean_k,
+                    std_mul: p.statistical.std_mul,
+                    sides: p.statistical.sides,
+                };
+                match after_radius.borrow_mut().take() {
+                    Some(first) => {
+                        let kept = first.statistical_indices(c, &params)?;
+                        Ok(PointCloud::new(kept.iter().map(|&i| c.points[i]).collect()))
+                    }
+                    None => statistical_outlier_removal(c, &params),
+                }
             }),
         ),
         (

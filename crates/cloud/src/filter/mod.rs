@@ -40,7 +40,8 @@ pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
 pub use pass_through::{pass_through, pass_through_indices, Axis, PassThroughParams};
 pub use radius_outlier::{
-    radius_outlier_removal, radius_outlier_removal_indices, RadiusOutlierParams,
+    radius_outlier_removal, radius_outlier_removal_indices, radius_outlier_removal_then,
+    RadiusKept, RadiusOutlierParams,
 };
 pub use statistical_outlier::{
     mean_distances_and_reach, mean_distances_and_reach_at, statistical_outlier_removal,

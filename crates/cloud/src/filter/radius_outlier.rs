@@ -38,9 +38,10 @@
 use autoshovel_core::config::short;
 use rayon::prelude::*;
 
-use super::common::{bad, emptied, empty_input, f32_at_most, gather, on_finite_points};
-use super::grid::Grid;
+use super::common::{bad, emptied, empty_input, f32_at_most, gather, is_finite, on_finite_points};
+use super::grid::{radius_side, Grid};
 use super::kdtree::KdTree;
+use super::statistical_outlier::{statistical_kept_on, StatisticalOutlierParams};
 use crate::{Point, PointCloud, Result};
 use serde::{Deserialize, Serialize};
 
@@ -123,31 +124,182 @@ pub fn radius_outlier_removal(cloud: &[Point], params: &RadiusOutlierParams) -> 
     Ok(gather(cloud, &kept))
 }
 
+/// What [`radius_outlier_removal_then`] kept, with the neighbour index it
+/// searched, for [`RadiusKept::statistical_indices`] to search again.
+pub struct RadiusKept {
+    /// Indices of the points kept, in input order (those of
+    /// [`radius_outlier_removal_indices`]).
+    pub kept: Vec<usize>,
+    /// The grid of the kept points, numbered as in `kept`, when the cloud
+    /// suited one sized for both searches.
+    grid: Option<Grid>,
+}
+
+/// Radius outlier removal ([RS eq. 13]) that keeps its neighbour index for
+/// the statistical filter to run on its output next ([RS eq. 14]–[RS eq. 16],
+/// `mean_k` neighbours), as the paper's filtering does: the same points
+/// as [`radius_outlier_removal_indices`], then (by
+/// [`RadiusKept::statistical_indices`]) as
+/// [`statistical_outlier_removal_indices`](super::statistical_outlier_removal_indices)
+/// on them, bit for bit; but the points are filed on a grid once, with
+/// columns as the k nearest want them (at least as wide as the radius),
+/// and the removed ones dropped from it rather than the kept ones filed
+/// again. A cloud that suits no such grid (sparse, or a radius far wider
+/// than the k nearest reach, or with non-finite points) takes the two
+/// filters' own paths.
+pub fn radius_outlier_removal_then(
+    cloud: &[Point],
+    params: &RadiusOutlierParams,
+    mean_k: usize,
+) -> Result<RadiusKept> {
+    params.validate()?;
+    if cloud.is_empty() {
+        return Err(empty_input(FILTER));
+    }
+    let wanted = params.min_neighbors + 1;
+    let grid = (params.min_neighbors > 0 && wanted <= cloud.len() && cloud.iter().all(is_finite))
+        .then(|| {
+            let r2 = f32_at_most(params.radius_m * params.radius_m);
+            let side = radius_side(f64::from(r2).sqrt());
+            Grid::for_k_nearest_at_least(cloud, mean_k.saturating_add(1), side)
+        })
+        .flatten();
+    let Some(grid) = grid else {
+        return Ok(RadiusKept {
+            kept: radius_outlier_removal_indices(cloud, params)?,
+            grid: None,
+        });
+    };
+    let keep = keep_flags(Some(&grid), cloud, params);
+    let kept = indices_of(&keep);
+    if kept.is_empty() {
+        return Err(emptied(FILTER, cloud.len(), HINT));
+    }
+    Ok(RadiusKept {
+        kept,
+        grid: Some(grid.retain(&keep)),
+    })
+}
+
+impl RadiusKept {
+    /// Statistical outlier removal ([RS eq. 14]–[RS eq. 16]) of the points
+    /// kept, `kept_points` (the cloud's points at `kept`, in order): the
+    /// indices into them that
+    /// [`statistical_outlier_removal_indices`](super::statistical_outlier_removal_indices)
+    /// gives, from the index the radius filter searched when it kept one.
+    pub fn statistical_indices(
+        self,
+        kept_points: &[Point],
+        params: &StatisticalOutlierParams,
+    ) -> Result<Vec<usize>> {
+        assert_eq!(
+            kept_points.len(),
+            self.kept.len(),
+            "the points the radius filter kept"
+        );
+        match self.grid {
+            Some(grid) => statistical_kept_on(&grid, kept_points.len(), params),
+            None => super::statistical_outlier_removal_indices(kept_points, params),
+        }
+    }
+}
+
 /// The kept indices of `points` (all finite, not empty).
 fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<usize> {
-    // [RS eq. 13]: kept when at least min_neighbors others lie within the radius.
-    let wanted = params.min_neighbors + 1; // the point itself comes first
     if params.min_neighbors == 0 {
         return (0..points.len()).collect();
     }
-    if wanted > points.len() {
+    if params.min_neighbors + 1 > points.len() {
         return Vec::new();
     }
     let r2 = f32_at_most(params.radius_m * params.radius_m);
+    let grid = Grid::for_radius(points, f64::from(r2).sqrt());
+    indices_of(&keep_flags(grid.as_ref(), points, params))
+}
+
+/// Whether each point (of at least `min_neighbors + 1`, all finite) is kept.
+fn keep_flags(grid: Option<&Grid>, points: &[Point], params: &RadiusOutlierParams) -> Vec<bool> {
+    // [RS eq. 13]: kept when at least min_neighbors others lie within the radius.
+    let wanted = params.min_neighbors + 1; // the point itself comes first
+    let r2 = f32_at_most(params.radius_m * params.radius_m);
     // The wanted-th nearest is within the radius exactly when at least
     // `wanted` points are: count them, stopping at `wanted` (on a grid of
-    // columns as wide as the radius when the cloud suits one, `grid/`;
-    // else on the k-d tree: the same counts).
-    let keep: Vec<bool> = match Grid::for_radius(points, f64::from(r2).sqrt()) {
+    // columns at least as wide as the radius when the cloud suits one,
+    // `grid/`; else on the k-d tree: the same counts).
+    match grid {
         Some(grid) => grid.map_has_within(r2, wanted),
         None => {
             let tree = KdTree::new(points);
             tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted))
         }
-    };
+    }
+}
+
+/// The positions of the `true`s.
+fn indices_of(keep: &[bool]) -> Vec<usize> {
     keep.par_iter()
         .enumerate()
         .filter(|(_, &k)| k)
         .map(|(i, _)| i)
         .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A scan of a wavy surface, 1 cm noise, 2 % of points flung up to
+    /// 0.5 m above it.
+    fn scan(n: usize, seed: u64) -> Vec<Point> {
+        let mut u = super::super::common::uniform(seed);
+        (0..n)
+            .map(|i| {
+                let (x, y) = (u() * 20.0, u() * 20.0);
+                let lift = if i % 50 == 0 { u() * 0.5 } else { 0.0 };
+                [x, y, (0.3 * x).sin() + 0.1 * y + 0.01 * u() + lift]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn the_shared_grid_keeps_what_the_two_filters_keep() {
+        // On a scan the index is shared (the radius within the k nearest's
+        // reach), and the result is the two filters', bit for bit.
+        let points = scan(60_000, 5);
+        for (radius_m, min_neighbors, mean_k) in [(0.1, 3, 20), (0.2, 5, 8), (0.05, 1, 50)] {
+            let radius = RadiusOutlierParams {
+                radius_m,
+                min_neighbors,
+            };
+            let statistical = StatisticalOutlierParams {
+                mean_k,
+                std_mul: 1.0,
+                ..Default::default()
+            };
+            let first = radius_outlier_removal_then(&points, &radius, mean_k).unwrap();
+            assert!(first.grid.is_some(), "{radius_m} {mean_k}");
+            let kept = radius_outlier_removal_indices(&points, &radius).unwrap();
+            assert_eq!(first.kept, kept);
+            let kept_points: Vec<Point> = kept.iter().map(|&i| points[i]).collect();
+            let want =
+                super::super::statistical_outlier_removal_indices(&kept_points, &statistical)
+                    .unwrap();
+            assert!(want.len() < kept.len());
+            assert_eq!(
+                first
+                    .statistical_indices(&kept_points, &statistical)
+                    .unwrap(),
+                want
+            );
+        }
+        // A radius far beyond the k nearest's reach: the filters' own paths.
+        let radius = RadiusOutlierParams {
+            radius_m: 3.0,
+            min_neighbors: 3,
+        };
+        assert!(radius_outlier_removal_then(&points, &radius, 20)
+            .unwrap()
+            .grid
+            .is_none());
+    }
 }

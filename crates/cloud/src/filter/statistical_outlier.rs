@@ -365,18 +365,44 @@ impl OutlierCut {
 /// The kept indices of `points` (all finite, not empty).
 fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<Vec<usize>> {
     enough_points(points.len(), params.mean_k)?;
-    let distances = mean_neighbour_distances(points, params.mean_k);
+    Ok(cut_kept(
+        &mean_neighbour_distances(points, params.mean_k),
+        params,
+    ))
+}
+
+/// [`statistical_outlier_removal_indices`] of the `n` points (finite, not
+/// empty) filed on `grid`.
+pub(crate) fn statistical_kept_on(
+    grid: &Grid,
+    n: usize,
+    params: &StatisticalOutlierParams,
+) -> Result<Vec<usize>> {
+    params.validate()?;
+    enough_points(n, params.mean_k)?;
+    let k = params.mean_k;
+    let distances = grid.map_k_nearest_distances(k + 1, |nearest| mean_of(nearest, k));
+    let kept = cut_kept(&distances, params);
+    if kept.is_empty() {
+        return Err(emptied(FILTER, n, "raise std_mul"));
+    }
+    Ok(kept)
+}
+
+/// The points whose d̄_i the cut of [RS eq. 15]–[RS eq. 16] keeps, the
+/// global sums of [RS eq. 14] added in input order.
+fn cut_kept(distances: &[f32], params: &StatisticalOutlierParams) -> Vec<usize> {
     let mut sums = DistanceSums::default();
-    for &d in &distances {
+    for &d in distances {
         sums.add(d);
     }
     let cut = sums.cut(params);
-    Ok(distances
+    distances
         .iter()
         .enumerate()
         .filter(|(_, &d)| cut.keeps(d))
         .map(|(i, _)| i)
-        .collect())
+        .collect()
 }
 
 #[cfg(test)]

@@ -27,7 +27,9 @@
 //! sweep many columns) is answered after the others (`far.rs`): blocks of
 //! columns and columns searched nearest box first, or on a large cloud
 //! with many such points a k-d tree (the columns that search opens grow
-//! with the density). In place of the tree's walk with a branch a node, a
+//! with the density). A grid searched once may be searched again with
+//! some points dropped (`Grid::retain`: the statistical filter on what the
+//! radius filter kept, on columns sized for both). In place of the tree's walk with a branch a node, a
 //! query costs a few look-ups and some six times k distances:
 //! the statistical filter on the 1 M-point bench pile fell from 2.15 s
 //! (the tree alone) to 0.64–0.79 s (BENCHMARKS.md, 2026-12-03). A cloud
@@ -125,6 +127,18 @@ impl Grid {
     /// their k-th neighbour distance, or `None` when the cloud is too
     /// sparse for a grid (see the module docs).
     pub(crate) fn for_k_nearest(points: &[Point], k: usize) -> Option<Self> {
+        Self::for_k_nearest_at_least(points, k, 0.0)
+    }
+
+    /// [`Grid::for_k_nearest`] with columns at least `min_side` wide (so
+    /// that the same grid serves searches within a radius below it), or
+    /// `None` also when that is more than [`WIDER`] times the side the k
+    /// nearest want.
+    pub(crate) fn for_k_nearest_at_least(
+        points: &[Point],
+        k: usize,
+        min_side: f64,
+    ) -> Option<Self> {
         let n = points.len();
         if n <= k || u32::try_from(n).is_err() {
             return None;
@@ -137,27 +151,38 @@ impl Grid {
         let first = (16.0 * area / n as f64).sqrt();
         let side = match Columns::new(points, lo, hi, first) {
             Some(columns) => {
-                let occupied = columns.counts().filter(|&c| c > 0).count();
+                // (A column with one point is a stray's: an outlier's.)
+                let occupied = columns.counts().filter(|&c| c > 1).count();
                 let covered = occupied as f64 * columns.h * columns.h;
                 (covered * k as f64 / (std::f64::consts::PI * n as f64)).sqrt()
             }
             None => first,
         };
-        let first = Self::new(points, lo, hi, side * SIDE)?;
+        let first = Self::new(points, lo, hi, (side * SIDE).max(min_side))?;
         // The density over the columns assumes a surface; where the range
         // noise makes the scan a layer of some thickness (dense scans) the
         // k nearest lie much closer. The median k-th distance of evenly
         // spread points tells, and a grid far off it is made again.
+        // (Points far from the rest, an outlier above the scan, would
+        // sweep many columns for nothing here: they are passed over.)
         let probes = PROBES.min(n);
         let mut scratch = Scratch::default();
         let mut kth: Vec<f64> = (0..probes)
-            .map(|i| {
-                let kth = first.k_nearest(i * n / probes, first.h / SIDE, k, &mut scratch, true);
-                f64::from(kth.unwrap_or(0.0)).sqrt()
+            .filter_map(|i| {
+                let kth =
+                    first.k_nearest(i * n / probes, first.h / SIDE, k, &mut scratch, false)?;
+                Some(f64::from(kth).sqrt())
             })
             .collect();
+        if kth.is_empty() {
+            return Some(first);
+        }
         kth.sort_unstable_by(f64::total_cmp);
-        let side = kth[probes / 2] * SIDE;
+        let side = kth[kth.len() / 2] * SIDE;
+        if min_side > WIDER * side {
+            return None;
+        }
+        let side = side.max(min_side);
         if side > 0.0 && (side < first.h / 1.5 || side > first.h * 1.5) {
             Self::new(points, lo, hi, side).or(Some(first))
         } else {
@@ -175,7 +200,56 @@ impl Grid {
         // A hair wider than the radius, so that a box of the radius
         // (widened by `SLACK`) reaches no further than the columns next
         // to its own (`near.rs`).
-        Self::new(points, lo, hi, radius * (1.0 + 2.0 * SLACK))
+        Self::new(points, lo, hi, radius_side(radius))
+    }
+
+    /// The grid of the points that `keep` marks (by input index),
+    /// numbered as they come in the input (the i-th kept point is point
+    /// i): the same columns, each still by height, the others dropped in
+    /// place in one pass, with no sort and no new memory but the ranks (a
+    /// filter's output searched again: the statistical filter after the
+    /// radius filter).
+    pub(crate) fn retain(self, keep: &[bool]) -> Self {
+        let Self {
+            origin,
+            h,
+            nx,
+            ny,
+            mut start,
+            mut x,
+            mut y,
+            mut z,
+            mut ids,
+            ..
+        } = self;
+        let mut rank = vec![u32::MAX; keep.len()];
+        for (kept, (r, _)) in rank.iter_mut().zip(keep).filter(|(_, &k)| k).enumerate() {
+            *r = kept as u32;
+        }
+        // Each kept point moves down to the next free position (never up,
+        // so none is overwritten before it is read).
+        let mut at = 0;
+        let mut from = 0;
+        for end in start.iter_mut().skip(1) {
+            let last = *end as usize;
+            for p in from..last {
+                let id = ids[p] as usize;
+                if keep[id] {
+                    x[at] = x[p];
+                    y[at] = y[p];
+                    z[at] = z[p];
+                    ids[at] = rank[id];
+                    at += 1;
+                }
+            }
+            from = last;
+            *end = at as u32;
+        }
+        for v in [&mut x, &mut y, &mut z] {
+            v.truncate(at);
+        }
+        ids.truncate(at);
+        Self::assemble(origin, h, (nx, ny), start, [x, y, z], ids)
     }
 
     /// Files the points on columns of side about `wanted`.
@@ -241,7 +315,21 @@ impl Grid {
         // point), then split by axis.
         let sorted: Vec<Point> = ids.par_iter().map(|&i| points[i as usize]).collect();
         let coordinate = |a: usize| -> Vec<f32> { sorted.par_iter().map(|p| p[a]).collect() };
-        let z = coordinate(2);
+        let xyz = [coordinate(0), coordinate(1), coordinate(2)];
+        Some(Self::assemble(lo, h, (nx, ny), start, xyz, ids))
+    }
+
+    /// The grid of points filed by column (`start`, numbered by
+    /// [`block_index`]), each column by height, with their coordinates and
+    /// input indices in that order: the columns' height indices added.
+    fn assemble(
+        origin: [f64; 3],
+        h: f64,
+        (nx, ny): (usize, usize),
+        start: Vec<u32>,
+        [x, y, z]: [Vec<f32>; 3],
+        ids: Vec<u32>,
+    ) -> Self {
         let (slabs, slab_start) = slab_index(&start, &z, h);
         let block_heights = slabs
             .chunks(BLOCK * BLOCK)
@@ -252,8 +340,8 @@ impl Grid {
                 })
             })
             .collect();
-        Some(Self {
-            origin: lo,
+        Self {
+            origin,
             h,
             nx,
             ny,
@@ -261,13 +349,13 @@ impl Grid {
             slabs,
             slab_start,
             block_heights,
-            x: coordinate(0),
-            y: coordinate(1),
+            x,
+            y,
             z,
             ids,
             isa: Isa::best(),
             tree_from: TREE_FROM,
-        })
+        }
     }
 
     /// The column holding coordinate `v` along axis `a` (0: x, 1: y),
@@ -617,6 +705,17 @@ const RUN: usize = 4096;
 
 /// The next query's radius: this times the k-th distance of the last.
 const GUESS: f64 = 1.1;
+
+/// The side of columns for searches within `radius`: a hair wider, so
+/// that a box of the radius (widened by `SLACK`) reaches no further than
+/// the columns next to its own (`near.rs`).
+pub(crate) fn radius_side(radius: f64) -> f64 {
+    radius * (1.0 + 2.0 * SLACK)
+}
+
+/// A k-nearest grid is not made this many times wider than the k nearest
+/// want for a radius search to share it (`Grid::for_k_nearest_at_least`).
+const WIDER: f64 = 2.0;
 
 /// Columns this many times as wide as the typical k-th distance: runs
 /// long enough to vectorise, few columns a query (1.3–1.5× faster than
