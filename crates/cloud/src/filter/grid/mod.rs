@@ -206,7 +206,7 @@ impl Grid {
     /// The grid of the points that `keep` marks (by input index),
     /// numbered as they come in the input (the i-th kept point is point
     /// i): the same columns, each still by height, the others dropped in
-    /// place in one pass, with no sort and no new memory but the ranks (a
+    /// place, with no sort and no new memory but the ranks (a
     /// filter's output searched again: the statistical filter after the
     /// radius filter).
     pub(crate) fn retain(self, keep: &[bool]) -> Self {
@@ -226,24 +226,64 @@ impl Grid {
         for (kept, (r, _)) in rank.iter_mut().zip(keep).filter(|(_, &k)| k).enumerate() {
             *r = kept as u32;
         }
-        // Each kept point moves down to the next free position (never up,
-        // so none is overwritten before it is read).
-        let mut at = 0;
-        let mut from = 0;
-        for end in start.iter_mut().skip(1) {
-            let last = *end as usize;
-            for p in from..last {
-                let id = ids[p] as usize;
-                if keep[id] {
-                    x[at] = x[p];
-                    y[at] = y[p];
-                    z[at] = z[p];
-                    ids[at] = rank[id];
-                    at += 1;
+        // Runs of columns in parallel, each kept point moved down to the
+        // next free position of its run (never up, so none is overwritten
+        // before it is read); then each run's kept points moved down next
+        // to the run before's, one block copy an axis.
+        let old = start.clone();
+        let columns = old.len() - 1;
+        let firsts: Vec<usize> = (0..columns)
+            .step_by(RETAIN_COLUMNS)
+            .chain(std::iter::once(columns))
+            .collect();
+        let mut parts = Vec::with_capacity(firsts.len());
+        let (mut xs, mut ys, mut zs) = (&mut x[..], &mut y[..], &mut z[..]);
+        let (mut is, mut ends) = (&mut ids[..], &mut start[1..]);
+        for w in firsts.windows(2) {
+            let (c0, c1) = (w[0], w[1]);
+            let size = (old[c1] - old[c0]) as usize;
+            let (px, rx) = std::mem::take(&mut xs).split_at_mut(size);
+            let (py, ry) = std::mem::take(&mut ys).split_at_mut(size);
+            let (pz, rz) = std::mem::take(&mut zs).split_at_mut(size);
+            let (pi, ri) = std::mem::take(&mut is).split_at_mut(size);
+            let (pe, re) = std::mem::take(&mut ends).split_at_mut(c1 - c0);
+            parts.push((c0, [px, py, pz], pi, pe));
+            (xs, ys, zs, is, ends) = (rx, ry, rz, ri, re);
+        }
+        let counts: Vec<usize> = parts
+            .into_par_iter()
+            .map(|(c0, [px, py, pz], pi, pe)| {
+                let base = old[c0] as usize;
+                let mut at = 0;
+                for (j, end) in pe.iter_mut().enumerate() {
+                    let (s, e) = (old[c0 + j] as usize - base, old[c0 + j + 1] as usize - base);
+                    for p in s..e {
+                        let id = pi[p] as usize;
+                        if keep[id] {
+                            px[at] = px[p];
+                            py[at] = py[p];
+                            pz[at] = pz[p];
+                            pi[at] = rank[id];
+                            at += 1;
+                        }
+                    }
+                    *end = at as u32;
                 }
+                at
+            })
+            .collect();
+        let mut at = 0;
+        for (w, &count) in firsts.windows(2).zip(&counts) {
+            let (c0, c1) = (w[0], w[1]);
+            let base = old[c0] as usize;
+            for v in [&mut x, &mut y, &mut z] {
+                v.copy_within(base..base + count, at);
             }
-            from = last;
-            *end = at as u32;
+            ids.copy_within(base..base + count, at);
+            for end in &mut start[c0 + 1..=c1] {
+                *end += at as u32;
+            }
+            at += count;
         }
         for v in [&mut x, &mut y, &mut z] {
             v.truncate(at);
@@ -693,6 +733,9 @@ fn block_index(cx: usize, cy: usize, nx: usize) -> usize {
     let blocks_x = nx.div_ceil(BLOCK);
     ((cy / BLOCK) * blocks_x + cx / BLOCK) * BLOCK * BLOCK + (cy % BLOCK) * BLOCK + cx % BLOCK
 }
+
+/// Columns a parallel task of `Grid::retain` compacts.
+const RETAIN_COLUMNS: usize = 256;
 
 /// Points whose k-th distance checks a grid's side.
 const PROBES: usize = 256;
