@@ -376,20 +376,26 @@ mod tests {
         [0, 1, 2].map(|r| [0, 1, 2].map(|c| x[c][r]))
     }
 
-    #[test]
-    fn jacobi_gives_orthonormal_eigenvectors_of_any_symmetric_matrix() {
-        // A V = V diag(λ), Vᵀ V = I, λ ascending, for covariance-like
-        // matrices (a flat neighbourhood, a repeated eigenvalue, a random one).
-        let mut u = super::super::common::uniform(7);
+    /// Covariance-like matrices: a flat neighbourhood with a repeated
+    /// largest eigenvalue, one with a repeated eigenvalue, then `n`
+    /// random B·Bᵀ (seeded).
+    fn covariances(seed: u64, n: usize) -> Vec<[[f64; 3]; 3]> {
+        let mut u = super::super::common::uniform(seed);
         let mut cases = vec![
             [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 1e-6]],
             [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 3.0]],
         ];
-        for _ in 0..200 {
+        for _ in 0..n {
             let b: [[f64; 3]; 3] = [0, 1, 2].map(|_| [0, 1, 2].map(|_| f64::from(u()) - 0.5));
             cases.push(mul(&b, &transpose(&b)));
         }
-        for a in cases {
+        cases
+    }
+
+    #[test]
+    fn jacobi_gives_orthonormal_eigenvectors_of_any_symmetric_matrix() {
+        // A V = V diag(λ), Vᵀ V = I, λ ascending.
+        for a in covariances(7, 200) {
             let (values, vectors) = symmetric_eigen3(a);
             assert!(values[0] <= values[1] && values[1] <= values[2]);
             let av = mul(&a, &vectors);
@@ -433,26 +439,19 @@ mod tests {
 
     #[test]
     fn the_closed_form_axis_is_jacobis() {
-        // Covariance-like matrices of every shape (random, flat with a
-        // smallest eigenvalue down to 1e-10 of the largest, rotated, a
-        // tie of the two largest): the same axis as the Jacobi rotations
-        // to 1e-9 (the closed form's error grows as λ₂/(λ₁ − λ₀)).
-        let mut u = super::super::common::uniform(11);
-        let mut cases = vec![
-            [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 1e-6]],
-            [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 3.0]],
-        ];
-        for i in 0..500 {
-            let b: [[f64; 3]; 3] = [0, 1, 2].map(|_| [0, 1, 2].map(|_| f64::from(u()) - 0.5));
-            let mut m = mul(&b, &transpose(&b));
+        // Covariance-like matrices, every other one flattened (its
+        // smallest eigenvalue 10⁻¹ to 10⁻⁵ of the largest), scaled to a
+        // pile's centimetres: the same axis as the Jacobi rotations to
+        // 1e-9 (the closed form's error grows as λ₂/(λ₁ − λ₀)).
+        let mut cases = covariances(11, 500);
+        for (i, m) in cases.iter_mut().enumerate().skip(2) {
             if i % 2 == 1 {
-                // Flatten it: shrink one direction by 10^-(1..5).
-                let flat = 10f64.powi(-(1 + i % 5));
-                let (_, v) = symmetric_eigen3(m);
+                let flat = 10f64.powi(-(1 + i as i32 % 5));
+                let (_, v) = symmetric_eigen3(*m);
                 let d = [[flat, 0.0, 0.0], [0.0, 1.0, 0.0], [0.0, 0.0, 2.0]];
-                m = mul(&mul(&v, &d), &transpose(&v));
+                *m = mul(&mul(&v, &d), &transpose(&v));
             }
-            cases.push(m.map(|r| r.map(|v| v * 1e-3)));
+            *m = m.map(|r| r.map(|v| v * 1e-3));
         }
         for a in cases {
             let (_, vectors) = symmetric_eigen3(a);
