@@ -130,8 +130,8 @@ pub struct RadiusKept {
     /// Indices of the points kept, in input order (those of
     /// [`radius_outlier_removal_indices`]).
     pub kept: Vec<usize>,
-    /// The grid of the kept points, numbered as in `kept`, when the cloud
-    /// suited one sized for both searches.
+    /// The grid of the kept points (by their indices in the cloud), when
+    /// the cloud suited one sized for both searches.
     grid: Option<Grid>,
 }
 
@@ -170,8 +170,10 @@ pub fn radius_outlier_removal_then(
             grid: None,
         });
     };
-    let keep = keep_flags(Some(&grid), cloud, params);
-    let kept = indices_of(&keep);
+    // [RS eq. 13] as in `keep_flags`, by sorted position for `retain`.
+    let r2 = f32_at_most(params.radius_m * params.radius_m);
+    let keep = grid.map_has_within_in_grid_order(r2, wanted);
+    let kept = indices_of(&grid.to_input_order(&keep));
     if kept.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }
@@ -198,7 +200,7 @@ impl RadiusKept {
             "the points the radius filter kept"
         );
         match self.grid {
-            Some(grid) => statistical_kept_on(&grid, kept_points.len(), params),
+            Some(grid) => statistical_kept_on(&grid, &self.kept, params),
             None => super::statistical_outlier_removal_indices(kept_points, params),
         }
     }

@@ -371,17 +371,20 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
     ))
 }
 
-/// [`statistical_outlier_removal_indices`] of the `n` points (finite, not
-/// empty) filed on `grid`.
+/// [`statistical_outlier_removal_indices`] of the points filed on `grid`,
+/// which are those at `filed` (ascending, not empty) of some cloud: indices
+/// into `filed`.
 pub(crate) fn statistical_kept_on(
     grid: &Grid,
-    n: usize,
+    filed: &[usize],
     params: &StatisticalOutlierParams,
 ) -> Result<Vec<usize>> {
     params.validate()?;
+    let n = filed.len();
     enough_points(n, params.mean_k)?;
     let k = params.mean_k;
-    let distances = grid.map_k_nearest_distances(k + 1, |nearest| mean_of(nearest, k));
+    let all = grid.map_k_nearest_distances(k + 1, |nearest| mean_of(nearest, k));
+    let distances: Vec<f32> = filed.iter().map(|&i| all[i]).collect();
     let kept = cut_kept(&distances, params);
     if kept.is_empty() {
         return Err(emptied(FILTER, n, "raise std_mul"));

@@ -115,6 +115,9 @@ pub(crate) struct Grid {
     z: Vec<f32>,
     /// Input index of each sorted position.
     ids: Vec<u32>,
+    /// Input indices run below this: the points filed, and after
+    /// [`Grid::retain`] those it dropped.
+    inputs: usize,
     /// The search loop's instruction set.
     isa: Isa,
     /// Points from which far points may go to a k-d tree (`TREE_FROM`;
@@ -203,12 +206,12 @@ impl Grid {
         Self::new(points, lo, hi, radius_side(radius))
     }
 
-    /// The grid of the points that `keep` marks (by input index),
-    /// numbered as they come in the input (the i-th kept point is point
-    /// i): the same columns, each still by height, the others dropped in
-    /// place, with no sort and no new memory but the ranks (a
-    /// filter's output searched again: the statistical filter after the
-    /// radius filter).
+    /// The grid of the points that `keep` marks by sorted position (as
+    /// [`Grid::map_has_within_in_grid_order`] gives it), which keep their
+    /// input indices: the same columns, each still by height, the others
+    /// dropped in place, with no sort and no new memory (a filter's output
+    /// searched again: the statistical filter after the radius filter).
+    /// Its results in input order hold the dropped points' places too.
     pub(crate) fn retain(self, keep: &[bool]) -> Self {
         let Self {
             origin,
@@ -220,12 +223,9 @@ impl Grid {
             mut y,
             mut z,
             mut ids,
+            inputs,
             ..
         } = self;
-        let mut rank = vec![u32::MAX; keep.len()];
-        for (kept, (r, _)) in rank.iter_mut().zip(keep).filter(|(_, &k)| k).enumerate() {
-            *r = kept as u32;
-        }
         // Runs of columns in parallel, each kept point moved down to the
         // next free position of its run (never up, so none is overwritten
         // before it is read); then each run's kept points moved down next
@@ -254,16 +254,16 @@ impl Grid {
             .into_par_iter()
             .map(|(c0, [px, py, pz], pi, pe)| {
                 let base = old[c0] as usize;
+                let keep = &keep[base..];
                 let mut at = 0;
                 for (j, end) in pe.iter_mut().enumerate() {
                     let (s, e) = (old[c0 + j] as usize - base, old[c0 + j + 1] as usize - base);
                     for p in s..e {
-                        let id = pi[p] as usize;
-                        if keep[id] {
+                        if keep[p] {
                             px[at] = px[p];
                             py[at] = py[p];
                             pz[at] = pz[p];
-                            pi[at] = rank[id];
+                            pi[at] = pi[p];
                             at += 1;
                         }
                     }
@@ -289,7 +289,10 @@ impl Grid {
             v.truncate(at);
         }
         ids.truncate(at);
-        Self::assemble(origin, h, (nx, ny), start, [x, y, z], ids)
+        Self {
+            inputs,
+            ..Self::assemble(origin, h, (nx, ny), start, [x, y, z], ids)
+        }
     }
 
     /// Files the points on columns of side about `wanted`.
@@ -392,6 +395,7 @@ impl Grid {
             x,
             y,
             z,
+            inputs: ids.len(),
             ids,
             isa: Isa::best(),
             tree_from: TREE_FROM,
@@ -555,9 +559,21 @@ impl Grid {
     /// within squared distance `r2`, in input order (radius outlier
     /// removal, [RS eq. 13]).
     pub(crate) fn map_has_within(&self, r2: f32, wanted: usize) -> Vec<bool> {
-        self.map_sorted(Near::default, |near, p| {
-            self.has_within(p, near, r2, wanted)
-        })
+        self.to_input_order(&self.map_has_within_in_grid_order(r2, wanted))
+    }
+
+    /// [`Grid::map_has_within`] by sorted position.
+    pub(crate) fn map_has_within_in_grid_order(&self, r2: f32, wanted: usize) -> Vec<bool> {
+        let n = self.ids.len();
+        (0..n.div_ceil(RUN))
+            .into_par_iter()
+            .map_init(Near::default, |near, i| {
+                (i * RUN..((i + 1) * RUN).min(n))
+                    .map(|p| self.has_within(p, near, r2, wanted))
+                    .collect::<Vec<bool>>()
+            })
+            .flatten_iter()
+            .collect()
     }
 
     /// `f(scratch, i, found)` for every point `i` of the input, `found` the
@@ -587,7 +603,8 @@ impl Grid {
     }
 
     /// `f(scratch, sorted position)` for every point, runs of positions in
-    /// parallel (`init` makes each task's scratch), in input order.
+    /// parallel (`init` makes each task's scratch), in input order (the
+    /// places of inputs not filed left at the default).
     fn map_sorted<T, S, I, F>(&self, init: I, f: F) -> Vec<T>
     where
         T: Send + Sync + Clone + Default,
@@ -604,11 +621,21 @@ impl Grid {
                 (s..e).map(|p| f(scratch, p)).collect()
             })
             .collect();
-        let mut result = vec![T::default(); n];
+        let mut result = vec![T::default(); self.inputs];
         for (part, &(s, _)) in parts.into_iter().zip(&runs) {
             for (j, value) in part.into_iter().enumerate() {
                 result[self.ids[s + j] as usize] = value;
             }
+        }
+        result
+    }
+
+    /// `values` by sorted position put in input order (the places of
+    /// inputs not filed left at the default).
+    pub(crate) fn to_input_order<T: Clone + Default>(&self, values: &[T]) -> Vec<T> {
+        let mut result = vec![T::default(); self.inputs];
+        for (value, &i) in values.iter().zip(&self.ids) {
+            result[i as usize] = value.clone();
         }
         result
     }
