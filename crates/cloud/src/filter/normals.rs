@@ -6,8 +6,9 @@
 //! The normal is the eigenvector of the smallest eigenvalue of the
 //! neighbourhood's covariance matrix (the point itself included, as in PCL's
 //! `NormalEstimation`, whose k nearest include the query point), in f64,
-//! in closed form as PCL's `eigen33` (cyclic Jacobi rotations where the two
-//! smallest eigenvalues nearly meet; see `smallest_axis`). It is oriented towards a viewpoint (PCL's
+//! in closed form as PCL's `eigen33` (cyclic Jacobi rotations where the
+//! two smallest eigenvalues nearly meet; see `smallest_axis`). It is
+//! oriented towards a viewpoint (PCL's
 //! `flipNormalTowardsViewpoint`: n·(v − p) ≥ 0), towards +z (a pile seen from
 //! above; Open3D's default when a cloud has no normals yet), or left as the
 //! solver returns it. A neighbourhood of fewer than three points, or one

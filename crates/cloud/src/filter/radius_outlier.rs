@@ -170,7 +170,7 @@ pub fn radius_outlier_removal_then(
             grid: None,
         });
     };
-    // [RS eq. 13] as in `keep_flags`, by sorted position for `retain`.
+    // [RS eq. 13] as in `kept_indices`, by sorted position for `retain`.
     let r2 = f32_at_most(params.radius_m * params.radius_m);
     let keep = grid.map_has_within_in_grid_order(r2, wanted);
     let kept = indices_of(&grid.to_input_order(&keep));
@@ -181,6 +181,15 @@ pub fn radius_outlier_removal_then(
         kept,
         grid: Some(grid.retain(&keep)),
     })
+}
+
+impl std::fmt::Debug for RadiusKept {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        f.debug_struct("RadiusKept")
+            .field("kept", &self.kept.len())
+            .field("index_shared", &self.grid.is_some())
+            .finish()
+    }
 }
 
 impl RadiusKept {
@@ -208,33 +217,27 @@ impl RadiusKept {
 
 /// The kept indices of `points` (all finite, not empty).
 fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<usize> {
+    // [RS eq. 13]: kept when at least min_neighbors others lie within the radius.
+    let wanted = params.min_neighbors + 1; // the point itself comes first
     if params.min_neighbors == 0 {
         return (0..points.len()).collect();
     }
-    if params.min_neighbors + 1 > points.len() {
+    if wanted > points.len() {
         return Vec::new();
     }
     let r2 = f32_at_most(params.radius_m * params.radius_m);
-    let grid = Grid::for_radius(points, f64::from(r2).sqrt());
-    indices_of(&keep_flags(grid.as_ref(), points, params))
-}
-
-/// Whether each point (of at least `min_neighbors + 1`, all finite) is kept.
-fn keep_flags(grid: Option<&Grid>, points: &[Point], params: &RadiusOutlierParams) -> Vec<bool> {
-    // [RS eq. 13]: kept when at least min_neighbors others lie within the radius.
-    let wanted = params.min_neighbors + 1; // the point itself comes first
-    let r2 = f32_at_most(params.radius_m * params.radius_m);
     // The wanted-th nearest is within the radius exactly when at least
     // `wanted` points are: count them, stopping at `wanted` (on a grid of
-    // columns at least as wide as the radius when the cloud suits one,
-    // `grid/`; else on the k-d tree: the same counts).
-    match grid {
+    // columns as wide as the radius when the cloud suits one, `grid/`;
+    // else on the k-d tree: the same counts).
+    let keep: Vec<bool> = match Grid::for_radius(points, f64::from(r2).sqrt()) {
         Some(grid) => grid.map_has_within(r2, wanted),
         None => {
             let tree = KdTree::new(points);
             tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted))
         }
-    }
+    };
+    indices_of(&keep)
 }
 
 /// The positions of the `true`s.

@@ -28,9 +28,10 @@
 //! columns and columns searched nearest box first, or on a large cloud
 //! with many such points a k-d tree (the columns that search opens grow
 //! with the density). A grid searched once may be searched again with
-//! some points dropped (`Grid::retain`: the statistical filter on what the
-//! radius filter kept, on columns sized for both). In place of the tree's walk with a branch a node, a
-//! query costs a few look-ups and some six times k distances:
+//! some points dropped (`Grid::retain`: the statistical filter on what
+//! the radius filter kept, on columns sized for both). In place of the
+//! tree's walk with a branch a node, a query costs a few look-ups and
+//! some six times k distances:
 //! the statistical filter on the 1 M-point bench pile fell from 2.15 s
 //! (the tree alone) to 0.64–0.79 s (BENCHMARKS.md, 2026-12-03). A cloud
 //! whose grid would need far more columns than points (two scans
@@ -209,7 +210,8 @@ impl Grid {
     /// The grid of the points that `keep` marks by sorted position (as
     /// [`Grid::map_has_within_in_grid_order`] gives it), which keep their
     /// input indices: the same columns, each still by height, the others
-    /// dropped in place, with no sort and no new memory (a filter's output
+    /// dropped in place, with no sort and no new memory but a copy of the
+    /// column starts (a filter's output
     /// searched again: the statistical filter after the radius filter).
     /// Its results in input order hold the dropped points' places too.
     pub(crate) fn retain(self, keep: &[bool]) -> Self {
