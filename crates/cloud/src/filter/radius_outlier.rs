@@ -41,7 +41,9 @@ use rayon::prelude::*;
 use super::common::{bad, emptied, empty_input, f32_at_most, gather, is_finite, on_finite_points};
 use super::grid::{radius_side, Grid};
 use super::kdtree::KdTree;
-use super::statistical_outlier::{statistical_kept_on, StatisticalOutlierParams};
+use super::statistical_outlier::{
+    statistical_kept_on, statistical_outlier_removal_indices, StatisticalOutlierParams,
+};
 use crate::{Point, PointCloud, Result};
 use serde::{Deserialize, Serialize};
 
@@ -140,7 +142,7 @@ pub struct RadiusKept {
 /// `mean_k` neighbours), as the paper's filtering does: the same points
 /// as [`radius_outlier_removal_indices`], then (by
 /// [`RadiusKept::statistical_indices`]) as
-/// [`statistical_outlier_removal_indices`](super::statistical_outlier_removal_indices)
+/// [`statistical_outlier_removal_indices`]
 /// on them, bit for bit; but the points are filed on a grid once, with
 /// columns as the k nearest want them (at least as wide as the radius),
 /// and the removed ones dropped from it rather than the kept ones filed
@@ -196,7 +198,7 @@ impl RadiusKept {
     /// Statistical outlier removal ([RS eq. 14]–[RS eq. 16]) of the points
     /// kept, `kept_points` (the cloud's points at `kept`, in order): the
     /// indices into them that
-    /// [`statistical_outlier_removal_indices`](super::statistical_outlier_removal_indices)
+    /// [`statistical_outlier_removal_indices`]
     /// gives, from the index the radius filter searched when it kept one.
     pub fn statistical_indices(
         self,
@@ -210,7 +212,7 @@ impl RadiusKept {
         );
         match self.grid {
             Some(grid) => statistical_kept_on(&grid, &self.kept, params),
-            None => super::statistical_outlier_removal_indices(kept_points, params),
+            None => statistical_outlier_removal_indices(kept_points, params),
         }
     }
 }
@@ -286,9 +288,7 @@ mod tests {
             let kept = radius_outlier_removal_indices(&points, &radius).unwrap();
             assert_eq!(first.kept, kept);
             let kept_points: Vec<Point> = kept.iter().map(|&i| points[i]).collect();
-            let want =
-                super::super::statistical_outlier_removal_indices(&kept_points, &statistical)
-                    .unwrap();
+            let want = statistical_outlier_removal_indices(&kept_points, &statistical).unwrap();
             assert!(want.len() < kept.len());
             assert_eq!(
                 first
