@@ -159,9 +159,9 @@ pub fn radius_outlier_removal_then(
         return Err(empty_input(FILTER));
     }
     let wanted = params.min_neighbors + 1;
+    let r2 = f32_at_most(params.radius_m * params.radius_m);
     let grid = (params.min_neighbors > 0 && wanted <= cloud.len() && cloud.iter().all(is_finite))
         .then(|| {
-            let r2 = f32_at_most(params.radius_m * params.radius_m);
             let side = radius_side(f64::from(r2).sqrt());
             Grid::for_k_nearest_at_least(cloud, mean_k.saturating_add(1), side)
         })
@@ -173,7 +173,6 @@ pub fn radius_outlier_removal_then(
         });
     };
     // [RS eq. 13] as in `kept_indices`, by sorted position for `retain`.
-    let r2 = f32_at_most(params.radius_m * params.radius_m);
     let keep = grid.map_has_within_in_grid_order(r2, wanted);
     let kept = indices_of(&grid.to_input_order(&keep));
     if kept.is_empty() {

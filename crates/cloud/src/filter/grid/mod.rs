@@ -566,16 +566,10 @@ impl Grid {
 
     /// [`Grid::map_has_within`] by sorted position.
     pub(crate) fn map_has_within_in_grid_order(&self, r2: f32, wanted: usize) -> Vec<bool> {
-        let n = self.ids.len();
-        (0..n.div_ceil(RUN))
-            .into_par_iter()
-            .map_init(Near::default, |near, i| {
-                (i * RUN..((i + 1) * RUN).min(n))
-                    .map(|p| self.has_within(p, near, r2, wanted))
-                    .collect::<Vec<bool>>()
-            })
-            .flatten_iter()
-            .collect()
+        self.map_runs(Near::default, |near, p| {
+            self.has_within(p, near, r2, wanted)
+        })
+        .concat()
     }
 
     /// `f(scratch, i, found)` for every point `i` of the input, `found` the
@@ -613,23 +607,34 @@ impl Grid {
         I: Fn() -> S + Sync + Send,
         F: Fn(&mut S, usize) -> T + Sync + Send,
     {
-        let n = self.ids.len();
-        let runs: Vec<(usize, usize)> = (0..n.div_ceil(RUN))
-            .map(|i| (i * RUN, ((i + 1) * RUN).min(n)))
-            .collect();
-        let parts: Vec<Vec<T>> = runs
-            .par_iter()
-            .map_init(init, |scratch, &(s, e)| {
-                (s..e).map(|p| f(scratch, p)).collect()
-            })
-            .collect();
         let mut result = vec![T::default(); self.inputs];
-        for (part, &(s, _)) in parts.into_iter().zip(&runs) {
-            for (j, value) in part.into_iter().enumerate() {
-                result[self.ids[s + j] as usize] = value;
+        let parts = self.map_runs(init, f);
+        for (values, ids) in parts.into_iter().zip(self.ids.chunks(RUN)) {
+            for (value, &i) in values.into_iter().zip(ids) {
+                result[i as usize] = value;
             }
         }
         result
+    }
+
+    /// `f(scratch, sorted position)` for every point, in sorted order, in
+    /// runs of `RUN` positions computed in parallel (`init` makes each
+    /// task's scratch).
+    fn map_runs<T, S, I, F>(&self, init: I, f: F) -> Vec<Vec<T>>
+    where
+        T: Send,
+        I: Fn() -> S + Sync + Send,
+        F: Fn(&mut S, usize) -> T + Sync + Send,
+    {
+        let n = self.ids.len();
+        (0..n.div_ceil(RUN))
+            .into_par_iter()
+            .map_init(init, |scratch, i| {
+                (i * RUN..((i + 1) * RUN).min(n))
+                    .map(|p| f(scratch, p))
+                    .collect()
+            })
+            .collect()
     }
 
     /// `values` by sorted position put in input order (the places of
