@@ -592,7 +592,7 @@ impl Grid {
                     within::keep_payload(self.isa, q, run, ids, r2, found);
                     true
                 });
-                found.sort_unstable();
+                within::sort_ids(self.isa, found);
                 f(scratch, self.ids[p] as usize, found)
             },
         )
