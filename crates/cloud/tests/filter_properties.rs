@@ -690,31 +690,45 @@ fn the_two_sided_rule_also_drops_what_is_unusually_dense() {
 
 /// A cloud large enough to be cut into many chunks and buckets gives the
 /// map of voxels bit for bit (each voxel's points summed in f64 in input
-/// order), whatever the number of threads.
+/// order), whatever the number of threads: points through a cube, and
+/// points on a gentle slope in a box of air (a scan's case: few buckets
+/// occupied, each with many voxels, counting-sorted).
 #[test]
 fn a_large_voxel_grid_is_the_map_of_voxels_bit_for_bit() {
-    let cloud = lcg_cloud(300_000, 3.0, 11);
+    let cube = lcg_cloud(300_000, 3.0, 11);
+    let slope = PointCloud::new(
+        lcg_cloud(300_000, 3.0, 12)
+            .points
+            .iter()
+            .map(|p| [p[0], p[1], 0.05 * p[0] + 0.001 * p[2]])
+            .chain([[0.0, 0.0, 3.0]])
+            .collect(),
+    );
     let leaf = 0.02_f64;
     let inv = 1.0 / leaf as f32;
-    let mut voxels: BTreeMap<[i64; 3], ([f64; 3], f64)> = BTreeMap::new();
-    for p in &cloud.points {
-        let c = [2, 1, 0].map(|a| (p[a] * inv).floor() as i64);
-        let e = voxels.entry(c).or_insert(([0.0; 3], 0.0));
-        for (sum, c) in e.0.iter_mut().zip(p) {
-            *sum += f64::from(*c);
+    for cloud in [cube, slope] {
+        let mut voxels: BTreeMap<[i64; 3], ([f64; 3], f64)> = BTreeMap::new();
+        for p in &cloud.points {
+            let c = [2, 1, 0].map(|a| (p[a] * inv).floor() as i64);
+            let e = voxels.entry(c).or_insert(([0.0; 3], 0.0));
+            for (sum, c) in e.0.iter_mut().zip(p) {
+                *sum += f64::from(*c);
+            }
+            e.1 += 1.0;
         }
-        e.1 += 1.0;
-    }
-    let expected: Vec<Point> = voxels
-        .values()
-        .map(|(s, c)| [0, 1, 2].map(|a| (s[a] / c) as f32))
-        .collect();
-    for threads in [1, 2, 5] {
-        let got = rayon::ThreadPoolBuilder::new()
-            .num_threads(threads)
-            .build()
-            .unwrap()
-            .install(|| filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(leaf)).unwrap());
-        assert!(got.points == expected, "{threads} threads");
+        let expected: Vec<Point> = voxels
+            .values()
+            .map(|(s, c)| [0, 1, 2].map(|a| (s[a] / c) as f32))
+            .collect();
+        for threads in [1, 2, 5] {
+            let got = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| {
+                    filter::voxel_grid(&cloud, &filter::VoxelGridParams::cube(leaf)).unwrap()
+                });
+            assert!(got.points == expected, "{threads} threads");
+        }
     }
 }

@@ -298,19 +298,48 @@ where
         })
         .collect();
     // Buckets in parallel ranges; each bucket gathered, sorted, summed.
+    // A bucket's voxels differ in the low `shift` bits of their index
+    // only; where the points lie on a surface in a box of air (a scan)
+    // most buckets are empty and the others hold many voxels, so a large
+    // bucket is counting-sorted on those bits (stable: each voxel's points
+    // stay in input order), a small one sorted unless it is in order.
+    let voxel_in_bucket = |e: &(u64, Point)| ((e.0 >> 32) & ((1u64 << shift) - 1)) as usize;
+    let counted = |len: usize| shift <= 16 && len >= 32 && 1usize << shift <= 4 * len;
     let per_task = buckets.div_ceil(rayon::current_num_threads() * 8).max(1);
     let out: Vec<Vec<Point>> = (0..buckets.div_ceil(per_task))
         .into_par_iter()
         .map(|t| {
             let mut out = Vec::new();
-            let mut scratch: Vec<(u64, Point)> = Vec::new();
+            let (mut scratch, mut by_voxel) = (Vec::new(), Vec::new());
+            let mut count: Vec<u32> = Vec::new();
             for b in t * per_task..((t + 1) * per_task).min(buckets) {
                 scratch.clear();
                 for (sorted, start) in &parts {
                     scratch.extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
                 }
-                scratch.sort_unstable_by_key(|e| e.0);
-                push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
+                if counted(scratch.len()) {
+                    count.clear();
+                    count.resize((1 << shift) + 1, 0);
+                    for e in &scratch {
+                        count[voxel_in_bucket(e) + 1] += 1;
+                    }
+                    for v in 0..1 << shift {
+                        count[v + 1] += count[v];
+                    }
+                    by_voxel.clear();
+                    by_voxel.resize(scratch.len(), (0u64, [0.0f32; 3]));
+                    for e in &scratch {
+                        let slot = &mut count[voxel_in_bucket(e)];
+                        by_voxel[*slot as usize] = *e;
+                        *slot += 1;
+                    }
+                    push_centroids(&by_voxel, |e| e.0 >> 32, |e| e.1, &mut out);
+                } else {
+                    if !scratch.is_sorted_by_key(|e| e.0) {
+                        scratch.sort_unstable_by_key(|e| e.0);
+                    }
+                    push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
+                }
             }
             out
         })
