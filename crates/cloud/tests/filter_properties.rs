@@ -692,7 +692,9 @@ fn the_two_sided_rule_also_drops_what_is_unusually_dense() {
 /// map of voxels bit for bit (each voxel's points summed in f64 in input
 /// order), whatever the number of threads: points through a cube, and
 /// points on a gentle slope in a box of air (a scan's case: few buckets
-/// occupied, each with many voxels, counting-sorted).
+/// occupied, each with many voxels, radix-sorted), and the slope in a box
+/// made 40 m long by one far point (buckets of 2¹⁰ voxel indices: two
+/// radix passes).
 #[test]
 fn a_large_voxel_grid_is_the_map_of_voxels_bit_for_bit() {
     let cube = lcg_cloud(300_000, 3.0, 11);
@@ -706,7 +708,9 @@ fn a_large_voxel_grid_is_the_map_of_voxels_bit_for_bit() {
     );
     let leaf = 0.02_f64;
     let inv = 1.0 / leaf as f32;
-    for cloud in [cube, slope] {
+    let mut far = slope.clone();
+    far.points.push([40.0, 0.0, 3.0]);
+    for cloud in [cube, slope, far] {
         let mut voxels: BTreeMap<[i64; 3], ([f64; 3], f64)> = BTreeMap::new();
         for p in &cloud.points {
             let c = [2, 1, 0].map(|a| (p[a] * inv).floor() as i64);

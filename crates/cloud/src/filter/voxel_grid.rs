@@ -301,50 +301,73 @@ where
     // A bucket's voxels differ in the low `shift` bits of their index
     // only; where the points lie on a surface in a box of air (a scan)
     // most buckets are empty and the others hold many voxels, so a large
-    // bucket is counting-sorted on those bits (stable: each voxel's points
-    // stay in input order), a small one sorted unless it is in order.
-    let voxel_in_bucket = |e: &(u64, Point)| ((e.0 >> 32) & ((1u64 << shift) - 1)) as usize;
-    let counted = |len: usize| shift <= 16 && len >= 32 && 1usize << shift <= 4 * len;
+    // bucket is radix-sorted on those bits, a small one sorted unless it is
+    // in order.
     let per_task = buckets.div_ceil(rayon::current_num_threads() * 8).max(1);
     let out: Vec<Vec<Point>> = (0..buckets.div_ceil(per_task))
         .into_par_iter()
         .map(|t| {
             let mut out = Vec::new();
-            let (mut scratch, mut by_voxel) = (Vec::new(), Vec::new());
-            let mut count: Vec<u32> = Vec::new();
+            let (mut scratch, mut spare) = (Vec::new(), Vec::new());
             for b in t * per_task..((t + 1) * per_task).min(buckets) {
                 scratch.clear();
                 for (sorted, start) in &parts {
                     scratch.extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
                 }
-                if counted(scratch.len()) {
-                    count.clear();
-                    count.resize((1 << shift) + 1, 0);
-                    for e in &scratch {
-                        count[voxel_in_bucket(e) + 1] += 1;
-                    }
-                    for v in 0..1 << shift {
-                        count[v + 1] += count[v];
-                    }
-                    by_voxel.clear();
-                    by_voxel.resize(scratch.len(), (0u64, [0.0f32; 3]));
-                    for e in &scratch {
-                        let slot = &mut count[voxel_in_bucket(e)];
-                        by_voxel[*slot as usize] = *e;
-                        *slot += 1;
-                    }
-                    push_centroids(&by_voxel, |e| e.0 >> 32, |e| e.1, &mut out);
-                } else {
-                    if !scratch.is_sorted_by_key(|e| e.0) {
-                        scratch.sort_unstable_by_key(|e| e.0);
-                    }
-                    push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
+                if scratch.len() >= RADIX_FROM {
+                    radix_sort_voxels(&mut scratch, &mut spare, shift);
+                } else if !scratch.is_sorted_by_key(|e| e.0) {
+                    scratch.sort_unstable_by_key(|e| e.0);
                 }
+                push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
             }
             out
         })
         .collect();
     out.concat()
+}
+
+/// Entries in a bucket from which [`radix_sort_voxels`] sorts them (below,
+/// a comparison sort is quicker).
+const RADIX_FROM: usize = 32;
+
+/// Sorts `entries` (voxel index in the high half of the key, point index
+/// in the low half, ascending among equal voxels) by the low `bits` bits
+/// of their voxel index, the rest being equal: a stable least-significant-
+/// digit radix sort on digits of 8 bits (a digit all entries share is
+/// passed over), so each voxel's points keep their order. `spare` is
+/// scratch.
+#[inline]
+fn radix_sort_voxels(entries: &mut Vec<(u64, Point)>, spare: &mut Vec<(u64, Point)>, bits: u32) {
+    let mut count = [0u32; 257];
+    let mut at = 0;
+    while at < bits {
+        let (from, width) = (32 + at, (bits - at).min(8));
+        let digits = 1 << width;
+        let digit = |e: &(u64, Point)| ((e.0 >> from) & (digits as u64 - 1)) as usize;
+        count[..=digits].fill(0);
+        for e in entries.iter() {
+            count[digit(e) + 1] += 1;
+        }
+        at += width;
+        if count[1..=digits]
+            .iter()
+            .any(|&c| c as usize == entries.len())
+        {
+            continue;
+        }
+        for d in 0..digits {
+            count[d + 1] += count[d];
+        }
+        spare.clear();
+        spare.resize(entries.len(), (0, [0.0; 3]));
+        for e in entries.iter() {
+            let slot = &mut count[digit(e)];
+            spare[*slot as usize] = *e;
+            *slot += 1;
+        }
+        std::mem::swap(entries, spare);
+    }
 }
 
 /// The centroid of each run of equal voxel keys in the sorted `keys`, in
@@ -412,7 +435,36 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::floor_i64;
+    use super::{floor_i64, radix_sort_voxels};
+
+    #[test]
+    fn radix_sort_orders_voxels_and_keeps_each_voxels_points_in_order() {
+        let mut s = 9u64;
+        let mut next = move |m: u64| {
+            s = s
+                .wrapping_mul(6364136223846793005)
+                .wrapping_add(1442695040888963407);
+            (s >> 33) % m
+        };
+        for trial in 0..2_000 {
+            let bits = 1 + (trial % 20) as u32;
+            let high = next(1 << 10) << bits;
+            let n = next(300) as usize;
+            // Ascending point indices, voxels at random within the bucket
+            // (from few distinct to all different).
+            let spread = 1 + next(1 << bits);
+            let mut entries: Vec<(u64, [f32; 3])> = (0..n)
+                .map(|i| {
+                    let voxel = high | next(spread);
+                    ((voxel << 32) | i as u64, [i as f32, 0.0, 0.0])
+                })
+                .collect();
+            let mut want = entries.clone();
+            want.sort_by_key(|e| e.0);
+            radix_sort_voxels(&mut entries, &mut Vec::new(), bits);
+            assert!(entries == want, "bits {bits}, {n} entries");
+        }
+    }
 
     #[test]
     fn floor_by_hand_is_floor() {
