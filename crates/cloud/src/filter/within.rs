@@ -171,52 +171,57 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
     }
 }
 
-/// Sorts `ids` ascending: a search's neighbours into input order (a few
-/// dozen, gathered column by column). Each value's rank is the count of
-/// values below it (vector compares, as in [`smallest`]) and it is stored
-/// at its rank: on AVX-512 about a fifth of the time of `sort_unstable`
-/// for 30–60 values, which was a tenth of the smoothing stage's time.
-/// Ties (no rank is then unique), longer lists and the portable path take
-/// `sort_unstable`.
-pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
+/// Most values [`ranks`] ranks (on AVX-512; 64 on AVX2).
+pub(super) const MOST_RANKED: usize = 96;
+
+/// Each of `values`' rank (the count of values below it, as unsigned
+/// integers) in `ranks[..n]`, by vector compares as in [`smallest`]; `false`
+/// where two are equal (no rank is then unique), for more than
+/// [`MOST_RANKED`] (64 on AVX2) values, and on the portable path.
+pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) -> bool {
+    let n = values.len();
     let ranked = match isa {
         Isa::Portable => false,
-        _ if ids.len() < 2 => true,
+        _ if n < 2 => {
+            ranks[..n].fill(0);
+            true
+        }
         // SAFETY: `Isa::best` and `Isa::available` give these only where
         // the machine has the instruction set; the lengths as required.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if ids.len() <= 32 => unsafe { avx2::sort::<4>(ids) },
+        Isa::Avx2 if n <= 32 => unsafe { avx2::ranks::<4>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if ids.len() <= 64 => unsafe { avx2::sort::<8>(ids) },
+        Isa::Avx2 if n <= 64 => unsafe { avx2::ranks::<8>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if ids.len() <= 32 => unsafe { avx512::sort::<2>(ids) },
+        Isa::Avx512 if n <= 32 => unsafe { avx512::ranks::<2>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if ids.len() <= 64 => unsafe { avx512::sort::<4>(ids) },
+        Isa::Avx512 if n <= 64 => unsafe { avx512::ranks::<4>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if ids.len() <= 96 => unsafe { avx512::sort::<6>(ids) },
+        Isa::Avx512 if n <= 96 => unsafe { avx512::ranks::<6>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 | Isa::Avx512 => false,
     };
-    if !ranked {
-        ids.sort_unstable();
-    }
+    // Distinct values have ranks 0..n, whose sum is n(n − 1)/2; with ties
+    // every rank is at most the distinct case's and some below it.
+    ranked && ranks[..n].iter().map(|&r| r as usize).sum::<usize>() == n * n.saturating_sub(1) / 2
 }
 
-/// Stores each of `values` at its rank (`ranks`, each the count of values
-/// below it) in `out`, unless two share a rank (ties): then `false` and
-/// `out` untouched. Distinct values have ranks 0..n, whose sum is
-/// n(n − 1)/2; with ties every rank is at most the distinct case's, some
-/// below it, so the sum tells.
-fn place_by_rank(values: &[u32], ranks: &[u32], out: &mut [u32]) -> bool {
-    let n = values.len();
-    let sum: usize = ranks[..n].iter().map(|&r| r as usize).sum();
-    if sum != n * (n - 1) / 2 {
-        return false;
+/// Sorts `ids` ascending: a search's neighbours into input order (a few
+/// dozen, gathered column by column). Each is stored at its rank
+/// ([`ranks`]): on AVX-512 about a fifth of the time of `sort_unstable`
+/// for 30–60 values, which was a tenth of the smoothing stage's time.
+/// Ties, longer lists and the portable path take `sort_unstable`.
+pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
+    let mut rank = [0u32; MOST_RANKED];
+    if !ranks(isa, ids, &mut rank) {
+        ids.sort_unstable();
+        return;
     }
-    for (&v, &r) in values.iter().zip(ranks) {
-        out[r as usize] = v;
+    let mut sorted = [0u32; MOST_RANKED];
+    for (&v, &r) in ids.iter().zip(&rank) {
+        sorted[r as usize] = v;
     }
-    true
+    ids.copy_from_slice(&sorted[..ids.len()]);
 }
 
 fn keep<const PAYLOAD: bool>(
@@ -463,43 +468,36 @@ mod avx2 {
         true
     }
 
-    /// [`super::sort_ids`] of at most `8 · V` values; `false`, `ids`
-    /// untouched, on ties.
+    /// [`super::ranks`] of at most `8 · V` values (ties not checked).
     ///
     /// # Safety
-    /// AVX2; `2 ≤ ids.len() ≤ 8 · V ≤ 64`.
+    /// AVX2; `values.len() ≤ 8 · V ≤ 64`.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn sort<const V: usize>(ids: &mut [u32]) -> bool {
-        let n = ids.len();
+    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 96]) -> bool {
+        let n = values.len();
         debug_assert!(n <= 8 * V && 8 * V <= 64);
         // AVX2 compares signed integers only: the sign bit flipped, they
         // order as the unsigned values do. Lanes past n are never read.
-        let mut values = [0i32; 64];
-        for (v, &b) in values.iter_mut().zip(ids.iter()) {
+        let mut flipped = [0i32; 64];
+        for (v, &b) in flipped.iter_mut().zip(values) {
             *v = (b ^ 1 << 31) as i32;
         }
-        // SAFETY: 8 · V ≤ 64 lanes of `values`.
+        // SAFETY: 8 · V ≤ 64 lanes of `flipped`.
         let lanes: [__m256i; V] = std::array::from_fn(|c| unsafe {
-            _mm256_loadu_si256(values.as_ptr().add(8 * c).cast())
+            _mm256_loadu_si256(flipped.as_ptr().add(8 * c).cast())
         });
         let mut rank = [_mm256_setzero_si256(); V];
-        for &v in &values[..n] {
+        for &v in &flipped[..n] {
             let v = _mm256_set1_epi32(v);
             for (rank, &lane) in rank.iter_mut().zip(&lanes) {
                 // −1 where the lane's value is above v
                 *rank = _mm256_sub_epi32(*rank, _mm256_cmpgt_epi32(lane, v));
             }
         }
-        let mut ranks = [0u32; 64];
         for (c, rank) in rank.iter().enumerate() {
-            // SAFETY: 8 · V ≤ 64 lanes of `ranks`.
+            // SAFETY: 8 · V ≤ 64 ≤ 96 lanes of `ranks`.
             unsafe { _mm256_storeu_si256(ranks.as_mut_ptr().add(8 * c).cast(), *rank) };
         }
-        let mut sorted = [0u32; 64];
-        if !super::place_by_rank(ids, &ranks[..n], &mut sorted) {
-            return false;
-        }
-        ids.copy_from_slice(&sorted[..n]);
         true
     }
 }
@@ -658,38 +656,31 @@ mod avx512 {
         true
     }
 
-    /// [`super::sort_ids`] of at most `16 · V` values; `false`, `ids`
-    /// untouched, on ties.
+    /// [`super::ranks`] of at most `16 · V` values (ties not checked).
     ///
     /// # Safety
-    /// AVX-512F; `2 ≤ ids.len() ≤ 16 · V ≤ 96`.
+    /// AVX-512F; `values.len() ≤ 16 · V ≤ 96`.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn sort<const V: usize>(ids: &mut [u32]) -> bool {
-        let n = ids.len();
+    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 96]) -> bool {
+        let n = values.len();
         debug_assert!(n <= 16 * V && 16 * V <= 96);
         let present: [__mmask16; V] = std::array::from_fn(|c| lanes((16 * c).min(n), n));
-        // SAFETY: masked loads touch only the lanes within `ids`.
-        let values: [__m512i; V] = std::array::from_fn(|c| unsafe {
-            _mm512_maskz_loadu_epi32(present[c], ids.as_ptr().add((16 * c).min(n)).cast())
+        // SAFETY: masked loads touch only the lanes within `values`.
+        let lanes: [__m512i; V] = std::array::from_fn(|c| unsafe {
+            _mm512_maskz_loadu_epi32(present[c], values.as_ptr().add((16 * c).min(n)).cast())
         });
         let (mut rank, one) = ([_mm512_setzero_si512(); V], _mm512_set1_epi32(1));
-        for &v in ids.iter() {
+        for &v in values {
             let v = _mm512_set1_epi32(v as i32);
-            for (rank, &lane) in rank.iter_mut().zip(&values) {
+            for (rank, &lane) in rank.iter_mut().zip(&lanes) {
                 let above = _mm512_cmpgt_epu32_mask(lane, v);
                 *rank = _mm512_mask_add_epi32(*rank, above, *rank, one);
             }
         }
-        let mut ranks = [0u32; 96];
         for (c, rank) in rank.iter().enumerate() {
             // SAFETY: 16 · V ≤ 96 lanes of `ranks`.
             unsafe { _mm512_storeu_si512(ranks.as_mut_ptr().add(16 * c).cast(), *rank) };
         }
-        let mut sorted = [0u32; 96];
-        if !super::place_by_rank(ids, &ranks[..n], &mut sorted) {
-            return false;
-        }
-        ids.copy_from_slice(&sorted[..n]);
         true
     }
 }

@@ -335,6 +335,7 @@ impl Grid {
             parts.push((r, part, mine));
             (rest, dealt) = (tail, others);
         }
+        let isa = Isa::best();
         parts.into_par_iter().for_each(|(r, part, mine)| {
             let (c0, base) = (r * row_len, first_of(r));
             let mut next = start[c0..((r + 1) * row_len).min(count)].to_vec();
@@ -352,7 +353,7 @@ impl Grid {
                 *slot += 1;
             }
             for column in part.chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32) {
-                column.sort_unstable();
+                sort_column(isa, column);
             }
         });
         let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
@@ -755,6 +756,30 @@ impl Grid {
 const TREE_FROM: usize = 2_000_000;
 const TREE_WORTH: usize = 1000;
 
+/// A column's entries (column above, height key below; point index) by
+/// height, ties by index: by rank ([`within::ranks`]) where the heights are
+/// distinct and a few dozen (a comparison sort of a column was half of
+/// filing a scan), else by a comparison sort.
+fn sort_column(isa: Isa, column: &mut [(u64, u32)]) {
+    let n = column.len();
+    if n <= within::MOST_RANKED {
+        let mut heights = [0u32; within::MOST_RANKED];
+        for (h, e) in heights.iter_mut().zip(column.iter()) {
+            *h = e.0 as u32;
+        }
+        let mut rank = [0u32; within::MOST_RANKED];
+        if within::ranks(isa, &heights[..n], &mut rank) {
+            let mut sorted = [(0u64, 0u32); within::MOST_RANKED];
+            for (e, &r) in column.iter().zip(&rank) {
+                sorted[r as usize] = *e;
+            }
+            column.copy_from_slice(&sorted[..n]);
+            return;
+        }
+    }
+    column.sort_unstable();
+}
+
 /// Columns a side of a block (see [`block_index`]).
 const BLOCK: usize = 8;
 
@@ -983,6 +1008,27 @@ fn bounds(points: &[Point]) -> ([f64; 3], [f64; 3]) {
 mod tests {
     use super::super::kdtree::KdTree;
     use super::*;
+
+    #[test]
+    fn a_column_sorts_by_height_then_index_on_every_path() {
+        let mut u = super::super::common::uniform(5);
+        for trial in 0..3_000 {
+            let n = trial % 120;
+            let column = 0x0000_0123_u64 << 32;
+            // Distinct heights mostly, ties (a few values) now and then.
+            let spread = if trial % 3 == 0 { 4.0 } else { 4e9 };
+            let entries: Vec<(u64, u32)> = (0..n)
+                .map(|i| (column | (f64::from(u()) * spread) as u64, (n - i) as u32))
+                .collect();
+            let mut want = entries.clone();
+            want.sort_unstable();
+            for isa in Isa::available() {
+                let mut got = entries.clone();
+                sort_column(isa, &mut got);
+                assert_eq!(got, want, "{isa:?}, {n} entries");
+            }
+        }
+    }
 
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
         let mut u = super::super::common::uniform(seed);
