@@ -859,9 +859,44 @@ impl Slabs {
 /// The slab index of every column: slabs of about `h / 2` (fewer in a
 /// column spanning a great height with few points).
 fn slab_index(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
+    // Runs of columns in parallel, each indexed on its own (its `first`s
+    // counted from its own start), then put end to end.
     let columns = start.len() - 1;
+    let parts: Vec<(Vec<Slabs>, Vec<u32>)> = (0..columns.div_ceil(SLAB_COLUMNS))
+        .into_par_iter()
+        .map(|part| {
+            let (c0, c1) = (
+                part * SLAB_COLUMNS,
+                ((part + 1) * SLAB_COLUMNS).min(columns),
+            );
+            slab_index_of(&start[c0..=c1], z, h)
+        })
+        .collect();
+    let mut slabs = Vec::with_capacity(columns);
+    let mut slab_start = Vec::with_capacity(parts.iter().map(|p| p.1.len()).sum());
+    for (part_slabs, part_starts) in parts {
+        let offset = slab_start.len() as u32;
+        slabs.extend(part_slabs.into_iter().map(|mut column| {
+            if column.count > 0 {
+                column.first += offset;
+            }
+            column
+        }));
+        slab_start.extend_from_slice(&part_starts);
+    }
+    (slabs, slab_start)
+}
+
+/// Columns a parallel task of [`slab_index`] indexes.
+const SLAB_COLUMNS: usize = 1024;
+
+/// [`slab_index`] of the columns starting at `start` (the last entry one
+/// past the last column's points), their `first`s from 0.
+fn slab_index_of(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
+    let columns = start.len() - 1;
+    let points = (start[columns] - start[0]) as usize;
     let mut slabs = vec![Slabs::default(); columns];
-    let mut slab_start = Vec::with_capacity(2 * columns + z.len() / 4);
+    let mut slab_start = Vec::with_capacity(2 * columns + points / 4);
     for c in 0..columns {
         let (s, e) = (start[c] as usize, start[c + 1] as usize);
         if s == e {
@@ -1008,6 +1043,31 @@ fn bounds(points: &[Point]) -> ([f64; 3], [f64; 3]) {
 mod tests {
     use super::super::kdtree::KdTree;
     use super::*;
+
+    #[test]
+    fn the_slab_index_by_runs_of_columns_is_the_index_in_one_run() {
+        // 5000 columns (five runs), some empty, some tall, heights sorted
+        // within each.
+        let mut u = super::super::common::uniform(3);
+        let (mut start, mut z) = (vec![0u32], Vec::new());
+        for c in 0..5000 {
+            let n = match c % 7 {
+                0 => 0,
+                1 => 60,
+                _ => (u() * 12.0) as usize,
+            };
+            let mut column: Vec<f32> = (0..n)
+                .map(|_| u() * if c % 5 == 0 { 9.0 } else { 0.3 })
+                .collect();
+            column.sort_by(f32::total_cmp);
+            z.extend(column);
+            start.push(z.len() as u32);
+        }
+        let (slabs, slab_start) = slab_index(&start, &z, 0.25);
+        let (one_slabs, one_start) = slab_index_of(&start, &z, 0.25);
+        assert_eq!(slab_start, one_start);
+        assert_eq!(format!("{slabs:?}"), format!("{one_slabs:?}"));
+    }
 
     #[test]
     fn a_column_sorts_by_height_then_index_on_every_path() {
