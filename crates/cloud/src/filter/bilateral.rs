@@ -27,14 +27,20 @@
 //! its plane, noise on a plane shrinks).
 
 use super::common::{bad, empty_input, f32_at_most, is_finite};
+use super::exp::exp_in_place;
 use super::grid::Grid;
 use super::kdtree::KdTree;
 use super::normals::pca_normal;
+use super::within::Isa;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
 use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "bilateral normal smoothing";
+
+/// A point's exponents (then weights) and offsets along its normal, one a
+/// neighbour.
+type Terms = (Vec<f64>, Vec<f64>);
 
 /// Parameters of [`bilateral_normal_smoothing`] ([RS eq. 19]–[RS eq. 20]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -118,19 +124,21 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
         1.0 / (2.0 * params.sigma_n_m * params.sigma_n_m),
     );
     let radius = f64::from(r2).sqrt();
+    let isa = Isa::best();
     for _ in 0..params.iterations {
         let current = &points;
         // [RS eq. 19]–[RS eq. 20] for point `i` from its neighbours within
         // the radius, in input order, so that the sums' rounding does not
         // depend on the search (the same points give the same result in any
         // cloud that holds their neighbourhood: a tile with its margin).
-        let smooth = |i: usize, found: &[u32]| -> Point {
+        let smooth = |(weight, offset): &mut Terms, i: usize, found: &[u32]| -> Point {
             let p = &current[i];
             let Some(n) = pca_normal(found.iter().map(|&q| current[q as usize])) else {
                 return *p;
             };
             let pf = p.map(f64::from);
-            let (mut num, mut den) = (0.0_f64, 0.0_f64);
+            weight.clear();
+            offset.clear();
             for &q in found.iter().filter(|&&q| q as usize != i) {
                 // (written out: `[0, 1, 2].map` here was left a call a point)
                 let c = &current[q as usize];
@@ -142,8 +150,14 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
                 let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
                 let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
                 // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩), two
-                // Gaussians taken as one exponential of their exponents' sum.
-                let w = (-(dist2 * inv_2sd2 + h * h * inv_2sn2)).exp();
+                // Gaussians taken as one exponential of their exponents' sum
+                // (all of a point's at once, `exp.rs`).
+                weight.push(-(dist2 * inv_2sd2 + h * h * inv_2sn2));
+                offset.push(h);
+            }
+            exp_in_place(isa, weight);
+            let (mut num, mut den) = (0.0_f64, 0.0_f64);
+            for (&w, &h) in weight.iter().zip(offset.iter()) {
                 num += w * h;
                 den += w;
             }
@@ -158,17 +172,20 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
         // On a grid of columns as wide as the radius when the cloud suits
         // one (`grid/`), else on the k-d tree: the same neighbours.
         points = match Grid::for_radius(current, radius) {
-            Some(grid) => grid.map_within(r2, || (), |_, i, found| smooth(i, found)),
+            Some(grid) => grid.map_within(r2, Terms::default, smooth),
             None => {
                 let tree = KdTree::new(current);
-                tree.map_points(Vec::new, |found, pos, p| {
-                    tree.within(p, r2, found);
-                    for q in found.iter_mut() {
-                        *q = tree.id(*q as usize) as u32;
-                    }
-                    found.sort_unstable();
-                    smooth(tree.id(pos), found)
-                })
+                tree.map_points(
+                    || (Vec::new(), Terms::default()),
+                    |(found, terms), pos, p| {
+                        tree.within(p, r2, found);
+                        for q in found.iter_mut() {
+                            *q = tree.id(*q as usize) as u32;
+                        }
+                        found.sort_unstable();
+                        smooth(terms, tree.id(pos), found)
+                    },
+                )
             }
         };
     }

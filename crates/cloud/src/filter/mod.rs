@@ -27,6 +27,7 @@
 
 mod bilateral;
 mod common;
+mod exp;
 mod grid;
 mod kdtree;
 mod normals;
