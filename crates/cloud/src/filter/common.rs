@@ -84,6 +84,19 @@ pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f32 {
     }
 }
 
+/// A seeded generator of integers below `m` (the same LCG, its top 31
+/// bits) for the tests: the same seed gives the same draws everywhere.
+#[cfg(test)]
+pub(crate) fn below(seed: u64) -> impl FnMut(u64) -> u64 {
+    let mut s = seed;
+    move |m| {
+        s = s
+            .wrapping_mul(6364136223846793005)
+            .wrapping_add(1442695040888963407);
+        (s >> 33) % m
+    }
+}
+
 /// The points of `cloud` at `indices`, in that order.
 pub(crate) fn gather(cloud: &[Point], indices: &[usize]) -> PointCloud {
     PointCloud::new(indices.iter().map(|&i| cloud[i]).collect())

@@ -455,13 +455,7 @@ mod tests {
 
     #[test]
     fn radix_sort_orders_voxels_and_keeps_each_voxels_points_in_order() {
-        let mut s = 9u64;
-        let mut next = move |m: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) % m
-        };
+        let mut next = super::super::common::below(9);
         for trial in 0..2_000 {
             let bits = 1 + (trial % 20) as u32;
             let high = next(1 << 10) << bits;

@@ -752,13 +752,7 @@ mod tests {
 
     #[test]
     fn every_path_leaves_the_k_smallest_with_the_kth_last() {
-        let mut s = 3u64;
-        let mut next = move |m: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) % m
-        };
+        let mut next = super::super::common::below(3);
         for trial in 0..20_000 {
             let n = 1 + trial % 110;
             // Distances of every spread, ties (duplicates, zeros) among them
@@ -791,13 +785,7 @@ mod tests {
 
     #[test]
     fn every_path_sorts_ids() {
-        let mut s = 5u64;
-        let mut next = move |m: u64| {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            (s >> 33) % m
-        };
+        let mut next = super::super::common::below(5);
         for trial in 0..20_000 {
             let n = trial % 110;
             // Distinct mostly, ties now and then, values up to u32::MAX
