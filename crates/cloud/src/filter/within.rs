@@ -212,16 +212,31 @@ pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) ->
 /// for 30–60 values, which was a tenth of the smoothing stage's time.
 /// Ties, longer lists and the portable path take `sort_unstable`.
 pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
-    let mut rank = [0u32; MOST_RANKED];
-    if !ranks(isa, ids, &mut rank) {
+    let ranked = ids.len() <= MOST_RANKED && {
+        let mut keys = [0u32; MOST_RANKED];
+        keys[..ids.len()].copy_from_slice(ids);
+        order_by_rank(isa, &keys[..ids.len()], ids)
+    };
+    if !ranked {
         ids.sort_unstable();
-        return;
     }
-    let mut sorted = [0u32; MOST_RANKED];
-    for (&v, &r) in ids.iter().zip(&rank) {
-        sorted[r as usize] = v;
+}
+
+/// Puts `items` in the order of their `keys` (one an item) where [`ranks`]
+/// ranks the keys; `false`, with `items` untouched, where it does not
+/// (ties, too many, the portable path).
+pub(super) fn order_by_rank<T: Copy + Default>(isa: Isa, keys: &[u32], items: &mut [T]) -> bool {
+    assert_eq!(keys.len(), items.len(), "a key an item");
+    let mut rank = [0u32; MOST_RANKED];
+    if !ranks(isa, keys, &mut rank) {
+        return false;
     }
-    ids.copy_from_slice(&sorted[..ids.len()]);
+    let mut sorted = [T::default(); MOST_RANKED];
+    for (&item, &r) in items.iter().zip(&rank) {
+        sorted[r as usize] = item;
+    }
+    items.copy_from_slice(&sorted[..items.len()]);
+    true
 }
 
 fn keep<const PAYLOAD: bool>(

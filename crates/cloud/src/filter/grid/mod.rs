@@ -761,23 +761,16 @@ const TREE_WORTH: usize = 1000;
 /// distinct and a few dozen (a comparison sort of a column was half of
 /// filing a scan), else by a comparison sort.
 fn sort_column(isa: Isa, column: &mut [(u64, u32)]) {
-    let n = column.len();
-    if n <= within::MOST_RANKED {
-        let mut heights = [0u32; within::MOST_RANKED];
+    let mut heights = [0u32; within::MOST_RANKED];
+    let ranked = column.len() <= within::MOST_RANKED && {
         for (h, e) in heights.iter_mut().zip(column.iter()) {
             *h = e.0 as u32;
         }
-        let mut rank = [0u32; within::MOST_RANKED];
-        if within::ranks(isa, &heights[..n], &mut rank) {
-            let mut sorted = [(0u64, 0u32); within::MOST_RANKED];
-            for (e, &r) in column.iter().zip(&rank) {
-                sorted[r as usize] = *e;
-            }
-            column.copy_from_slice(&sorted[..n]);
-            return;
-        }
+        within::order_by_rank(isa, &heights[..column.len()], column)
+    };
+    if !ranked {
+        column.sort_unstable();
     }
-    column.sort_unstable();
 }
 
 /// Columns a side of a block (see [`block_index`]).
