@@ -30,7 +30,7 @@ use super::common::{bad, empty_input, f32_at_most, is_finite};
 use super::exp::exp_in_place;
 use super::grid::Grid;
 use super::kdtree::KdTree;
-use super::normals::pca_normal;
+use super::normals::{add_lanes, pca_normal, Columns, LANES};
 use super::within::Isa;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
@@ -38,9 +38,14 @@ use serde::{Deserialize, Serialize};
 
 const FILTER: &str = "bilateral normal smoothing";
 
-/// A point's exponents (then weights) and offsets along its normal, one a
-/// neighbour.
-type Terms = (Vec<f64>, Vec<f64>);
+/// A point's neighbourhood in f64 columns, and its exponents (then
+/// weights) and offsets along its normal, one a neighbour.
+#[derive(Default)]
+struct Terms {
+    near: Columns,
+    weight: Vec<f64>,
+    offset: Vec<f64>,
+}
 
 /// Parameters of [`bilateral_normal_smoothing`] ([RS eq. 19]–[RS eq. 20]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
@@ -131,33 +136,55 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
         // the radius, in input order, so that the sums' rounding does not
         // depend on the search (the same points give the same result in any
         // cloud that holds their neighbourhood: a tile with its margin).
-        let smooth = |(weight, offset): &mut Terms, i: usize, found: &[u32]| -> Point {
+        let smooth = |terms: &mut Terms, i: usize, found: &[u32]| -> Point {
             let p = &current[i];
-            let Some(n) = pca_normal(found.iter().map(|&q| current[q as usize])) else {
+            let Terms {
+                near,
+                weight,
+                offset,
+            } = terms;
+            near.gather(p, current, found);
+            let Some(n) = pca_normal(near) else {
                 return *p;
             };
             let pf = p.map(f64::from);
-            weight.clear();
-            offset.clear();
-            for &q in found.iter().filter(|&&q| q as usize != i) {
-                // (written out: `[0, 1, 2].map` here was left a call a point)
-                let c = &current[q as usize];
-                let d = [
-                    f64::from(c[0]) - pf[0],
-                    f64::from(c[1]) - pf[1],
-                    f64::from(c[2]) - pf[2],
-                ];
-                let dist2 = d[0] * d[0] + d[1] * d[1] + d[2] * d[2];
-                let h = n[0] * d[0] + n[1] * d[1] + n[2] * d[2];
+            // Every neighbour's terms at once (P's own are dropped below):
+            // no term depends on another, so the loop runs by vector.
+            weight.resize(near.x.len(), 0.0);
+            offset.resize(near.x.len(), 0.0);
+            for ((((w, h), &x), &y), &z) in weight
+                .iter_mut()
+                .zip(offset.iter_mut())
+                .zip(&near.x)
+                .zip(&near.y)
+                .zip(&near.z)
+            {
+                let dist2 = x * x + y * y + z * z;
+                *h = n[0] * x + n[1] * y + n[2] * z;
                 // [RS eq. 19]: w = w_d(‖p − p_j‖) · w_n(⟨n, p_j − p⟩), two
                 // Gaussians taken as one exponential of their exponents' sum
                 // (all of a point's at once, `exp.rs`).
-                weight.push(-(dist2 * inv_2sd2 + h * h * inv_2sn2));
-                offset.push(h);
+                *w = -(dist2 * inv_2sd2 + *h * *h * inv_2sn2);
+            }
+            if let Some(own) = found.iter().position(|&q| q as usize == i) {
+                weight.remove(own);
+                offset.remove(own);
             }
             exp_in_place(isa, weight);
-            let (mut num, mut den) = (0.0_f64, 0.0_f64);
-            for (&w, &h) in weight.iter().zip(offset.iter()) {
+            // Σ w·h and Σ w, LANES sums of each side by side.
+            let (mut num, mut den) = ([0.0_f64; LANES], [0.0_f64; LANES]);
+            let whole = weight.len() / LANES * LANES;
+            for (w, h) in weight[..whole]
+                .chunks_exact(LANES)
+                .zip(offset.chunks_exact(LANES))
+            {
+                for l in 0..LANES {
+                    num[l] += w[l] * h[l];
+                    den[l] += w[l];
+                }
+            }
+            let (mut num, mut den) = (add_lanes(num), add_lanes(den));
+            for (&w, &h) in weight[whole..].iter().zip(&offset[whole..]) {
                 num += w * h;
                 den += w;
             }

@@ -119,8 +119,9 @@ pub fn estimate_normals(cloud: &[Point], params: &NormalParams) -> Result<Vec<Op
     let normals: Vec<Option<[f64; 3]>> = tree.map_points(
         || Scratch::new(params.neighbourhood),
         |scratch, _, p| {
-            let neighbours = scratch.neighbourhood(&tree, p);
-            let n = pca_normal(neighbours.iter().map(|&j| tree.points()[j as usize]))?;
+            let (neighbours, columns) = scratch.neighbourhood(&tree, p);
+            columns.gather(p, tree.points(), neighbours);
+            let n = pca_normal(columns)?;
             Some(orient(n, p, params.orientation))
         },
     );
@@ -136,6 +137,7 @@ struct Scratch {
     which: Neighbourhood,
     knn: Nearest,
     found: Vec<u32>,
+    columns: Columns,
 }
 
 impl Scratch {
@@ -148,12 +150,14 @@ impl Scratch {
             which,
             knn: Nearest::new(k),
             found: Vec::new(),
+            columns: Columns::default(),
         }
     }
 
-    /// Tree positions of the neighbourhood of `p`.
-    fn neighbourhood(&mut self, tree: &KdTree, p: &Point) -> &[u32] {
-        match self.which {
+    /// Tree positions of the neighbourhood of `p`, and the buffer to
+    /// gather its points into.
+    fn neighbourhood(&mut self, tree: &KdTree, p: &Point) -> (&[u32], &mut Columns) {
+        let found = match self.which {
             Neighbourhood::Nearest(_) => {
                 tree.nearest(p, &mut self.knn);
                 self.knn.positions()
@@ -162,7 +166,8 @@ impl Scratch {
                 tree.within(p, f32_at_most(r * r), &mut self.found);
                 &self.found
             }
-        }
+        };
+        (found, &mut self.columns)
     }
 }
 
@@ -183,35 +188,102 @@ pub(crate) fn orient(n: [f64; 3], p: &Point, orientation: Orientation) -> [f64; 
     }
 }
 
-/// The unit normal (smallest principal axis) of these points, `None` for
-/// fewer than 3 points or collinear ones.
-pub(crate) fn pca_normal(points: impl Iterator<Item = Point> + Clone) -> Option<[f64; 3]> {
-    let mut count = 0usize;
-    let mut mean = [0.0_f64; 3];
-    for p in points.clone() {
-        count += 1;
-        for a in 0..3 {
-            mean[a] += f64::from(p[a]);
-        }
-    }
+/// The unit normal (smallest principal axis) of these points (their offsets
+/// from one point), `None` for fewer than 3 points or collinear ones.
+pub(crate) fn pca_normal(d: &Columns) -> Option<[f64; 3]> {
+    let count = d.x.len();
     if count < 3 {
         return None;
     }
-    let mean = mean.map(|m| m / count as f64);
-    let mut cov = [[0.0_f64; 3]; 3];
-    for p in points {
-        let d = [
-            f64::from(p[0]) - mean[0],
-            f64::from(p[1]) - mean[1],
-            f64::from(p[2]) - mean[2],
-        ];
-        for r in 0..3 {
-            for c in 0..3 {
-                cov[r][c] += d[r] * d[c];
-            }
+    // One pass over the offsets: Σd and the six distinct entries of Σddᵀ,
+    // LANES sums of each side by side (rather than one chain a sum, whose
+    // additions wait on each other), then added in a fixed order.
+    let whole = count / LANES * LANES;
+    let mut lanes = [[0.0_f64; LANES]; 9];
+    for ((x, y), z) in d.x[..whole]
+        .chunks_exact(LANES)
+        .zip(d.y.chunks_exact(LANES))
+        .zip(d.z.chunks_exact(LANES))
+    {
+        for l in 0..LANES {
+            lanes[0][l] += x[l];
+            lanes[1][l] += y[l];
+            lanes[2][l] += z[l];
+            lanes[3][l] += x[l] * x[l];
+            lanes[4][l] += x[l] * y[l];
+            lanes[5][l] += x[l] * z[l];
+            lanes[6][l] += y[l] * y[l];
+            lanes[7][l] += y[l] * z[l];
+            lanes[8][l] += z[l] * z[l];
         }
     }
-    smallest_axis(cov)
+    let mut t = lanes.map(add_lanes);
+    for j in whole..count {
+        let (x, y, z) = (d.x[j], d.y[j], d.z[j]);
+        for (sum, v) in t
+            .iter_mut()
+            .zip([x, y, z, x * x, x * y, x * z, y * y, y * z, z * z])
+        {
+            *sum += v;
+        }
+    }
+    // Σ(d − m)(d − m)ᵀ = Σddᵀ − (Σd) mᵀ: the offsets are from a point of the
+    // neighbourhood, so both terms are of the neighbourhood's own size.
+    let n = count as f64;
+    let m = [t[0] / n, t[1] / n, t[2] / n];
+    let c = [
+        t[3] - t[0] * m[0],
+        t[4] - t[0] * m[1],
+        t[5] - t[0] * m[2],
+        t[6] - t[1] * m[1],
+        t[7] - t[1] * m[2],
+        t[8] - t[2] * m[2],
+    ];
+    smallest_axis([[c[0], c[1], c[2]], [c[1], c[3], c[4]], [c[2], c[4], c[5]]])
+}
+
+/// The lanes of a sum taken side by side, added in a fixed order.
+#[inline]
+pub(crate) fn add_lanes(s: [f64; LANES]) -> f64 {
+    (s[0] + s[1]) + (s[2] + s[3])
+}
+
+/// Sums side by side in [`pca_normal`] and the smoothing's weights.
+pub(crate) const LANES: usize = 4;
+
+/// A neighbourhood's offsets from a point (its own, for a search's) in f64,
+/// a column an axis: gathered from the cloud once, then read by every pass
+/// over it (the sums of the covariance, a smoothing's weights) from
+/// contiguous memory.
+#[derive(Debug, Default)]
+pub(crate) struct Columns {
+    pub x: Vec<f64>,
+    pub y: Vec<f64>,
+    pub z: Vec<f64>,
+}
+
+impl Columns {
+    /// The offsets from `origin` of `cloud[ids]`, in this order.
+    pub fn gather(&mut self, origin: &Point, cloud: &[Point], ids: &[u32]) {
+        for (a, column) in [&mut self.x, &mut self.y, &mut self.z]
+            .into_iter()
+            .enumerate()
+        {
+            let o = f64::from(origin[a]);
+            column.clear();
+            column.extend(ids.iter().map(|&q| f64::from(cloud[q as usize][a]) - o));
+        }
+    }
+
+    /// Gathered into a new set, from the first point.
+    #[cfg(test)]
+    pub fn of(points: impl Iterator<Item = Point>) -> Self {
+        let points: Vec<Point> = points.collect();
+        let ids: Vec<u32> = (0..points.len() as u32).collect();
+        let mut c = Self::default();
+        c.gather(&points[0], &points, &ids);
+        c
+    }
 }
 
 /// The unit eigenvector of the smallest eigenvalue of a symmetric positive
@@ -247,7 +319,8 @@ fn cubic_axis(a: [[f64; 3]; 3]) -> Option<[f64; 3]> {
     if !(scale > 0.0 && scale.is_finite()) {
         return None;
     }
-    let m = m.map(|row| row.map(|v| v / scale));
+    let inv = 1.0 / scale;
+    let m = m.map(|row| row.map(|v| v * inv));
     // M has trace 0: det(λI − M) = λ³ + c₁λ − c₀, with c₁ the sum of its
     // principal 2 × 2 minors and c₀ its determinant.
     let c1 = m[0][0] * m[1][1] + m[0][0] * m[2][2] + m[1][1] * m[2][2]
@@ -492,10 +565,41 @@ mod tests {
     }
 
     #[test]
+    fn the_normal_of_a_plane_far_from_the_origin_is_exact() {
+        // Covariance from offsets (Σddᵀ − (Σd)mᵀ, lanes of sums side by
+        // side) against the closed form: z = 0.5x − 0.25y on a 7 × 9 grid a
+        // kilometre from the origin, every count from 8 (past the first,
+        // collinear row) to 63 points.
+        let len = (1.0_f64 + 0.25 + 0.0625).sqrt();
+        let want = [-0.5 / len, 0.25 / len, 1.0 / len];
+        let points: Vec<Point> = (0..63)
+            .map(|i| {
+                let (x, y) = (f64::from(i % 7) * 0.125, f64::from(i / 7) * 0.125);
+                [
+                    (1000.0 + x) as f32,
+                    (-2000.0 + y) as f32,
+                    (300.0 + 0.5 * x - 0.25 * y) as f32,
+                ]
+            })
+            .collect();
+        for count in 8..=points.len() {
+            let some = &points[..count];
+            let n = pca_normal(&Columns::of(some.iter().copied())).unwrap();
+            let n = if n[2] < 0.0 { n.map(|c| -c) } else { n };
+            for a in 0..3 {
+                assert!(
+                    (n[a] - want[a]).abs() < 1e-9,
+                    "{count} points: {n:?} against {want:?}"
+                );
+            }
+        }
+    }
+
+    #[test]
     fn collinear_points_have_no_normal() {
         let line = (0..5).map(|i| [i as f32, 2.0 * i as f32, 0.0]);
-        assert!(pca_normal(line).is_none());
+        assert!(pca_normal(&Columns::of(line)).is_none());
         let two = [[0.0, 0.0, 0.0], [1.0, 0.0, 0.0]].into_iter();
-        assert!(pca_normal(two).is_none());
+        assert!(pca_normal(&Columns::of(two)).is_none());
     }
 }
