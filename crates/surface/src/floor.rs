@@ -208,11 +208,13 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
     let mut iterations = 0;
     let limit = |needed: usize| needed.max(MIN_HYPOTHESES.min(r.max_iterations));
     // The hypotheses are drawn in order from the one generator, whatever
-    // the draws before them gave, so a batch of them (one a thread) is
-    // drawn, grown and counted in parallel, then taken in order as one
-    // after another would be: the same estimate and count of draws (the
-    // batch's draws past the last taken are dropped; nothing draws after).
-    let batch = rayon::current_num_threads().max(1);
+    // the draws before them gave, so a batch of them is drawn, grown and
+    // counted in parallel, then taken in order as one after another would
+    // be: the same estimate and count of draws (the batch's draws past the
+    // last taken are dropped; nothing draws after). Four a thread: with one
+    // a thread, the search took as long on two threads as on one (each
+    // batch waits for its slowest hypothesis); 10 → 7.5 ms at 1 M points.
+    let batch = 4 * rayon::current_num_threads().max(1);
     while iterations < limit(needed) {
         let draws: Vec<Option<Plane>> = (0..batch.min(limit(needed) - iterations))
             .map(|_| grid.local_plane(&scored, &mut rng))
@@ -320,6 +322,7 @@ impl Split {
     /// The split of `points` (filed in the cells `of`) by `plane`.
     fn of(points: &[[f32; 3]], of: &[u32], plane: &Plane, threshold: f64, below_m: f64) -> Self {
         const CHUNK: usize = 1 << 16;
+        const BLOCK: usize = 256;
         let parts: Vec<Split> = points
             .par_chunks(CHUNK)
             .zip(of.par_chunks(CHUNK))
@@ -332,14 +335,24 @@ impl Split {
                 let mut inliers: Vec<usize> = Vec::with_capacity(chunk.len());
                 let room = inliers.spare_capacity_mut();
                 let (mut kept, mut rising, mut below) = (0, Vec::new(), 0);
-                for (j, (p, &cell)) in chunk.iter().zip(cells).enumerate() {
-                    let d = plane.signed_distance(to_f64(p));
-                    room[kept].write(base + j);
-                    kept += usize::from(d.abs() <= threshold);
-                    if d > threshold && d <= RISE_BAND * threshold {
-                        rising.push(cell);
+                // The distances a block at a time first (a loop with no
+                // dependence between points, which runs by vector).
+                let mut distance = [0.0_f64; BLOCK];
+                let rise = RISE_BAND * threshold;
+                for (b, (block, cells)) in chunk.chunks(BLOCK).zip(cells.chunks(BLOCK)).enumerate()
+                {
+                    for (d, p) in distance.iter_mut().zip(block) {
+                        *d = plane.signed_distance(to_f64(p));
                     }
-                    below += usize::from(d < -below_m);
+                    let first = base + b * BLOCK;
+                    for (j, (&d, &cell)) in distance.iter().zip(cells).enumerate() {
+                        room[kept].write(first + j);
+                        kept += usize::from(d.abs() <= threshold);
+                        if d > threshold && d <= rise {
+                            rising.push(cell);
+                        }
+                        below += usize::from(d < -below_m);
+                    }
                 }
                 // SAFETY: the first `kept` were written (each slot before
                 // the count moved past it).

@@ -1008,27 +1008,8 @@ fn heights_within(z: f32, wide: f64) -> (f32, f32) {
 
 /// The cloud's bounding box, in f64.
 fn bounds(points: &[Point]) -> ([f64; 3], [f64; 3]) {
-    let (lo, hi) = points
-        .par_iter()
-        .fold(
-            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-            |(mut lo, mut hi), p| {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a]);
-                    hi[a] = hi[a].max(p[a]);
-                }
-                (lo, hi)
-            },
-        )
-        .reduce(
-            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]),
-            |(l1, h1), (l2, h2)| {
-                (
-                    std::array::from_fn(|a| l1[a].min(l2[a])),
-                    std::array::from_fn(|a| h1[a].max(h2[a])),
-                )
-            },
-        );
+    let (lo, hi) =
+        crate::cloud::bounds(points).unwrap_or(([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]));
     (lo.map(f64::from), hi.map(f64::from))
 }
 
