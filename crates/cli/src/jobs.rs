@@ -244,6 +244,7 @@ pub fn read_and_perceive(
 ) -> Result<Perceived> {
     let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
     let spinner = progress_bar(progress, "{spinner} {msg} ({elapsed})");
+    let mut ticking = false;
     let got = perceive_file_with(
         input,
         params,
@@ -253,7 +254,12 @@ pub fn read_and_perceive(
         },
         &mut |stage| {
             bar.finish_and_clear();
-            spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+            // Once, and only when shown: each call starts a ticking
+            // thread anew, hidden or not.
+            if progress && !ticking {
+                spinner.enable_steady_tick(std::time::Duration::from_millis(120));
+                ticking = true;
+            }
             spinner.set_message(match stage {
                 "level" => "levelling",
                 "ground" => "removing the floor",
