@@ -397,16 +397,28 @@ impl SurfaceFit {
 
     /// R², RMS residual [m] and count of the cloud points inside the extent.
     fn score_points(&self, cloud: &PointCloud) -> (f64, f64, usize) {
+        use rayon::prelude::*;
+        // The surface's heights in parallel (most of the work), the sums
+        // then in the points' order.
+        let inside: Vec<Vec<(f64, f64)>> = cloud
+            .points
+            .par_chunks(1 << 14)
+            .map(|chunk| {
+                chunk
+                    .iter()
+                    .filter_map(|p| {
+                        let (x, y, z) = (f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
+                        self.extent.contains(x, y).then(|| (z, self.height(x, y)))
+                    })
+                    .collect()
+            })
+            .collect();
         let (mut n, mut sum, mut sum2, mut ss_res) = (0usize, 0.0, 0.0, 0.0);
-        for p in &cloud.points {
-            let (x, y, z) = (f64::from(p[0]), f64::from(p[1]), f64::from(p[2]));
-            if !self.extent.contains(x, y) {
-                continue;
-            }
+        for &(z, h) in inside.iter().flatten() {
             n += 1;
             sum += z;
             sum2 += z * z;
-            ss_res += (z - self.height(x, y)).powi(2);
+            ss_res += (z - h).powi(2);
         }
         if n == 0 {
             return (f64::NAN, f64::NAN, 0);

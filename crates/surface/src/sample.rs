@@ -33,6 +33,7 @@
 //!   than 64 samples.
 
 use autoshovel_cloud::PointCloud;
+use rayon::prelude::*;
 
 use crate::error::{Result, SurfaceError};
 
@@ -228,12 +229,15 @@ pub fn sample_grid(cloud: &PointCloud, params: &SampleParams) -> Result<Samples>
     let min_points = params
         .min_cell_points
         .max((params.min_cell_share * median_count as f64).ceil() as usize);
-    let mut samples = Vec::with_capacity(nx * ny);
-    for iy in 0..ny {
-        for ix in 0..nx {
-            let cell = &mut cells[iy * nx + ix];
+    // The cells one by one in parallel (each its own nearest and robust
+    // height), in their order.
+    let samples: Vec<GridSample> = cells
+        .par_iter_mut()
+        .enumerate()
+        .filter_map(|(c, cell)| {
+            let (ix, iy) = (c % nx, c / nx);
             if cell.len() < min_points {
-                continue;
+                return None;
             }
             let node_x = extent.x_min_m + (ix as f64 + 0.5) * dx;
             let node_y = extent.y_min_m + (iy as f64 + 0.5) * dy;
@@ -245,16 +249,16 @@ pub fn sample_grid(cloud: &PointCloud, params: &SampleParams) -> Result<Samples>
             let near = &cell[..k];
             let (x_m, y_m) = evaluation_point(near, node_x, node_y);
             let z_m = robust_local_height(near, x_m, y_m);
-            samples.push(GridSample {
+            Some(GridSample {
                 ix,
                 iy,
                 x_m,
                 y_m,
                 z_m,
                 points: k,
-            });
-        }
-    }
+            })
+        })
+        .collect();
     Ok(Samples { extent, samples })
 }
 
