@@ -271,10 +271,12 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
     let mut split = Split::of(&cloud.points, &all_grid.of, &plane, threshold, below_m);
     for _ in 0..r.refine_rounds {
         let flat = all_grid.away_from_rises(&split.rising, &split.inliers);
-        let used = if flat.len() >= 3 {
+        let every;
+        let used: &[usize] = if flat.len() >= 3 {
             &flat
         } else {
-            &split.inliers
+            every = split.inliers.concat();
+            &every
         };
         match plane_through(used, at) {
             Some(refined) if refined.normal[2] >= min_nz => plane = refined,
@@ -282,15 +284,17 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
         }
         split = Split::of(&cloud.points, &all_grid.of, &plane, threshold, below_m);
     }
-    let Split { inliers, below, .. } = split;
-    if inliers.len() < required {
-        return Err(no_floor(inliers.len()));
+    let (inliers, below) = (split.count(), split.below);
+    if inliers < required {
+        return Err(no_floor(inliers));
     }
-    let rms_m = (inliers
+    let rms_m = (split
+        .inliers
         .iter()
+        .flatten()
         .map(|&i| plane.signed_distance(at(i)).powi(2))
         .sum::<f64>()
-        / inliers.len() as f64)
+        / inliers as f64)
         .sqrt();
     let (roll_rad, pitch_rad) =
         angles_from_normal(plane.normal).expect("a fitted plane has a unit normal");
@@ -299,7 +303,7 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
         pitch_rad,
         floor_height_m: plane.offset_m,
         normal: plane.normal,
-        inliers: inliers.len(),
+        inliers,
         candidates: n,
         below,
         rms_m,
@@ -309,8 +313,10 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
 
 /// What one plane makes of the whole cloud, in one pass.
 struct Split {
-    /// The points within the threshold of it, ascending.
-    inliers: Vec<usize>,
+    /// The points within the threshold of it, ascending, in parts (one a
+    /// chunk of the cloud, in order: put together, they were a serial
+    /// copy of a third of the cloud each time).
+    inliers: Vec<Vec<usize>>,
     /// The cell of each point just above the inlier band (up to
     /// [`RISE_BAND`] thresholds above the plane), in no order.
     rising: Vec<u32>,
@@ -358,23 +364,28 @@ impl Split {
                 // the count moved past it).
                 unsafe { inliers.set_len(kept) };
                 Split {
-                    inliers,
+                    inliers: vec![inliers],
                     rising,
                     below,
                 }
             })
             .collect();
         let mut all = Split {
-            inliers: Vec::with_capacity(parts.iter().map(|s| s.inliers.len()).sum()),
+            inliers: Vec::with_capacity(parts.len()),
             rising: Vec::new(),
             below: 0,
         };
         for part in parts {
-            all.inliers.extend_from_slice(&part.inliers);
+            all.inliers.extend(part.inliers);
             all.rising.extend_from_slice(&part.rising);
             all.below += part.below;
         }
         all
+    }
+
+    /// The number of inliers.
+    fn count(&self) -> usize {
+        self.inliers.iter().map(Vec::len).sum()
     }
 }
 
@@ -622,7 +633,7 @@ impl Grid {
     /// pile, where the bottom of the face lies inside the band and would tilt
     /// the plane towards the pile (a bias that grows as the floor's share
     /// of the scan falls).
-    fn away_from_rises(&self, rising: &[u32], inliers: &[usize]) -> Vec<usize> {
+    fn away_from_rises(&self, rising: &[u32], inliers: &[Vec<usize>]) -> Vec<usize> {
         // Points just above the band (`rising`, their cells), per cell.
         let cells = self.start.len() - 1;
         let mut above = vec![0u32; cells];
@@ -631,22 +642,39 @@ impl Grid {
         }
         // Every cell next to (or at) a rising one.
         let mut near = vec![false; cells];
-        self.cells.each(|key, c| {
-            let (above, all) = (above[c], self.start[c + 1] - self.start[c]);
-            if above >= 3 && 10 * above > all {
-                for dx in -1..=1 {
-                    for dy in -1..=1 {
-                        if let Some(n) = self.cells.id((key.0 + dx, key.1 + dy)) {
-                            near[n as usize] = true;
-                        }
+        let rises =
+            |above: u32, c: usize| above >= 3 && 10 * above > self.start[c + 1] - self.start[c];
+        let mut mark = |key: (i64, i64)| {
+            for dx in -1..=1 {
+                for dy in -1..=1 {
+                    if let Some(n) = self.cells.id((key.0 + dx, key.1 + dy)) {
+                        near[n as usize] = true;
                     }
                 }
             }
-        });
+        };
+        match self.cells {
+            // The cells with points above the band only (a few thousand,
+            // where the box holds millions), each once.
+            Cells::Dense { x0, y0, nx, .. } => {
+                for &c in rising {
+                    let c = c as usize;
+                    if rises(above[c], c) {
+                        above[c] = 0;
+                        let i = c as i64;
+                        mark((x0 + i % nx, y0 + i / nx));
+                    }
+                }
+            }
+            Cells::Hashed(_) => self.cells.each(|key, c| {
+                if rises(above[c], c) {
+                    mark(key);
+                }
+            }),
+        }
         inliers
             .par_iter()
-            .copied()
-            .filter(|&i| !near[self.of[i] as usize])
+            .flat_map_iter(|part| part.iter().copied().filter(|&i| !near[self.of[i] as usize]))
             .collect()
     }
 
@@ -756,6 +784,48 @@ mod tests {
             });
             assert_eq!(seen, points.len());
             assert!(grid.cell((-7, 99)).is_empty());
+        }
+    }
+
+    #[test]
+    fn away_from_rises_drops_the_cells_round_a_rise() {
+        // Against brute force: an inlier is dropped when a cell within one
+        // of its own in x and y holds 3 or more rising points, more than a
+        // tenth of its points; on a dense grid and a hashed one.
+        let patch: Vec<[f64; 3]> = (0..600)
+            .map(|i| [f64::from(i % 30) * 0.1, f64::from(i / 30) * 0.1, 0.0])
+            .collect();
+        let mut far = patch.clone();
+        far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 0.0]));
+        for (points, dense) in [(patch, true), (far, false)] {
+            let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
+            assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
+            let is_rising = |i: usize| i % 7 == 0 && i < 300;
+            let rising: Vec<u32> = (0..points.len())
+                .filter(|&i| is_rising(i))
+                .map(|i| grid.of[i])
+                .collect();
+            let inliers: Vec<usize> = (0..points.len()).filter(|i| i % 3 != 0).collect();
+            let parts = vec![inliers[..150].to_vec(), inliers[150..].to_vec()];
+            let got = grid.away_from_rises(&rising, &parts);
+            let key = |i: usize| Grid::key(0.5, &points[i]);
+            let rises = |k: (i64, i64)| {
+                let all = (0..points.len()).filter(|&i| key(i) == k).count();
+                let above = (0..points.len())
+                    .filter(|&i| is_rising(i) && key(i) == k)
+                    .count();
+                above >= 3 && 10 * above > all
+            };
+            let want: Vec<usize> = inliers
+                .iter()
+                .copied()
+                .filter(|&i| {
+                    let (x, y) = key(i);
+                    !(-1..=1).any(|dx| (-1..=1).any(|dy| rises((x + dx, y + dy))))
+                })
+                .collect();
+            assert_eq!(got, want);
+            assert!(!got.is_empty() && got.len() < inliers.len());
         }
     }
 
