@@ -800,12 +800,12 @@ mod tests {
         for (points, dense) in [(patch, true), (far, false)] {
             let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
             assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
-            let is_rising = |i: usize| i % 7 == 0 && i < 300;
+            let is_rising = |i: usize| i.is_multiple_of(7) && i < 300;
             let rising: Vec<u32> = (0..points.len())
                 .filter(|&i| is_rising(i))
                 .map(|i| grid.of[i])
                 .collect();
-            let inliers: Vec<usize> = (0..points.len()).filter(|i| i % 3 != 0).collect();
+            let inliers: Vec<usize> = (0..points.len()).filter(|i| !i.is_multiple_of(3)).collect();
             let parts = vec![inliers[..150].to_vec(), inliers[150..].to_vec()];
             let got = grid.away_from_rises(&rising, &parts);
             let key = |i: usize| Grid::key(0.5, &points[i]);
