@@ -753,16 +753,27 @@ mod tests {
         }
     }
 
+    /// A flat patch of `n` points, `per_row` a row at `step` apart, and
+    /// the same with a second patch 10 km away (a grid's cells between
+    /// them too many to number densely).
+    fn patch_and_far(n: u32, per_row: u32, step: [f64; 2]) -> (Vec<[f64; 3]>, Vec<[f64; 3]>) {
+        let patch: Vec<[f64; 3]> = (0..n)
+            .map(|i| {
+                let (x, y) = (i % per_row, i / per_row);
+                [f64::from(x) * step[0], f64::from(y) * step[1], 0.0]
+            })
+            .collect();
+        let mut far = patch.clone();
+        far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 1.0]));
+        (patch, far)
+    }
+
     #[test]
     fn cells_list_their_points_numbered_densely_or_hashed() {
         // One patch (dense numbering), and the same with a second patch
         // 10 km away (too many cells between: hashed); each cell lists
         // exactly the points whose key is its own, in point order.
-        let patch: Vec<[f64; 3]> = (0..500)
-            .map(|i| [f64::from(i % 23) * 0.37, f64::from(i / 23) * 0.29, 0.0])
-            .collect();
-        let mut far = patch.clone();
-        far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 1.0]));
+        let (patch, far) = patch_and_far(500, 23, [0.37, 0.29]);
         // A point with a NaN coordinate is filed where its key says (0).
         let mut odd = patch
             .iter()
@@ -792,11 +803,7 @@ mod tests {
         // Against brute force: an inlier is dropped when a cell within one
         // of its own in x and y holds 3 or more rising points, more than a
         // tenth of its points; on a dense grid and a hashed one.
-        let patch: Vec<[f64; 3]> = (0..600)
-            .map(|i| [f64::from(i % 30) * 0.1, f64::from(i / 30) * 0.1, 0.0])
-            .collect();
-        let mut far = patch.clone();
-        far.extend(patch.iter().map(|p| [p[0] + 1e4, p[1] - 1e4, 0.0]));
+        let (patch, far) = patch_and_far(600, 30, [0.1, 0.1]);
         for (points, dense) in [(patch, true), (far, false)] {
             let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
             assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
