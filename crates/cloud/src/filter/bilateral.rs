@@ -166,7 +166,8 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
                 // (all of a point's at once, `exp.rs`).
                 *w = -(dist2 * inv_2sd2 + *h * *h * inv_2sn2);
             }
-            if let Some(own) = found.iter().position(|&q| q as usize == i) {
+            // P's own terms out (its neighbours come ascending, in input order).
+            if let Ok(own) = found.binary_search(&(i as u32)) {
                 weight.remove(own);
                 offset.remove(own);
             }
