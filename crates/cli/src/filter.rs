@@ -5,12 +5,12 @@
 
 use std::path::PathBuf;
 
-use anyhow::{bail, Context, Result};
-use autoshovel_cloud::io::read;
-use autoshovel_surface::chain::{run_chain, FilterSummary, Stage, StageKind};
+use anyhow::Result;
+use autoshovel_surface::chain::{Stage, StageKind};
 use clap::ArgMatches;
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 use crate::pile::EncodingArg;
 
 /// The stage flags, in no particular order (the command line gives it).
@@ -67,9 +67,6 @@ pub fn ordered_stages(matches: &ArgMatches) -> Result<Vec<Stage>> {
         given.extend(idx.zip(values).map(|(i, v)| (i, kind, v.clone())));
     }
     given.sort_by_key(|(i, _, _)| *i);
-    if given.is_empty() {
-        bail!("no stage given: add one or more of --voxel, --statistical, --radius, --pass, --level (run in the order given)");
-    }
     Ok(given
         .into_iter()
         .map(|(_, kind, v)| Stage::parse(kind, &v))
@@ -79,60 +76,20 @@ pub fn ordered_stages(matches: &ArgMatches) -> Result<Vec<Stage>> {
 /// Runs `filter` with the stages in `matches`' order.
 pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
     let stages = ordered_stages(matches)?;
-    if same_file(&args.input, &args.output) {
-        bail!(
-            "--output {} is the input: write the filtered cloud elsewhere",
-            args.output.display()
-        );
-    }
     let out = out_dir(
         args.report.out.as_deref(),
         &[Some(&args.input), Some(&args.output)],
         args.report.force,
     )?;
-    let show = !args.report.json;
-    let bar = crate::output::progress_bar(show, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
-    let t0 = std::time::Instant::now();
-    let got = read(&args.input, &mut |done, total| {
-        bar.set_length(total);
-        bar.set_position(done);
-    })
-    .with_context(|| format!("reading {}", args.input.display()))?;
-    bar.finish_and_clear();
-    let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let (cloud, report) = run_chain(&got.cloud, &stages)?;
-    let filter_ms: f64 = report.iter().map(|r| r.ms).sum();
-    let t1 = std::time::Instant::now();
-    let encoding = crate::pile::write_cloud_file(
+    let job = autoshovel_jobs::filter(
+        &args.input,
         &args.output,
-        std::slice::from_ref(&args.input),
-        &cloud,
-        args.encoding,
+        &stages,
+        args.encoding.map(Into::into),
+        out.as_ref(),
         args.report.force,
+        !args.report.json,
     )?;
-    let summary = FilterSummary {
-        job: "filter",
-        success: true,
-        input: args.input.display().to_string(),
-        input_format: got.format,
-        output: args.output.display().to_string(),
-        output_encoding: encoding.name(),
-        points_in: got.cloud.len(),
-        non_finite_dropped: got.non_finite_dropped,
-        points_out: cloud.len(),
-        stages: report,
-        read_ms,
-        filter_ms,
-        write_ms: t1.elapsed().as_secs_f64() * 1e3,
-    };
-    let stages_done = summary.stages.clone();
-    let job = crate::output::Job::finish(summary, out.as_ref(), |dir, written| {
-        Ok(autoshovel_figures::filter::write(
-            dir,
-            &stages_done,
-            written,
-        )?)
-    })?;
     job.report(args.report.json, |s| {
         crate::say!(
             "filter {} ({}, {} points)",
@@ -157,12 +114,4 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
             s.output_encoding
         );
     })
-}
-
-/// Whether `a` and `b` name the same file (`b` need not exist).
-fn same_file(a: &std::path::Path, b: &std::path::Path) -> bool {
-    match (a.canonicalize(), b.canonicalize()) {
-        (Ok(x), Ok(y)) => x == y,
-        _ => false,
-    }
 }

@@ -8,15 +8,15 @@ use std::path::{Path, PathBuf};
 use std::sync::atomic::{AtomicBool, Ordering};
 use std::time::Duration;
 
-use anyhow::{bail, Context, Result};
+use anyhow::{bail, Result};
 use autoshovel_link::drive::DriveSummary;
 use autoshovel_link::{
     pki, Clock, FaultKind, Link, LinkParams, PlcParams, PlcServer, Policy, ServeParams,
 };
 use autoshovel_track::scenario::{resolve, TrackScenario};
-use autoshovel_track::{ControllerKind, ControllerRun, Tracking};
 
-use crate::output::{out_dir, Job};
+use crate::output::out_dir;
+use crate::output::Report as _;
 use crate::track::{ControllerArg, NoiseArg};
 
 /// Set by Ctrl-C while a drive runs: the drive zeroes the setpoints and ends.
@@ -97,15 +97,6 @@ fn first_use(root: &Path) -> Result<()> {
         );
     }
     Ok(())
-}
-
-/// The async runtime of the link's commands.
-pub fn runtime() -> Result<tokio::runtime::Runtime> {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .context("starting the async runtime")
 }
 
 fn scenario_of(name: &str, noise: Option<NoiseArg>, seed: u64) -> Result<TrackScenario> {
@@ -220,7 +211,7 @@ pub fn plc_sim(args: &PlcSimArgs) -> Result<()> {
         ],
         false,
     )?;
-    let rt = runtime()?;
+    let rt = autoshovel_jobs::runtime()?;
     DRIVE_STOP.store(false, Ordering::Relaxed);
     DRIVE_ACTIVE.store(true, Ordering::Relaxed);
     let summary = rt.block_on(async {
@@ -349,10 +340,10 @@ pub fn drive(args: &DriveArgs) -> Result<()> {
         .log
         .clone()
         .unwrap_or_else(|| default_log(args.out.as_deref(), "drive"));
-    let rt = runtime()?;
+    let rt = autoshovel_jobs::runtime()?;
     DRIVE_STOP.store(false, Ordering::Relaxed);
     DRIVE_ACTIVE.store(true, Ordering::Relaxed);
-    let job = crate::jobs::drive(
+    let job = autoshovel_jobs::drive(
         &rt,
         &scenario,
         args.controller.into(),
@@ -411,7 +402,7 @@ pub struct AckArgs {
 /// Runs `plc-ack`: calls the PLC's Acknowledge method.
 pub fn ack(args: &AckArgs) -> Result<()> {
     let params = args.security.link(&args.endpoint)?;
-    let rt = runtime()?;
+    let rt = autoshovel_jobs::runtime()?;
     rt.block_on(async {
         let link = Link::open(&params).await?;
         let r = link.acknowledge().await;
@@ -482,65 +473,16 @@ pub struct ReplayArgs {
 
 /// Runs `replay`.
 pub fn replay(args: &ReplayArgs) -> Result<()> {
-    use autoshovel_link::replay::{read_rtk_csv, replay_mcap, replay_rtk};
-    let is_csv = args
-        .log
-        .extension()
-        .is_some_and(|e| e.eq_ignore_ascii_case("csv"));
-    let (r, scenario) = if is_csv {
-        let Some(path) = &args.path else {
-            bail!(
-                "{}: a CSV of fixes needs --path (the planned path: a built-in or a scenario TOML)",
-                args.log.display()
-            );
-        };
-        let sc = scenario_of(path, Some(NoiseArg::Off), 1)?;
-        let rows = read_rtk_csv(&args.log)?;
-        (
-            replay_rtk(
-                &rows,
-                sc.setup.legs.clone(),
-                &args.log.display().to_string(),
-            ),
-            Some(sc),
-        )
-    } else {
-        if args.path.is_some() {
-            bail!("--path is for a CSV of fixes; an MCAP log carries its own path");
-        }
-        (replay_mcap(&args.log)?, None)
+    let planned = match &args.path {
+        Some(path) => Some(scenario_of(path, Some(NoiseArg::Off), 1)?),
+        None => None,
     };
     let out = out_dir(
         args.output.out.as_deref(),
         &[Some(args.log.as_path())],
         args.output.force,
     )?;
-    let scenario = scenario.unwrap_or_else(|| {
-        let mut sc = resolve("straight", Some(autoshovel_track::Noise::Off), 1)
-            .expect("a built-in scenario");
-        sc.name = format!("replay of {}", args.log.display());
-        sc.setup.legs = r.legs.clone();
-        sc.setup.start = r
-            .run
-            .samples
-            .first()
-            .map(|s| s.truth)
-            .unwrap_or(sc.setup.start);
-        sc.map = None;
-        sc
-    });
-    let summary = r.summary();
-    let tracking = Tracking::single(ControllerRun {
-        kind: ControllerKind::Fuzzy,
-        name: "replay",
-        gains: ControllerKind::Fuzzy.build(&Default::default()).gains(),
-        run: r.run,
-        sim_time_ms: 0.0,
-    });
-    let job = Job::finish(summary, out.as_ref(), |dir, written| {
-        autoshovel_figures::track::write(dir, &scenario, &tracking, written)
-            .context("writing the replay figures")
-    })?;
+    let job = autoshovel_jobs::replay(&args.log, planned.as_ref(), out.as_ref())?;
     job.report(args.output.json, |s: &autoshovel_link::replay::ReplaySummary| {
         let m = &s.metrics;
         crate::say!(

@@ -14,10 +14,8 @@ macro_rules! say {
 }
 pub(crate) use say;
 
-mod demo;
 mod filter;
 mod heap;
-mod jobs;
 mod link;
 mod output;
 mod perceive;
@@ -155,6 +153,27 @@ fn print_scenario(name: &str) -> anyhow::Result<()> {
     Ok(())
 }
 
+/// `autoshovel demo`: every job on its embedded defaults into `out`, one
+/// line a job (or the summary alone under `--json`).
+fn demo(out: &std::path::Path, json: bool, force: bool) -> anyhow::Result<()> {
+    let options = autoshovel_jobs::demo::DemoOptions {
+        force,
+        progress: !json,
+        stop: &link::DRIVE_STOP,
+    };
+    let got = autoshovel_jobs::demo::run(out, options, &mut |line| {
+        if !json {
+            say!("{line}");
+        }
+    })?;
+    if json {
+        output::print_json(&serde_json::json!({ "job": "demo", "jobs": got.jobs }))?;
+    } else {
+        say!("report: {}", got.index.display());
+    }
+    Ok(())
+}
+
 fn main() -> ExitCode {
     // The matches are kept: `filter` runs its stages in the order given.
     let matches = Cli::command().get_matches();
@@ -198,17 +217,21 @@ fn main() -> ExitCode {
         Command::PlcAck(args) => link::ack(&args),
         Command::Replay(args) => link::replay(&args),
         Command::Pki(cmd) => link::pki_cmd(&cmd),
-        Command::Demo { out, json, force } => demo::run(&out, json, force),
+        Command::Demo { out, json, force } => demo(&out, json, force),
     };
     match result {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
             eprintln!("error: {e:#}");
             // Interrupted (Ctrl-C), after zeroing the setpoints: the shell's 128 + SIGINT.
-            if matches!(
-                e.downcast_ref::<autoshovel_link::LinkError>(),
-                Some(autoshovel_link::LinkError::Interrupted { .. })
-            ) {
+            let interrupted = match e.downcast_ref::<autoshovel_jobs::JobError>() {
+                Some(e) => e.interrupted(),
+                None => matches!(
+                    e.downcast_ref::<autoshovel_link::LinkError>(),
+                    Some(autoshovel_link::LinkError::Interrupted { .. })
+                ),
+            };
+            if interrupted {
                 return ExitCode::from(130);
             }
             ExitCode::FAILURE

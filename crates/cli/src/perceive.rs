@@ -8,6 +8,7 @@ use anyhow::{Context, Result};
 use autoshovel_surface::perceive::PerceptionParams;
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 
 /// Arguments of `perceive`.
 #[derive(Debug, clap::Args)]
@@ -85,8 +86,13 @@ pub fn run(args: &Args) -> Result<()> {
             model_cell_m: args.model_cell.unwrap_or(defaults.model_cell_m),
             ..defaults
         };
-        let job =
-            crate::jobs::perceive_tiles(input, &params, options, out.as_ref(), !args.output.json)?;
+        let job = autoshovel_jobs::perceive_tiles(
+            input,
+            &params,
+            options,
+            out.as_ref(),
+            !args.output.json,
+        )?;
         return job.report(args.output.json, |s| {
             crate::say!(
                 "perceive {} by tiles: {} file(s), {} points in {} tiles of {:.1} m (halo {:.2} m)",
@@ -125,8 +131,13 @@ pub fn run(args: &Args) -> Result<()> {
             relevel_every: args.relevel_every,
             model_cell_m: args.model_cell,
         };
-        let job =
-            crate::jobs::perceive_frames(input, &params, options, out.as_ref(), !args.output.json)?;
+        let job = autoshovel_jobs::perceive_frames(
+            input,
+            &params,
+            options,
+            out.as_ref(),
+            !args.output.json,
+        )?;
         return job.report(args.output.json, |s| {
             crate::say!(
                 "perceive {} frames of {}: {} perceived, {} skipped",
@@ -169,7 +180,7 @@ pub fn run(args: &Args) -> Result<()> {
             input.display()
         );
     }
-    let job = crate::jobs::perceive(input, &params, out.as_ref(), !args.output.json)?;
+    let job = autoshovel_jobs::perceive(input, &params, out.as_ref(), !args.output.json)?;
     job.report(args.output.json, |s| {
         crate::say!("perceive {}", s.input);
         for st in &s.stages {

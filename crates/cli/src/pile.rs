@@ -4,7 +4,7 @@
 use std::path::{Path, PathBuf};
 
 use anyhow::{Context, Result};
-use autoshovel_cloud::io::{write, Encoding};
+use autoshovel_cloud::io::Encoding;
 use autoshovel_surface::{generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern};
 
 use crate::output::print_json;
@@ -31,29 +31,6 @@ impl From<EncodingArg> for Encoding {
             EncodingArg::BinaryBigEndian => Encoding::BinaryBigEndian,
         }
     }
-}
-
-/// Writes `cloud` to `path` (format by extension, `encoding` or its
-/// default) atomically, never over `inputs`, and over an existing file
-/// autoshovel did not write only with `force`; returns the encoding used.
-pub fn write_cloud_file(
-    path: &std::path::Path,
-    inputs: &[PathBuf],
-    cloud: &autoshovel_cloud::PointCloud,
-    encoding: Option<EncodingArg>,
-    force: bool,
-) -> Result<Encoding> {
-    let encoding = encoding.map_or_else(|| Encoding::default_for(path), Encoding::from);
-    autoshovel_report::write_file_atomically::<anyhow::Error>(
-        path,
-        inputs,
-        (&Default::default(), force),
-        |p| {
-            write(p, cloud, encoding)?;
-            Ok(())
-        },
-    )?;
-    Ok(encoding)
 }
 
 /// Arguments of `generate-pile`.
@@ -258,7 +235,8 @@ fn generate_one(params: &PileParams, path: &Path, args: &Args) -> Result<Generat
     })?;
     let gen_ms = t0.elapsed().as_secs_f64() * 1e3;
     let t1 = std::time::Instant::now();
-    let encoding = write_cloud_file(path, &[], &cloud, args.encoding, args.force)?;
+    let encoding =
+        autoshovel_jobs::write_cloud(path, &[], &cloud, args.encoding.map(Into::into), args.force)?;
     Ok(GeneratePileSummary::new(
         params,
         cloud.len(),

@@ -24,6 +24,7 @@ use autoshovel_surface::PileShape;
 use autoshovel_surface::perceive::PerceptionParams;
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 
 /// How the optimiser's first pack is placed.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -143,10 +144,12 @@ pub fn run(args: &Args) -> Result<()> {
         return run_all_surfaces(&setup, out.as_ref(), args.output.json);
     }
     let pile = match &args.cloud {
-        Some(path) => crate::jobs::scan_pile(path, &pipeline, &setup.profile, !args.output.json)?,
+        Some(path) => {
+            autoshovel_jobs::scan_pile(path, &pipeline, &setup.profile, !args.output.json)?
+        }
         None => Pile::shape(args.surface.unwrap_or_default(), &setup.profile)?,
     };
-    let job = crate::jobs::plan_dig(&pile, &setup, out.as_ref())?;
+    let job = autoshovel_jobs::plan_dig(&pile, &setup, out.as_ref())?;
     job.report(args.output.json, print_human)?;
     match &job.summary.error {
         Some(e) => bail!("{e}"),
@@ -160,7 +163,7 @@ fn run_all_surfaces(
     out: Option<&crate::output::OutDir>,
     json: bool,
 ) -> Result<()> {
-    let job = crate::jobs::plan_dig_all_surfaces(setup, out, |s| {
+    let job = autoshovel_jobs::plan_dig_all_surfaces(setup, out, |s| {
         if !json {
             crate::say!(
                 "planned the {} pile: {} ({:.0} ms)",

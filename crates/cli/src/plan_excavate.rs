@@ -8,6 +8,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::output::Report as _;
 use anyhow::Result;
 use autoshovel_excavate::{ExcavateSummary, Setup};
 
@@ -47,7 +48,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
         args.output.force,
     )?;
-    crate::jobs::plan_excavate(&setup, out.as_ref())?.report(args.output.json, print_human)
+    autoshovel_jobs::plan_excavate(&setup, out.as_ref())?.report(args.output.json, print_human)
 }
 
 fn print_raw(text: &str) {

@@ -7,6 +7,7 @@ use anyhow::Result;
 use autoshovel_propel::{PlanPathSummary, Scenario};
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 use crate::PlannerArg;
 
 /// Arguments of `plan-path`.
@@ -33,13 +34,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario))],
         args.output.force,
     )?;
-    if !(args.heading_tolerance_deg.is_finite() && args.heading_tolerance_deg >= 0.0) {
-        anyhow::bail!(
-            "--heading-tolerance-deg {} must be a non-negative number",
-            args.heading_tolerance_deg
-        );
-    }
-    let job = crate::jobs::plan_path(
+    let job = autoshovel_jobs::plan_path(
         &scenario,
         args.planner.into(),
         args.heading_tolerance_deg,

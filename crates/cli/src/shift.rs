@@ -6,6 +6,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::output::Report as _;
 use anyhow::Result;
 use autoshovel_dig::MachineProfile;
 use autoshovel_shift::{ShiftOptions, ShiftScenario, ShiftSummary, TomlFile};
@@ -61,7 +62,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
         args.output.force,
     )?;
-    crate::jobs::shift(
+    autoshovel_jobs::shift(
         &scenario,
         &profile,
         &options,

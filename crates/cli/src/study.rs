@@ -6,6 +6,7 @@ use autoshovel_figures::study::markdown_table;
 use autoshovel_propel::study::StudyParams;
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 
 /// Arguments of `study-paths`.
 #[derive(Debug, clap::Args)]
@@ -36,6 +37,6 @@ pub fn run(args: &Args) -> Result<()> {
         ..Default::default()
     };
     let out = out_dir(args.output.out.as_deref(), &[], args.output.force)?;
-    let job = crate::jobs::study(&params, out.as_ref(), !args.output.json)?;
+    let job = autoshovel_jobs::study(&params, out.as_ref(), !args.output.json)?;
     job.report(args.output.json, |s| crate::say!("{}", markdown_table(s)))
 }

@@ -4,6 +4,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::output::Report as _;
 use anyhow::Result;
 use autoshovel_excavate::study::BoulderStudyParams;
 use autoshovel_excavate::Setup;
@@ -48,7 +49,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario)), args.profile.as_deref()],
         args.output.force,
     )?;
-    let job = crate::jobs::study_boulders(
+    let job = autoshovel_jobs::study_boulders(
         &setup.scenario,
         &setup.profile,
         &params,

@@ -9,6 +9,7 @@ use autoshovel_track::scenario::{resolve, Noise};
 use autoshovel_track::{ControllerKind, RunSummary, TrackSummary};
 
 use crate::output::out_dir;
+use crate::output::Report as _;
 
 /// Controller choice.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, clap::ValueEnum)]
@@ -77,7 +78,7 @@ pub fn run(args: &Args) -> Result<()> {
         &[Some(Path::new(&args.scenario))],
         args.output.force,
     )?;
-    let job = crate::jobs::track(
+    let job = autoshovel_jobs::track(
         &scenario,
         args.controller.into(),
         args.compare,

@@ -2,6 +2,7 @@
 //! the same training runs, then scored on runs none was tuned on
 //! (`autoshovel_track::tune`).
 
+use crate::output::Report as _;
 use anyhow::Result;
 use autoshovel_figures::tune::markdown_table;
 
@@ -21,6 +22,7 @@ pub struct Args {
 /// Runs the comparison as the command line asks.
 pub fn run(args: &Args) -> Result<()> {
     let out = crate::output::out_dir(args.output.out.as_deref(), &[], args.output.force)?;
-    let job = crate::jobs::tune_trackers(args.budget, args.seed, out.as_ref(), !args.output.json)?;
+    let job =
+        autoshovel_jobs::tune_trackers(args.budget, args.seed, out.as_ref(), !args.output.json)?;
     job.report(args.output.json, |s| crate::say!("{}", markdown_table(s)))
 }

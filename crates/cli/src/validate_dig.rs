@@ -11,6 +11,7 @@
 
 use std::path::{Path, PathBuf};
 
+use crate::output::Report as _;
 use anyhow::{bail, Result};
 use autoshovel_dig::validate::{
     simulate_measurement, AlignParams, MeasuredRecord, MeasurementModel, PlannedRecord,
@@ -159,7 +160,7 @@ pub fn run(args: &Args) -> Result<()> {
         (None, Some(path)) => simulate(&planned, &args.model(), path, args.output.force)?,
         (None, None) => bail!("give --measured FILE.csv, or --simulate FILE.csv"),
     };
-    let job = crate::jobs::validate_dig(&planned, &measured, &params, out.as_ref())?;
+    let job = autoshovel_jobs::validate_dig(&planned, &measured, &params, out.as_ref())?;
     job.report(args.output.json, print_human)
 }
 

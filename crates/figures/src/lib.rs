@@ -1,7 +1,7 @@
 //! Each job's figures (SVG + PNG) and CSV tables, built from the typed
 //! results of the library crates: one module per job, the shared drawing
-//! helpers in `autoshovel-report`. Only the `autoshovel` binary depends on
-//! this crate; it sits at the end of the data flow beside it.
+//! helpers in `autoshovel-report`. The jobs (`autoshovel-jobs`) call it;
+//! it sits at the end of the data flow beside them.
 //!
 //! Every `write_*` function takes the output folder and a
 //! [`Written`](autoshovel_report::Written) that records each file written.

@@ -1,6 +1,6 @@
 //! The native half of the Python package `autoshovel` (crates/py/README.md).
 //!
-//! Each function here is one library call, as `crates/cli/src/jobs.rs`
+//! Each function here is one library call, as `autoshovel-jobs`
 //! makes it for the binary: arguments checked at the edge (naming the
 //! argument and what was expected), the GIL released while the library
 //! works, the library's own error messages passed on unchanged as

@@ -1,9 +1,10 @@
-//! `autoshovel demo`: every job on its embedded defaults, one report
-//! (`index.html` linking each job's plots and tabulating its summary).
+//! The demo: every job on its embedded defaults, one report (`index.html`
+//! linking each job's plots and tabulating its summary) and one
+//! `summary.json` of them all.
 
-use std::path::Path;
+use std::path::{Path, PathBuf};
+use std::sync::atomic::AtomicBool;
 
-use anyhow::Result;
 use autoshovel_propel::study::StudyParams;
 use autoshovel_propel::{FieldKind, Scenario};
 use autoshovel_report::{write_index_html, write_summary, Section};
@@ -11,18 +12,60 @@ use serde_json::{json, Value};
 
 use autoshovel_surface::perceive::PerceptionParams;
 
-use crate::output::{print_json, OutDir, Written};
+use crate::{JobError, OutDir, Result, Written};
 
-/// Runs the demo into `out`.
+/// How the demo runs.
+#[derive(Debug, Clone, Copy)]
+pub struct DemoOptions {
+    /// Replace files in the output folder that autoshovel did not write.
+    pub force: bool,
+    /// Draw the progress bars of the longer jobs on stderr.
+    pub progress: bool,
+    /// Set (Ctrl-C) to zero the setpoints of the demo's drive and end it.
+    pub stop: &'static AtomicBool,
+}
+
+/// Never set: a demo that cannot be stopped by its drive's flag.
+static NEVER: AtomicBool = AtomicBool::new(false);
+
+impl Default for DemoOptions {
+    fn default() -> Self {
+        Self {
+            force: false,
+            progress: false,
+            stop: &NEVER,
+        }
+    }
+}
+
+/// What the demo made.
+#[derive(Debug, Clone)]
+pub struct Demo {
+    /// The report, `index.html`.
+    pub index: PathBuf,
+    /// Every job's summary, under its key (as `summary.json` holds them).
+    pub jobs: Value,
+}
+
+/// Runs the demo into `out`; `say` hears one line per job as it ends.
 ///
 /// The demo writes only into its own sub-folders (each job under the output
 /// rule of `autoshovel_report::staging`) and its `index.html`,
 /// `summary.json` and the two scans it generates, which its summary lists
 /// as its own; without `force` a user's file of those names is refused
 /// before any work.
-pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
+pub fn run(out: &Path, options: DemoOptions, say: &mut dyn FnMut(&str)) -> Result<Demo> {
+    let DemoOptions {
+        force,
+        progress,
+        stop,
+    } = options;
     if out.exists() && !out.is_dir() {
-        anyhow::bail!("--out {}: exists and is not a directory", out.display());
+        return Err(JobError::setting(
+            "--out",
+            out.display(),
+            "exists and is not a directory",
+        ));
     }
     let ours = autoshovel_report::files_written_before(out);
     for name in [
@@ -31,25 +74,27 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
     ] {
         let target = out.join(name);
         if let Some(why) = autoshovel_report::refusal(&target, &[], &ours, force) {
-            anyhow::bail!("refusing to write {}: {why}", target.display());
+            return Err(autoshovel_report::ReportError::Refused { path: target, why }.into());
         }
     }
-    std::fs::create_dir_all(out)?;
-    let p = Place {
+    std::fs::create_dir_all(out).map_err(|e| JobError::io(out, e))?;
+    let mut p = Place {
         out: out.to_path_buf(),
         force,
-        json_only,
+        progress,
+        stop,
         ours,
+        say,
     };
     let mut r = Report::default();
-    plan_paths(&p, &mut r)?;
-    tracking(&p, &mut r)?;
-    drive(&p, &mut r)?;
-    perception(&p, &mut r)?;
-    dig(&p, &mut r)?;
-    excavation(&p, &mut r)?;
-    shift(&p, &mut r)?;
-    study(&p, &mut r)?;
+    plan_paths(&mut p, &mut r)?;
+    tracking(&mut p, &mut r)?;
+    drive(&mut p, &mut r)?;
+    perception(&mut p, &mut r)?;
+    dig(&mut p, &mut r)?;
+    excavation(&mut p, &mut r)?;
+    shift(&mut p, &mut r)?;
+    study(&mut p, &mut r)?;
     let Report {
         mut own,
         sections,
@@ -63,24 +108,21 @@ pub fn run(out: &Path, json_only: bool, force: bool) -> Result<()> {
     ]);
     write_summary(&out, &json!({ "job": "demo", "jobs": all, "files": own }))?;
     let index = write_index_html(&out, "autoshovel demo", &sections)?;
-    if json_only {
-        print_json(&json!({ "job": "demo", "jobs": all }))?;
-    } else {
-        crate::say!("report: {}", index.display());
-    }
-    Ok(())
+    Ok(Demo { index, jobs: all })
 }
 
-/// Where the demo writes, and by what rule.
-struct Place {
-    out: std::path::PathBuf,
+/// Where the demo writes, by what rule, and who hears of each job.
+struct Place<'a> {
+    out: PathBuf,
     force: bool,
-    json_only: bool,
+    progress: bool,
+    stop: &'static AtomicBool,
     /// Files autoshovel wrote in `out` before this run.
-    ours: std::collections::HashSet<std::path::PathBuf>,
+    ours: std::collections::HashSet<PathBuf>,
+    say: &'a mut dyn FnMut(&str),
 }
 
-impl Place {
+impl Place<'_> {
     /// A job's folder under the demo's.
     fn dir(&self, sub: &str) -> OutDir {
         OutDir {
@@ -88,6 +130,11 @@ impl Place {
             inputs: Vec::new(),
             force: self.force,
         }
+    }
+
+    /// One line about a job that ended.
+    fn say(&mut self, line: String) {
+        (self.say)(&line)
     }
 }
 
@@ -130,7 +177,7 @@ impl Report {
 }
 
 /// Potential-field walks on the built-in scenarios, improved and classic.
-fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
+fn plan_paths(p: &mut Place, r: &mut Report) -> Result<()> {
     let runs: [(&str, FieldKind, &str); 6] = [
         ("straight", FieldKind::Improved, "Straight travel along a haul road (Fig. 1a)."),
         ("curve", FieldKind::Improved, "Round a parked truck and a stockpile on a bending road (Fig. 1b, Fig. 4a/b)."),
@@ -144,30 +191,28 @@ fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
         let key = format!("plan-path {name} {}", field.name());
         let sub = format!("plan-path-{name}-{}", field.name());
         let dir = p.dir(&sub);
-        let job = crate::jobs::plan_path(
+        let job = crate::plan_path(
             &scenario,
             field,
             autoshovel_propel::DEFAULT_HEADING_TOLERANCE_DEG,
             Some(&dir),
         )?;
-        if !p.json_only {
-            let s = &job.summary;
-            let v = |x: Option<f64>| x.unwrap_or(f64::NAN);
-            crate::say!(
-                "{key:40} {}",
-                if s.success {
-                    format!(
-                        "ok: {:.2} m, heading error {:.2} deg, clearance {:.2} m, {:.2} ms",
-                        v(s.length_m),
-                        v(s.final_heading_error_deg),
-                        v(s.min_clearance_m),
-                        v(s.plan_time_ms)
-                    )
-                } else {
-                    format!("failed: {}", s.error.as_deref().unwrap_or(""))
-                }
-            );
-        }
+        let s = &job.summary;
+        let v = |x: Option<f64>| x.unwrap_or(f64::NAN);
+        p.say(format!(
+            "{key:40} {}",
+            if s.success {
+                format!(
+                    "ok: {:.2} m, heading error {:.2} deg, clearance {:.2} m, {:.2} ms",
+                    v(s.length_m),
+                    v(s.final_heading_error_deg),
+                    v(s.min_clearance_m),
+                    v(s.plan_time_ms)
+                )
+            } else {
+                format!("failed: {}", s.error.as_deref().unwrap_or(""))
+            }
+        ));
         let summary = job.json()?;
         r.add_job(&key, description, summary, &sub, &job.written);
     }
@@ -175,7 +220,7 @@ fn plan_paths(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// Tracking runs of the walking paper's Fig. 9 and §5.3.
-fn tracking(p: &Place, r: &mut Report) -> Result<()> {
+fn tracking(p: &mut Place, r: &mut Report) -> Result<()> {
     // Every run uses the fuzzy tracker; the last compares all three. The
     // paths, starts, speeds and noise are said from the scenarios themselves.
     let track_runs: [(&str, bool, &str); 6] = [
@@ -210,18 +255,16 @@ fn tracking(p: &Place, r: &mut Report) -> Result<()> {
         let dir = p.dir(&sub);
         let description = format!("{description}: {}.", track_setting(&scenario));
         let description = description.as_str();
-        let job = crate::jobs::track(&scenario, ctl, compare, Some(&dir))?;
-        if !p.json_only {
-            let m = &job.summary.run.metrics;
-            crate::say!(
-                "{key:40} {}: max dev {:.3} m, mean {:.3} m, reached after {:.2} m, final heading error {:.2} deg",
-                if job.summary.success { "ok" } else { "FAILED" },
-                m.max_centroid_dev_m,
-                m.mean_centroid_dev_m,
-                m.reached_distance_m,
-                m.final_heading_error_deg
-            );
-        }
+        let job = crate::track(&scenario, ctl, compare, Some(&dir))?;
+        let m = &job.summary.run.metrics;
+        p.say(format!(
+            "{key:40} {}: max dev {:.3} m, mean {:.3} m, reached after {:.2} m, final heading error {:.2} deg",
+            if job.summary.success { "ok" } else { "FAILED" },
+            m.max_centroid_dev_m,
+            m.mean_centroid_dev_m,
+            m.reached_distance_m,
+            m.final_heading_error_deg
+        ));
         let summary = job.json()?;
         r.add_job(&key, description, summary, &sub, &job.written);
     }
@@ -229,7 +272,7 @@ fn tracking(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// Fig. 9a driven over OPC UA against a simulated PLC.
-fn drive(p: &Place, r: &mut Report) -> Result<()> {
+fn drive(p: &mut Place, r: &mut Report) -> Result<()> {
     // The machine link: a simulated PLC in lockstep on loopback, the
     // workstation driving it over Basic256Sha256 SignAndEncrypt; a PKI made
     // for the run in a temporary folder and removed after.
@@ -244,7 +287,7 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
         let _ = std::fs::remove_dir_all(&pki_dir);
         pki::init(&pki_dir, &[])?;
         let pw = pki::read_password(&pki_dir.join(pki::PASSWORD_FILE))?;
-        let rt = crate::link::runtime()?;
+        let rt = crate::runtime()?;
         let job = (|| {
             let server = rt.block_on(PlcServer::start(
                 PlcParams {
@@ -269,7 +312,7 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
             );
             let log = dir.dir.join("drive.mcap");
             let overwrite = p.force || p.ours.contains(&log);
-            let job = crate::jobs::drive(
+            let job = crate::drive(
                 &rt,
                 &scenario,
                 autoshovel_track::ControllerKind::Fuzzy,
@@ -277,7 +320,7 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
                 &log,
                 overwrite,
                 Some(&dir),
-                &crate::link::DRIVE_STOP,
+                p.stop,
             );
             rt.block_on(server.stop());
             job
@@ -285,17 +328,15 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
         let _ = std::fs::remove_dir_all(&pki_dir);
         let job = job?;
         r.own.push(format!("{sub}/drive.mcap"));
-        if !p.json_only {
-            let m = &job.summary.track.run.metrics;
-            crate::say!(
-                "{key:40} {}: max dev {:.3} m, mean {:.3} m, setpoint write p50 {:.2} ms (plc-sim in lockstep, metrics on {})",
-                if job.summary.track.success { "ok" } else { "FAILED" },
-                m.max_centroid_dev_m,
-                m.mean_centroid_dev_m,
-                job.summary.link.write_ms.p50,
-                job.summary.link.metrics_on
-            );
-        }
+        let m = &job.summary.track.run.metrics;
+        p.say(format!(
+            "{key:40} {}: max dev {:.3} m, mean {:.3} m, setpoint write p50 {:.2} ms (plc-sim in lockstep, metrics on {})",
+            if job.summary.track.success { "ok" } else { "FAILED" },
+            m.max_centroid_dev_m,
+            m.mean_centroid_dev_m,
+            job.summary.link.write_ms.p50,
+            job.summary.link.metrics_on
+        ));
         let summary = job.json()?;
         let mut files = job.written.files.clone();
         files.push("drive.mcap".into());
@@ -312,7 +353,7 @@ fn drive(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// The §3 pipeline on a synthetic scan of two pile shapes.
-fn perception(p: &Place, r: &mut Report) -> Result<()> {
+fn perception(p: &mut Place, r: &mut Report) -> Result<()> {
     // Perception: a synthetic scan of each pile shape, levelled, filtered and fitted.
     for shape in [
         autoshovel_surface::PileShape::Typical,
@@ -327,8 +368,8 @@ fn perception(p: &Place, r: &mut Report) -> Result<()> {
             ..Default::default()
         };
         let cloud = autoshovel_surface::generate_pile(&params)?;
-        std::fs::create_dir_all(&dir.dir)?;
-        autoshovel_report::write_file_atomically::<anyhow::Error>(
+        std::fs::create_dir_all(&dir.dir).map_err(|e| JobError::io(&dir.dir, e))?;
+        autoshovel_report::write_file_atomically::<JobError>(
             &scan,
             &[],
             (&p.ours, p.force),
@@ -338,24 +379,22 @@ fn perception(p: &Place, r: &mut Report) -> Result<()> {
             },
         )?;
         r.own.push(format!("{sub}/scan.pcd"));
-        let job = crate::jobs::perceive(&scan, &PerceptionParams::default(), Some(&dir), false)?;
+        let job = crate::perceive(&scan, &PerceptionParams::default(), Some(&dir), false)?;
         let mut written = job.written.clone();
         written.file(&dir.dir, &scan);
         let key = format!("perceive {} pile", shape.name());
-        if !p.json_only {
-            let s = &job.summary;
-            crate::say!(
-                "{key:40} roll {:.3} deg (true {:.3}), pitch {:.3} deg (true {:.3}), R² {:.4}, {} → {} points in {:.0} ms",
-                s.roll_deg,
-                params.roll_rad.to_degrees(),
-                s.pitch_deg,
-                params.pitch_rad.to_degrees(),
-                s.r2,
-                s.input_points,
-                s.output_points,
-                s.total_ms
-            );
-        }
+        let s = &job.summary;
+        p.say(format!(
+            "{key:40} roll {:.3} deg (true {:.3}), pitch {:.3} deg (true {:.3}), R² {:.4}, {} → {} points in {:.0} ms",
+            s.roll_deg,
+            params.roll_rad.to_degrees(),
+            s.pitch_deg,
+            params.pitch_rad.to_degrees(),
+            s.r2,
+            s.input_points,
+            s.output_points,
+            s.total_ms
+        ));
         let summary = job.json()?;
         let description = format!(
             "A synthetic {}-point scan of a {} pile (Fig. 7) tilted by roll {:.1}°, pitch {:.1}°, then the §3 pipeline.",
@@ -370,30 +409,28 @@ fn perception(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// The rope-shovel dig plan on the typical pile and on all four.
-fn dig(p: &Place, r: &mut Report) -> Result<()> {
+fn dig(p: &mut Place, r: &mut Report) -> Result<()> {
     // Dig planning: the typical pile, then all four beside the paper's Tables 4–5.
     let setup = autoshovel_dig::DigSetup::scale_model(1);
     let sub = "plan-dig-typical";
     let dir = p.dir(sub);
     let typical = autoshovel_dig::paper_row(autoshovel_surface::PileShape::Typical);
     let pile = autoshovel_dig::Pile::shape(typical.shape, &setup.profile)?;
-    let job = crate::jobs::plan_dig(&pile, &setup, Some(&dir))?;
+    let job = crate::plan_dig(&pile, &setup, Some(&dir))?;
     let key = "plan-dig typical";
-    if !p.json_only {
-        let s = &job.summary;
-        match (&s.error, &s.plan) {
-            (None, Some(p)) => crate::say!(
-                "{key:40} ok: m_dig {:.3} kg (paper {}), fill {:.1} %, t_d {:.2} s, f {:.2} (paper {}), {:.0} ms",
-                p.m_dig_kg,
-                typical.m_dig_kg,
-                100.0 * p.fill_factor,
-                p.td_s,
-                p.f,
-                typical.f,
-                s.plan_time_ms
-            ),
-            (e, _) => crate::say!("{key:40} FAILED: {}", e.as_deref().unwrap_or("no plan")),
-        }
+    let s = &job.summary;
+    match (&s.error, &s.plan) {
+        (None, Some(plan)) => p.say(format!(
+            "{key:40} ok: m_dig {:.3} kg (paper {}), fill {:.1} %, t_d {:.2} s, f {:.2} (paper {}), {:.0} ms",
+            plan.m_dig_kg,
+            typical.m_dig_kg,
+            100.0 * plan.fill_factor,
+            plan.td_s,
+            plan.f,
+            typical.f,
+            s.plan_time_ms
+        )),
+        (e, _) => p.say(format!("{key:40} FAILED: {}", e.as_deref().unwrap_or("no plan"))),
     }
     let summary = job.json()?;
     let mut shown = summary.clone();
@@ -415,13 +452,11 @@ fn dig(p: &Place, r: &mut Report) -> Result<()> {
     ), summary);
     let sub = "plan-dig-all-surfaces";
     let dir = p.dir(sub);
-    let job = crate::jobs::plan_dig_all_surfaces(&setup, Some(&dir), |_| {})?;
+    let job = crate::plan_dig_all_surfaces(&setup, Some(&dir), |_| {})?;
     let key = "plan-dig --all-surfaces";
-    if !p.json_only {
-        crate::say!("{}", autoshovel_figures::dig::markdown_table(&job.summary));
-        if let Some(e) = job.summary.error() {
-            crate::say!("{key:40} FAILED: {e}");
-        }
+    p.say(autoshovel_figures::dig::markdown_table(&job.summary));
+    if let Some(e) = job.summary.error() {
+        p.say(format!("{key:40} FAILED: {e}"));
     }
     let calibrated: Vec<&str> = autoshovel_dig::PAPER_TABLES_4_5
         .iter()
@@ -437,7 +472,7 @@ fn dig(p: &Place, r: &mut Report) -> Result<()> {
         section(
             key,
             &description,
-            &serde_json::to_value(autoshovel_dig::table_summary(&job.summary))?,
+            &autoshovel_report::summary_value(&autoshovel_dig::table_summary(&job.summary))?,
             sub,
             // The comparison and each pile's path; the other plots are in the pile folders.
             &job.written
@@ -459,7 +494,7 @@ fn dig(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// The hydraulic-excavator cases of its paper's §3 and two boulders.
-fn excavation(p: &Place, r: &mut Report) -> Result<()> {
+fn excavation(p: &mut Place, r: &mut Report) -> Result<()> {
     // Hydraulic excavator: the paper's §3 case passed over and under, then two boulders in one dig.
     let excavate_runs: [(&str, &str); 3] = [
         ("paper-over", "The hydraulic-excavator paper's §3 case (Fig. 5): 0.9 m³ from (7, 0) at 0.7 m depth; the descending tooth meets a 0.5 m boulder it did not know about on its upper part, γ ∈ (0°, 180°), so it passes over; the boulder counts as dug and the rest is re-planned."),
@@ -479,30 +514,28 @@ fn excavation(p: &Place, r: &mut Report) -> Result<()> {
         };
         let sub = format!("plan-excavate-{name}");
         let dir = p.dir(&sub);
-        let job = crate::jobs::plan_excavate(&setup, Some(&dir))?;
+        let job = crate::plan_excavate(&setup, Some(&dir))?;
         let key = format!("plan-excavate {name}");
-        if !p.json_only {
-            let s = &job.summary;
-            let contacts: Vec<String> = s
-                .plan
-                .contacts
-                .iter()
-                .map(|c| format!("{:.2} s γ {:.0}° {}", c.t_s, c.gamma_deg, c.decision))
-                .collect();
-            crate::say!(
-                "{key:40} ok: {:.3} m³ of {:.3} m³ ({:+.2} %), contacts: {}, dig {:.1} s, {:.1} ms",
-                s.plan.achieved_volume_m3,
-                s.plan.target_volume_m3,
-                s.volume_error_pct,
-                if contacts.is_empty() {
-                    "none".to_string()
-                } else {
-                    contacts.join("; ")
-                },
-                s.plan.duration_s,
-                s.plan.plan_time_ms
-            );
-        }
+        let s = &job.summary;
+        let contacts: Vec<String> = s
+            .plan
+            .contacts
+            .iter()
+            .map(|c| format!("{:.2} s γ {:.0}° {}", c.t_s, c.gamma_deg, c.decision))
+            .collect();
+        p.say(format!(
+            "{key:40} ok: {:.3} m³ of {:.3} m³ ({:+.2} %), contacts: {}, dig {:.1} s, {:.1} ms",
+            s.plan.achieved_volume_m3,
+            s.plan.target_volume_m3,
+            s.volume_error_pct,
+            if contacts.is_empty() {
+                "none".to_string()
+            } else {
+                contacts.join("; ")
+            },
+            s.plan.duration_s,
+            s.plan.plan_time_ms
+        ));
         let summary = job.json()?;
         let mut shown = summary.clone();
         if let Some(o) = shown.as_object_mut() {
@@ -525,7 +558,7 @@ fn excavation(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// A 45-minute shift of the whole machine on the built-in bench.
-fn shift(p: &Place, r: &mut Report) -> Result<()> {
+fn shift(p: &mut Place, r: &mut Report) -> Result<()> {
     // The whole machine: a short shift on the built-in bench.
     let scenario = autoshovel_shift::ShiftScenario::bench();
     let options = autoshovel_shift::ShiftOptions {
@@ -534,27 +567,25 @@ fn shift(p: &Place, r: &mut Report) -> Result<()> {
     };
     let sub = "shift";
     let dir = p.dir(sub);
-    let job = crate::jobs::shift(
+    let job = crate::shift(
         &scenario,
         &autoshovel_dig::MachineProfile::scale_model(),
         &options,
         Some(&dir),
         false,
     )?;
-    if !p.json_only {
-        let s = &job.summary;
-        crate::say!(
-            "{:40} ok: {:.0} t in {:.2} h ({:.0} t/h), {} passes from {} stands, {} walks; mass balance {}",
-            "shift (45 min)",
-            s.tonnes,
-            s.hours,
-            s.tonnes_per_hour,
-            s.passes,
-            s.stands,
-            s.walks,
-            if s.mass_balance.closes { "closes" } else { "DOES NOT CLOSE" }
-        );
-    }
+    let s = &job.summary;
+    p.say(format!(
+        "{:40} ok: {:.0} t in {:.2} h ({:.0} t/h), {} passes from {} stands, {} walks; mass balance {}",
+        "shift (45 min)",
+        s.tonnes,
+        s.hours,
+        s.tonnes_per_hour,
+        s.passes,
+        s.stands,
+        s.walks,
+        if s.mass_balance.closes { "closes" } else { "DOES NOT CLOSE" }
+    ));
     let summary = job.json()?;
     let shown_plots: Vec<String> = job
         .written
@@ -577,20 +608,15 @@ fn shift(p: &Place, r: &mut Report) -> Result<()> {
 }
 
 /// The random-road study on 100 maps.
-fn study(p: &Place, r: &mut Report) -> Result<()> {
+fn study(p: &mut Place, r: &mut Report) -> Result<()> {
     let params = StudyParams {
         maps: 100,
         ..Default::default()
     };
     let sub = "study-paths";
     let dir = p.dir(sub);
-    let job = crate::jobs::study(&params, Some(&dir), !p.json_only)?;
-    if !p.json_only {
-        crate::say!(
-            "{}",
-            autoshovel_figures::study::markdown_table(&job.summary)
-        );
-    }
+    let job = crate::study(&params, Some(&dir), p.progress)?;
+    p.say(autoshovel_figures::study::markdown_table(&job.summary));
     let summary = job.json()?;
     r.add("study-paths", section(
         "study-paths (100 maps)",
