@@ -303,42 +303,76 @@ impl Grid {
         let columns = Columns::new(points, lo, hi, wanted)?;
         let Columns { h, nx, ny, of, .. } = columns;
         let count = block_index(nx - 1, ny - 1, nx) + 1;
-        let mut start = vec![0u32; count + 1];
-        for &c in &of {
-            start[c as usize + 1] += 1;
-        }
-        for c in 0..count {
-            start[c + 1] += start[c];
-        }
         // Counting sort by column, then each column by height, a row of
         // blocks at a time in parallel (their columns are numbered in one
-        // run): the points are first dealt to their rows of blocks in one
-        // serial pass that writes a few streams, then each row sorts its
-        // own part of the output.
+        // run). The points are first dealt to their rows of blocks: chunks
+        // of the input count theirs a row, then write them into their own
+        // piece of each row's part, all in parallel (a row keeps the input
+        // order). Each row then counts its columns and sorts its own part
+        // of the output.
         let row_len = nx.div_ceil(BLOCK) * BLOCK * BLOCK;
         let rows = count.div_ceil(row_len);
-        let first_of = |r: usize| start[(r * row_len).min(count)] as usize;
+        let chunk = n.div_ceil(4 * rayon::current_num_threads()).max(1 << 14);
+        let tallies: Vec<Vec<usize>> = of
+            .par_chunks(chunk)
+            .map(|part| {
+                let mut tally = vec![0usize; rows];
+                for &c in part {
+                    tally[c as usize / row_len] += 1;
+                }
+                tally
+            })
+            .collect();
         let mut order = vec![0u32; n];
-        let mut fill: Vec<usize> = (0..rows).map(first_of).collect();
-        for (i, &c) in of.iter().enumerate() {
-            let r = c as usize / row_len;
-            order[fill[r]] = i as u32;
-            fill[r] += 1;
+        let mut row_first = Vec::with_capacity(rows + 1);
+        let mut pieces: Vec<Vec<&mut [u32]>> = tallies.iter().map(|_| Vec::new()).collect();
+        let (mut rest, mut at) = (order.as_mut_slice(), 0);
+        for r in 0..rows {
+            row_first.push(at);
+            for (tally, mine) in tallies.iter().zip(pieces.iter_mut()) {
+                let (piece, tail) = std::mem::take(&mut rest).split_at_mut(tally[r]);
+                mine.push(piece);
+                rest = tail;
+                at += tally[r];
+            }
         }
+        row_first.push(at);
+        of.par_chunks(chunk)
+            .zip(pieces.par_iter_mut())
+            .enumerate()
+            .for_each(|(j, (part, mine))| {
+                let mut fill = vec![0usize; rows];
+                for (i, &c) in part.iter().enumerate() {
+                    let r = c as usize / row_len;
+                    mine[r][fill[r]] = (j * chunk + i) as u32;
+                    fill[r] += 1;
+                }
+            });
+        drop(pieces);
+        let mut start = vec![0u32; count + 1];
+        start[count] = n as u32;
         let mut entries = vec![(0u64, 0u32); n];
         let mut parts = Vec::with_capacity(rows);
         let (mut rest, mut dealt) = (entries.as_mut_slice(), order.as_slice());
-        for r in 0..rows {
-            let len = first_of(r + 1) - first_of(r);
-            let (part, tail) = rest.split_at_mut(len);
+        for (r, starts) in start[..count].chunks_mut(row_len).enumerate() {
+            let len = row_first[r + 1] - row_first[r];
+            let (part, tail) = std::mem::take(&mut rest).split_at_mut(len);
             let (mine, others) = dealt.split_at(len);
-            parts.push((r, part, mine));
+            parts.push((r, starts, part, mine));
             (rest, dealt) = (tail, others);
         }
         let isa = Isa::best();
-        parts.into_par_iter().for_each(|(r, part, mine)| {
-            let (c0, base) = (r * row_len, first_of(r));
-            let mut next = start[c0..((r + 1) * row_len).min(count)].to_vec();
+        parts.into_par_iter().for_each(|(r, starts, part, mine)| {
+            let (c0, base) = (r * row_len, row_first[r]);
+            // The row's columns' starts (their counts, summed).
+            for &i in mine {
+                starts[of[i as usize] as usize - c0] += 1;
+            }
+            let mut sum = base as u32;
+            for s in starts.iter_mut() {
+                (*s, sum) = (sum, sum + *s);
+            }
+            let mut next = starts.to_vec();
             for &i in mine {
                 let c = of[i as usize] as usize;
                 let slot = &mut next[c - c0];
@@ -986,10 +1020,13 @@ struct Scratch {
     nearest: Vec<f32>,
     /// The tree's search state, for far points.
     knn: Option<Nearest>,
-    /// The k nearest so far of `far_k_nearest`, farthest on top.
-    best: std::collections::BinaryHeap<u32>,
-    /// The boxes `far_k_nearest` has still to open, nearest first.
-    waiting: std::collections::BinaryHeap<std::cmp::Reverse<(u64, bool, usize)>>,
+    /// The nearest so far of `far_k_nearest` (the k nearest, the k-th
+    /// last, after each pick).
+    best: Vec<u32>,
+    /// The blocks `far_k_nearest` has still to open, nearest first.
+    waiting: std::collections::BinaryHeap<std::cmp::Reverse<(u64, usize)>>,
+    /// The columns of the block `far_k_nearest` is opening.
+    columns: Vec<(u64, usize)>,
 }
 
 /// The heights within `wide` of `z`, rounded outwards to f32 (so that
