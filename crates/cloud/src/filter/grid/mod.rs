@@ -351,51 +351,63 @@ impl Grid {
         drop(pieces);
         let mut start = vec![0u32; count + 1];
         start[count] = n as u32;
-        let mut entries = vec![(0u64, 0u32); n];
+        // Each row writes its own part of the grid's arrays: the input
+        // indices and coordinates in sorted order.
+        let (mut ids, mut x, mut y, mut z) =
+            (vec![0u32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n]);
         let mut parts = Vec::with_capacity(rows);
-        let (mut rest, mut dealt) = (entries.as_mut_slice(), order.as_slice());
+        let mut rest = (&mut ids[..], &mut x[..], &mut y[..], &mut z[..]);
+        let mut dealt = order.as_slice();
         for (r, starts) in start[..count].chunks_mut(row_len).enumerate() {
             let len = row_first[r + 1] - row_first[r];
-            let (part, tail) = std::mem::take(&mut rest).split_at_mut(len);
+            let (ids, x, y, z) = std::mem::take(&mut rest);
+            let ((pi, ri), (px, rx)) = (ids.split_at_mut(len), x.split_at_mut(len));
+            let ((py, ry), (pz, rz)) = (y.split_at_mut(len), z.split_at_mut(len));
             let (mine, others) = dealt.split_at(len);
-            parts.push((r, starts, part, mine));
-            (rest, dealt) = (tail, others);
+            parts.push((r, starts, [px, py, pz], pi, mine));
+            (rest, dealt) = ((ri, rx, ry, rz), others);
         }
         let isa = Isa::best();
-        parts.into_par_iter().for_each(|(r, starts, part, mine)| {
-            let (c0, base) = (r * row_len, row_first[r]);
-            // The row's columns' starts (their counts, summed).
-            for &i in mine {
-                starts[of[i as usize] as usize - c0] += 1;
-            }
-            let mut sum = base as u32;
-            for s in starts.iter_mut() {
-                (*s, sum) = (sum, sum + *s);
-            }
-            let mut next = starts.to_vec();
-            for &i in mine {
-                let c = of[i as usize] as usize;
-                let slot = &mut next[c - c0];
-                // Heights ordered as integers (finite f32, sign folded).
-                let bits = points[i as usize][2].to_bits();
-                let key = if bits >> 31 == 1 {
-                    !bits
-                } else {
-                    bits | 1 << 31
-                };
-                part[*slot as usize - base] = ((c as u64) << 32 | u64::from(key), i);
-                *slot += 1;
-            }
-            for column in part.chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32) {
-                sort_column(isa, column);
-            }
-        });
-        let ids: Vec<u32> = entries.into_iter().map(|(_, i)| i).collect();
-        // The points in sorted order in one gather (one random read a
-        // point), then split by axis.
-        let sorted: Vec<Point> = ids.par_iter().map(|&i| points[i as usize]).collect();
-        let coordinate = |a: usize| -> Vec<f32> { sorted.par_iter().map(|p| p[a]).collect() };
-        let xyz = [coordinate(0), coordinate(1), coordinate(2)];
+        parts
+            .into_par_iter()
+            .for_each_init(Vec::new, |part, (r, starts, xyz, pi, mine)| {
+                let (c0, base) = (r * row_len, row_first[r]);
+                // The row's columns' starts (their counts, summed).
+                for &i in mine {
+                    starts[of[i as usize] as usize - c0] += 1;
+                }
+                let mut sum = base as u32;
+                for s in starts.iter_mut() {
+                    (*s, sum) = (sum, sum + *s);
+                }
+                let mut next = starts.to_vec();
+                part.clear();
+                part.resize(mine.len(), (0u64, 0u32));
+                for &i in mine {
+                    let c = of[i as usize] as usize;
+                    let slot = &mut next[c - c0];
+                    // Heights ordered as integers (finite f32, sign folded).
+                    let bits = points[i as usize][2].to_bits();
+                    let key = if bits >> 31 == 1 {
+                        !bits
+                    } else {
+                        bits | 1 << 31
+                    };
+                    part[*slot as usize - base] = ((c as u64) << 32 | u64::from(key), i);
+                    *slot += 1;
+                }
+                for column in part.chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32) {
+                    sort_column(isa, column);
+                }
+                // The points in sorted order (one random read a point), split
+                // by axis.
+                let [px, py, pz] = xyz;
+                for (j, &(_, i)) in part.iter().enumerate() {
+                    let p = points[i as usize];
+                    (pi[j], px[j], py[j], pz[j]) = (i, p[0], p[1], p[2]);
+                }
+            });
+        let xyz = [x, y, z];
         Some(Self::assemble(lo, h, (nx, ny), start, xyz, ids))
     }
 
