@@ -25,9 +25,9 @@
 //! query's own, which on a dense scan already hold the few it wants. A
 //! point far from the rest (an outlier above the scan, whose box would
 //! sweep many columns) is answered after the others (`far.rs`): blocks of
-//! columns and columns searched nearest box first, or on a large cloud
-//! with many such points a k-d tree (the columns that search opens grow
-//! with the density). A grid searched once may be searched again with
+//! columns searched nearest box first, and a block's columns nearest
+//! first (a k-d tree built for them at 2 M points and more answered them
+//! more slowly since, and took 0.8 GB more at 20 M). A grid searched once may be searched again with
 //! some points dropped (`Grid::retain`: the statistical filter on what
 //! the radius filter kept, on columns sized for both). In place of the
 //! tree's walk with a branch a node, a query costs a few look-ups and
@@ -48,7 +48,6 @@ use rayon::prelude::*;
 mod far;
 mod near;
 
-use super::kdtree::{KdTree, Nearest};
 use super::within::{self, Isa, Run};
 use near::Near;
 
@@ -121,9 +120,6 @@ pub(crate) struct Grid {
     inputs: usize,
     /// The search loop's instruction set.
     isa: Isa,
-    /// Points from which far points may go to a k-d tree (`TREE_FROM`;
-    /// tests lower it).
-    tree_from: usize,
 }
 
 impl Grid {
@@ -447,7 +443,6 @@ impl Grid {
             inputs: ids.len(),
             ids,
             isa: Isa::best(),
-            tree_from: TREE_FROM,
         }
     }
 
@@ -731,8 +726,7 @@ impl Grid {
     /// `f` of the k nearest squared distances (the point itself counted;
     /// in any order, the k-th last) of every point, in input order; runs of
     /// sorted positions in parallel. Points far from the rest (outliers of
-    /// a noisy scan) are answered after the others, by `far_k_nearest` or
-    /// a k-d tree.
+    /// a noisy scan) are answered after the others, by `far_k_nearest`.
     pub(crate) fn map_k_nearest_distances<T, F>(&self, k: usize, f: F) -> Vec<T>
     where
         T: Send + Sync + Clone + Default,
@@ -760,33 +754,16 @@ impl Grid {
         let far: Vec<usize> = (0..self.ids.len())
             .filter(|&p| out[self.ids[p] as usize].is_none())
             .collect();
-        // On a large cloud with many far points, a k-d tree answers them
-        // sooner: the columns a far point's search opens grow with the
-        // density (the statistical filter on the bench pile, with and
-        // without the tree: 100 k 50 against 44 ms, 1 M alike, 5 M 2.8
-        // against 3.1 s).
-        let n = self.ids.len();
-        let tree = (n >= self.tree_from && far.len() * TREE_WORTH > n).then(|| {
-            let points: Vec<Point> = (0..n).map(|p| [self.x[p], self.y[p], self.z[p]]).collect();
-            KdTree::new(&points)
-        });
+        // (A k-d tree built for them on large clouds answered them more
+        // slowly than `far_k_nearest` once a block's columns were ordered
+        // on their own: the statistical filter on the bench pile at 5 M
+        // 2.44–2.48 s with it against 2.14–2.32 without, at 20 M 11.5
+        // against 11.3 s and 2.0 against 1.2 GB of memory.)
         let late: Vec<(usize, T)> = far
             .par_iter()
             .map_init(Scratch::default, |scratch, &p| {
                 let q = [self.x[p], self.y[p], self.z[p]];
-                match &tree {
-                    Some(tree) => {
-                        let knn = scratch.knn.get_or_insert_with(|| Nearest::new(k));
-                        tree.nearest(&q, knn);
-                        scratch.bits.clear();
-                        scratch
-                            .bits
-                            .extend(knn.distances().iter().map(|d| d.to_bits()));
-                    }
-                    None => {
-                        self.far_k_nearest(q, k, scratch);
-                    }
-                }
+                self.far_k_nearest(q, k, scratch);
                 (self.ids[p] as usize, answer(scratch))
             })
             .collect();
@@ -796,11 +773,6 @@ impl Grid {
         out.into_iter().map(|v| v.unwrap_or_default()).collect()
     }
 }
-
-/// Points from which far points, when more than one in `TREE_WORTH`, are
-/// answered by a k-d tree (see `map_k_nearest_distances`).
-const TREE_FROM: usize = 2_000_000;
-const TREE_WORTH: usize = 1000;
 
 /// A column's entries (column above, height key below; point index) by
 /// height, ties by index: by rank ([`within::ranks`]) where the heights are
@@ -1030,8 +1002,6 @@ struct Scratch {
     /// The columns round the last query's.
     near: Near,
     nearest: Vec<f32>,
-    /// The tree's search state, for far points.
-    knn: Option<Nearest>,
     /// The nearest so far of `far_k_nearest` (the k nearest, the k-th
     /// last, after each pick).
     best: Vec<u32>,
@@ -1141,18 +1111,17 @@ mod tests {
     }
 
     fn both(points: &[Point], k: usize) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
-        let mut grid = Grid::for_k_nearest(points, k).expect("a grid");
+        let grid = Grid::for_k_nearest(points, k).expect("a grid");
         let tree = KdTree::new(points);
-        let by_grid = grid.map_k_nearest_distances(k, bits);
-        // Far points by the grid's own tree, as on a large cloud.
-        grid.tree_from = 0;
-        assert_eq!(grid.map_k_nearest_distances(k, bits), by_grid, "k {k}");
-        (by_grid, tree.map_k_nearest_distances(k, bits))
+        (
+            grid.map_k_nearest_distances(k, bits),
+            tree.map_k_nearest_distances(k, bits),
+        )
     }
 
     #[test]
     fn the_k_nearest_are_the_trees_bit_for_bit() {
-        // (with outliers: some queries answered by the grid's own tree)
+        // (with outliers: some queries answered by `far_k_nearest`)
         for (n, k, seed) in [(20_000, 21, 1), (5_000, 51, 2), (300, 8, 3), (60, 59, 4)] {
             let points = cloud(n, seed);
             let (grid, tree) = both(&points, k);
