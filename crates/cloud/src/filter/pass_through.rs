@@ -164,32 +164,36 @@ const CHUNK: usize = 1 << 15;
 /// `out(i, p)` for the points `p` (at index `i`) that pass `keep`, in input
 /// order. Each task writes its chunk's survivors, branch-free, to the start
 /// of the chunk's own range of the output; the ranges are then closed up in
-/// order.
+/// order. The output is never zeroed first (that was a serial pass over
+/// all of it, a fifth of the filter's time at 1 M).
 fn compact<T, K, O>(points: &[Point], keep: K, out: O) -> Vec<T>
 where
-    T: Copy + Default + Send + Sync,
+    T: Copy + Send + Sync,
     K: Fn(&Point) -> bool + Sync,
     O: Fn(usize, &Point) -> T + Sync,
 {
-    let mut result = vec![T::default(); points.len()];
-    let counts: Vec<usize> = result
+    let mut result: Vec<T> = Vec::with_capacity(points.len());
+    let counts: Vec<usize> = result.spare_capacity_mut()[..points.len()]
         .par_chunks_mut(CHUNK)
         .zip(points.par_chunks(CHUNK))
         .enumerate()
         .map(|(chunk, (dst, src))| {
             let mut n = 0;
             for (j, p) in src.iter().enumerate() {
-                dst[n] = out(chunk * CHUNK + j, p);
+                dst[n].write(out(chunk * CHUNK + j, p));
                 n += usize::from(keep(p));
             }
             n
         })
         .collect();
+    let spare = result.spare_capacity_mut();
     let mut kept = 0;
     for (chunk, &count) in counts.iter().enumerate() {
-        result.copy_within(chunk * CHUNK..chunk * CHUNK + count, kept);
+        spare.copy_within(chunk * CHUNK..chunk * CHUNK + count, kept);
         kept += count;
     }
-    result.truncate(kept);
+    // SAFETY: each chunk wrote its `count` survivors at the start of its
+    // range, and those were copied, in order, to `..kept`.
+    unsafe { result.set_len(kept) };
     result
 }
