@@ -395,23 +395,11 @@ fn perceive(
             (got, "<array>".to_string())
         }
         (None, Some(p)) => {
+            // A read error names the file; the pipeline's are prefixed
+            // with it (the rule of the CLI's jobs).
             let got = py
-                .detach(|| {
-                    autoshovel_surface::perceive::perceive_file_with(
-                        &p,
-                        &params,
-                        &mut |_, _| {},
-                        &mut |_| {},
-                    )
-                })
-                .map_err(|e| match e {
-                    autoshovel_surface::SurfaceError::Cloud(e) => lib_err(e),
-                    e => crate::AutoshovelError::new_err(format!(
-                        "{}: {}",
-                        p.display(),
-                        crate::message(&e)
-                    )),
-                })?;
+                .detach(|| autoshovel_jobs::read_and_perceive(&p, &params, false))
+                .map_err(lib_err)?;
             (got, p.display().to_string())
         }
         _ => {

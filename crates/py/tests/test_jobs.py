@@ -68,6 +68,20 @@ def test_perceive_settings_as_keywords(pile):
         autoshovel.perceive(42)
 
 
+def test_perceive_errors_name_the_file(tmp_path):
+    # A pipeline error on a file is prefixed with it, as the CLI's are; a
+    # read error names it by itself.
+    few = tmp_path / "three.xyz"
+    few.write_text("0 0 0\n1 0 0\n0 1 0\n")
+    with pytest.raises(AutoshovelError) as e:
+        autoshovel.perceive(few)
+    assert str(e.value).startswith(f"{few}: "), str(e.value)
+    bad = tmp_path / "bad.pcd"
+    bad.write_text("not a point cloud\n")
+    with pytest.raises(AutoshovelError, match="bad.pcd"):
+        autoshovel.perceive(bad)
+
+
 def test_perceive_matches_the_cli(tmp_path, pile, cli):
     path = tmp_path / "pile.pcd"
     autoshovel.write_cloud(path, pile)
