@@ -398,8 +398,11 @@ fn perceive(
             // A read error names the file; the pipeline's are prefixed
             // with it (the rule of the CLI's jobs).
             let got = py
-                .detach(|| autoshovel_jobs::read_and_perceive(&p, &params, false))
-                .map_err(lib_err)?;
+                .detach(|| {
+                    autoshovel_jobs::read_and_perceive(&p, &params, false)
+                        .map_err(|e| crate::message(&e))
+                })
+                .map_err(crate::AutoshovelError::new_err)?;
             (got, p.display().to_string())
         }
         _ => {
