@@ -41,9 +41,17 @@ impl Grid {
         waiting.clear();
         best.clear();
         let mut cap = f32::INFINITY;
+        // Boxes nearer than this may hold points within the k-th so far.
+        let limit_of = |cap: f32| f64::from(cap) * (1.0 + SLACK);
+        // The k nearest of `best` kept, the k-th last; returns the k-th.
+        let pick = |best: &mut Vec<u32>| {
+            within::smallest(self.isa, best, k);
+            best.truncate(k);
+            f32::from_bits(best[k - 1])
+        };
         let mut ring = 0;
         loop {
-            let limit = f64::from(cap) * (1.0 + SLACK);
+            let limit = limit_of(cap);
             // Beyond the rings of blocks so far (0 to ring − 1), every
             // box lies at least `outside` from q (no side: the grid's edge).
             let sides = [
@@ -111,7 +119,7 @@ impl Grid {
             }
             columns.sort_unstable();
             for &(d, c) in columns.iter() {
-                if f64::from_bits(d) > f64::from(cap) * (1.0 + SLACK) {
+                if f64::from_bits(d) > limit_of(cap) {
                     break;
                 }
                 // Its points nearer than the k-th so far.
@@ -122,17 +130,13 @@ impl Grid {
                 // (cheaper than a heap kept in order at every point; the
                 // k-th of the last pick bounds the search meanwhile).
                 if best.len() >= k && (cap.is_infinite() || best.len() >= 2 * k) {
-                    within::smallest(self.isa, best, k);
-                    best.truncate(k);
-                    cap = f32::from_bits(best[k - 1]);
+                    cap = pick(best);
                 }
             }
         }
         // The k (the grid holds more than k points), the k-th last.
         if best.len() > k {
-            within::smallest(self.isa, best, k);
-            best.truncate(k);
-            cap = f32::from_bits(best[k - 1]);
+            cap = pick(best);
         }
         bits.clear();
         bits.extend_from_slice(best);

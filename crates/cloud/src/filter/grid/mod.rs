@@ -27,7 +27,8 @@
 //! sweep many columns) is answered after the others (`far.rs`): blocks of
 //! columns searched nearest box first, and a block's columns nearest
 //! first (a k-d tree built for them at 2 M points and more answered them
-//! more slowly since, and took 0.8 GB more at 20 M). A grid searched once may be searched again with
+//! more slowly since, and took 0.8 GB more at 20 M). A grid searched once
+//! may be searched again with
 //! some points dropped (`Grid::retain`: the statistical filter on what
 //! the radius filter kept, on columns sized for both). In place of the
 //! tree's walk with a branch a node, a query costs a few look-ups and
