@@ -5,6 +5,7 @@ PCL keeps the very points we keep, and print a table. Run by hand (not by CI):
     apt-get install -y pcl-tools && pip install open3d-cpu   # or open3d
     python3 crates/cloud/peer/bench_peers.py [--runs 3] [--dir /tmp/filter_bench]
         [--sizes 100k,1m,5m,20m | --input SCAN] [--process] [--markdown FILE]
+        [--peer-timeout SECONDS]
 
 It runs `FILTER_BENCH_WRITE=DIR cargo bench -p autoshovel-cloud --bench
 filters`, which writes the bench clouds (or reads --input, a scan made by
@@ -32,6 +33,7 @@ voxel_down_sample(0.05) (grid anchored differently),
 crop(AxisAlignedBoundingBox(z >= 0.1)).
 """
 import argparse
+import json
 import os
 import re
 import resource
@@ -119,6 +121,35 @@ def repeat(fn, runs, warm=True):
     return statistics.median(r[0] for r in results), results[0][1]
 
 
+def open3d_in_child(inp, name, tensor, runs, warm, timeout_s):
+    """`repeat` of one Open3D call in a child process that reads `inp`
+    itself (not timed), stopped after `timeout_s` seconds: (median ms, kept)
+    or (None, reason). Open3D's legacy radius filter at 20 M points runs for
+    tens of minutes; the row still gets PCL's time and the lower bound."""
+    cmd = [sys.executable, os.path.abspath(__file__), "--open3d-one", inp, name, str(int(tensor)),
+           str(runs), str(int(warm))]
+    try:
+        res = subprocess.run(cmd, capture_output=True, text=True, timeout=timeout_s)
+    except subprocess.TimeoutExpired:
+        return None, f"over {timeout_s:.0f} s (stopped)"
+    lines = res.stdout.strip().splitlines()
+    if res.returncode != 0 or not lines:
+        return None, f"failed: {(res.stderr.strip().splitlines() or ['exit %d' % res.returncode])[-1][:60]}"
+    ms, kept = json.loads(lines[-1])
+    return ms, kept
+
+
+def open3d_one(argv):
+    """The child of `open3d_in_child`: prints `repeat`'s pair as JSON."""
+    import open3d as o3d
+    inp, name, tensor, runs, warm = argv[0], argv[1], argv[2] == "1", int(argv[3]), argv[4] == "1"
+    cloud = o3d.io.read_point_cloud(inp)
+    if tensor:
+        cloud = o3d.t.geometry.PointCloud.from_legacy(cloud, o3d.core.float32)
+    ms, kept = repeat(lambda: open3d_time(o3d, cloud, name, tensor), runs, warm)
+    print(json.dumps([ms, kept]))
+
+
 # `autoshovel filter` flags of each filter, for the whole-process timing.
 OUR_FLAGS = {
     "pass_through": ["--pass", "z:0.1:1e30"],
@@ -137,6 +168,9 @@ def process_ms(cmd):
 
 
 def main():
+    if sys.argv[1:2] == ["--open3d-one"]:
+        open3d_one(sys.argv[2:])
+        return
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=3)
     ap.add_argument("--big-runs", type=int, default=1,
@@ -148,6 +182,9 @@ def main():
     ap.add_argument("--process", action="store_true",
                     help="also time `autoshovel filter` and the PCL tool as whole processes (read, filter, write)")
     ap.add_argument("--markdown", help="also write the table to this file")
+    ap.add_argument("--peer-timeout", type=float, default=None,
+                    help="at 5 M points and more, run each Open3D call in a child process and stop it after this "
+                         "many seconds (the cell then gives the bound); PCL and ours always run to the end")
     ap.add_argument("--memory-limit-gb", type=float, default=None,
                     help="address-space limit of this script and its children (default: 3/4 of the machine's memory), "
                          "so that a peer that runs out fails alone instead of the machine killing the run")
@@ -249,8 +286,12 @@ def main():
             if cloud is not None:
                 # At 5 M points and more, --big-runs runs and no warm-up, as PCL.
                 big = n_points >= 5_000_000
-                o3d_ms, o3d_n = repeat(lambda: open3d_time(o3d, cloud, name, False), pcl_runs_n, not big)
-                o3t_ms, o3t_n = repeat(lambda: open3d_time(o3d, cloud_t, name, True), pcl_runs_n, not big)
+                if big and args.peer_timeout:
+                    o3d_ms, o3d_n = open3d_in_child(inp, name, False, pcl_runs_n, False, args.peer_timeout)
+                    o3t_ms, o3t_n = open3d_in_child(inp, name, True, pcl_runs_n, False, args.peer_timeout)
+                else:
+                    o3d_ms, o3d_n = repeat(lambda: open3d_time(o3d, cloud, name, False), pcl_runs_n, not big)
+                    o3t_ms, o3t_n = repeat(lambda: open3d_time(o3d, cloud_t, name, True), pcl_runs_n, not big)
                 peers += [m for m in (o3d_ms, o3t_ms) if m is not None]
                 o3d_cells = tuple(f"{m:.1f}" if m is not None else n for m, n in ((o3d_ms, o3d_n), (o3t_ms, o3t_n))) \
                     + (str(o3d_n) if o3d_ms is not None else "–", str(o3t_n) if o3t_ms is not None else "–")

@@ -15,6 +15,7 @@ mod cloud;
 mod error;
 pub mod filter;
 pub mod io;
+mod room;
 
 pub use cloud::{Point, PointCloud};
 pub use error::{CloudError, Result};

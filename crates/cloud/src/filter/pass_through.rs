@@ -178,6 +178,7 @@ where
         .zip(points.par_chunks(CHUNK))
         .enumerate()
         .map(|(chunk, (dst, src))| {
+            crate::room::populate(dst);
             let mut n = 0;
             for (j, p) in src.iter().enumerate() {
                 dst[n].write(out(chunk * CHUNK + j, p));

@@ -16,12 +16,12 @@
 //! refuses a leaf whose linear voxel index would overflow an `int32`
 //! ("Leaf size is too small for the input dataset. Integer indices would
 //! overflow.") and returns the input unchanged; here voxel coordinates are
-//! i64, and the points are sorted by voxel through one u64 holding the
-//! linear voxel index and the point index when the occupied box has at most
-//! 2³² voxels (bucketed by the voxel bits in parallel chunks, each bucket
-//! sorted: `bucketed_centroids`), through (u64 linear
-//! index, point index) pairs below 2⁶⁴ voxels, and through (z, y, x) i64
-//! triplets beyond, so any leaf whose products stay finite in f32 works.
+//! i64, and the points are sorted by voxel through their linear voxel
+//! index when the occupied box has at most 2³² voxels (bucketed by its top
+//! bits in parallel chunks, each bucket sorted stably by the rest:
+//! `bucketed_centroids`), through (u64 linear index, point index) pairs
+//! below 2⁶⁴ voxels, and through (z, y, x) i64 triplets beyond, so any leaf
+//! whose products stay finite in f32 works.
 //!
 //! Open3D's `voxel_down_sample` anchors its grid at `min_bound − leaf/2`
 //! and computes in f64, so its voxels differ from PCL's.
@@ -185,9 +185,9 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
         let c = [0, 1, 2].map(|a| (floor_i64(v[a]) - lo[a]) as u64);
         c[0] + c[1] * ex + c[2] * exy
     };
-    let centroids = if voxels <= 1 << 32 && points.len() <= 1 << 32 {
-        // Usual case: voxel index and point index packed in one u64,
-        // bucketed by the voxel index's top bits, each bucket sorted.
+    let centroids = if voxels <= 1 << 32 {
+        // Usual case: bucketed by the voxel index's top bits, each bucket
+        // sorted by the rest.
         bucketed_centroids(points, voxels as u64, &linear)
     } else if voxels <= u128::from(u64::MAX) {
         let mut keys: Vec<(u64, usize)> = points
@@ -239,34 +239,46 @@ impl VoxelCells {
     }
 }
 
-/// Points a bucket of [`bucketed_centroids`] holds on average (at most).
-const BUCKET: usize = 8;
+/// Points a bucket of [`bucketed_centroids`] holds on average (at most):
+/// every chunk keeps a start a bucket, and every bucket gathers from every
+/// chunk, so fewer buckets mean fewer starts and gathers, and a bucket's
+/// sort stays in the first-level cache (1 M bench pile: 15.8–17.3 ms with
+/// 128, 16.3–17.7 with 8).
+const BUCKET: usize = 128;
 
-/// Most buckets of [`bucketed_centroids`] (2¹⁷): every chunk keeps a start
-/// a bucket, and every bucket gathers from every chunk, so on a large
-/// cloud more buckets cost more than their sorts save (the 20 M bench
-/// pile, 2²² buckets: 0.75–0.99 s; 2¹⁶ or 2¹⁷: 0.41–0.49 s with
-/// [`MAX_CHUNK`]; 2¹⁷ is what a 1 M cloud takes anyway).
+/// Most buckets of [`bucketed_centroids`] (2¹⁷): on a large cloud more
+/// buckets cost more than their sorts save (the 20 M bench pile, 2²²
+/// buckets: 0.75–0.99 s; 2¹⁶ or 2¹⁷: 0.41–0.49 s with [`MAX_CHUNK`], with
+/// entries of 24 bytes then).
 const MAX_BUCKET_BITS: u32 = 17;
 
 /// Most points of a chunk of [`bucketed_centroids`]: a chunk's entries
-/// (24 bytes a point) stay within the caches' reach and the allocator's
-/// reuse, where an eighth of a large cloud is fresh memory (the 20 M bench
-/// pile: 0.82 s with chunks of 2.5 M points, 0.41–0.45 s with 2¹⁷).
+/// stay within the caches' reach and the allocator's reuse, where an
+/// eighth of a large cloud is fresh memory (the 20 M bench pile, entries of
+/// 24 bytes then: 0.82 s with chunks of 2.5 M points, 0.41–0.45 s with 2¹⁷).
 const MAX_CHUNK: usize = 1 << 17;
 
+/// A point filed by [`bucketed_centroids`]: its voxel's linear index less
+/// the bucket's bits, and the point itself (16 bytes). The point's index is
+/// not kept: every step keeps a voxel's points in input order (chunks in
+/// order, each counting-sorted stably, each bucket sorted stably), and the
+/// entries are most of the memory the grid writes at 20 M points.
+#[derive(Debug, Clone, Copy, PartialEq)]
+struct Entry {
+    voxel: u32,
+    point: Point,
+}
+
 /// The centroids of the occupied voxels in linear-index order, for a box
-/// of at most 2³² `voxels` and at most 2³² points; `linear` gives a
-/// finite point's voxel index. Each point becomes a key (voxel index above,
-/// point index below) with its coordinates. Why not one sort of all keys:
-/// the cloud is cut into chunks (a few a thread, at most [`MAX_CHUNK`]
-/// points), and each chunk is counting-sorted on its own (in cache, in
-/// parallel) into buckets by the voxel index's top bits (a few points a
-/// bucket, at most 2^[`MAX_BUCKET_BITS`] buckets); then each bucket's parts
-/// (in chunk order) are gathered, sorted by key (the point index keeps
-/// each voxel's points in input order) and summed, buckets in parallel. No
-/// pass over the whole cloud is serial, and the centroids read the points
-/// from the gathered parts, not at random from the cloud.
+/// of at most 2³² `voxels`; `linear` gives a finite point's voxel index.
+/// Why not one sort of all keys: the cloud is cut into chunks (a few a
+/// thread, at most [`MAX_CHUNK`] points), and each chunk is counting-sorted
+/// on its own (in cache, in parallel) into buckets by the voxel index's top
+/// bits (a few points a bucket, at most 2^[`MAX_BUCKET_BITS`] buckets); then
+/// each bucket's parts (in chunk order) are gathered, sorted stably by voxel
+/// and summed, buckets in parallel. No pass over the whole cloud is serial,
+/// and the centroids read the points from the gathered parts, not at random
+/// from the cloud.
 fn bucketed_centroids<L>(points: &[Point], voxels: u64, linear: &L) -> Vec<Point>
 where
     L: Fn(&Point) -> u64 + Sync,
@@ -276,40 +288,53 @@ where
     let bucket_bits = (usize::BITS - (n / BUCKET).max(1).leading_zeros())
         .min(voxel_bits)
         .min(MAX_BUCKET_BITS);
+    // At most 31: `voxels` ≤ 2³² and at least one bucket bit.
     let shift = voxel_bits - bucket_bits;
+    let low = (1u64 << shift) - 1;
     let buckets = 1usize << bucket_bits;
-    let bucket = |key: u64| ((key >> 32) >> shift) as usize;
-    // Each chunk counting-sorted by bucket: its entries and bucket starts.
+    let bucket = |key: u64| (key >> shift) as usize;
+    const NOT_FINITE: u64 = u64::MAX;
     let chunk = n
         .div_ceil(rayon::current_num_threads() * 4)
         .clamp(1 << 12, MAX_CHUNK);
-    // Per chunk: its (key, point) entries by bucket, and the bucket starts.
-    type Part = (Vec<(u64, Point)>, Vec<u32>);
+    // Per chunk: its entries by bucket, and `start`, where bucket b's
+    // entries are `start[b]..start[b + 1]`. Each thread reuses one buffer
+    // for its chunks' voxel indices.
+    type Part = (Vec<Entry>, Vec<u32>);
     let parts: Vec<Part> = points
         .par_chunks(chunk)
-        .enumerate()
-        .map(|(c, ps)| {
-            let base = c * chunk;
-            let keyed: Vec<(u64, Point)> = ps
-                .iter()
-                .enumerate()
-                .filter(|(_, p)| is_finite(p))
-                .map(|(i, p)| ((linear(p) << 32) | (base + i) as u64, *p))
-                .collect();
-            let mut start = vec![0u32; buckets + 1];
-            for (k, _) in &keyed {
-                start[bucket(*k) + 1] += 1;
+        .map_init(Vec::new, |keys: &mut Vec<u64>, ps| {
+            keys.clear();
+            keys.extend(
+                ps.iter()
+                    .map(|p| if is_finite(p) { linear(p) } else { NOT_FINITE }),
+            );
+            // Counted at b + 2, summed so that start[b + 1] is bucket b's
+            // start, which the filing below moves on to its end (the next
+            // bucket's start), leaving start[b] as bucket b's start.
+            let mut start = vec![0u32; buckets + 2];
+            for &k in keys.iter().filter(|&&k| k != NOT_FINITE) {
+                start[bucket(k) + 2] += 1;
             }
-            for b in 0..buckets {
-                start[b + 1] += start[b];
+            for b in 1..buckets + 2 {
+                start[b] += start[b - 1];
             }
-            let mut next = start.clone();
-            let mut sorted = vec![(0u64, [0.0f32; 3]); keyed.len()];
-            for e in keyed {
-                let slot = &mut next[bucket(e.0)];
-                sorted[*slot as usize] = e;
+            let total = start[buckets + 1] as usize;
+            let mut sorted: Vec<Entry> = crate::room::with_room(total);
+            let room = &mut sorted.spare_capacity_mut()[..total];
+            for (&k, p) in keys.iter().zip(ps).filter(|(&k, _)| k != NOT_FINITE) {
+                let slot = &mut start[bucket(k) + 1];
+                room[*slot as usize].write(Entry {
+                    voxel: (k & low) as u32,
+                    point: *p,
+                });
                 *slot += 1;
             }
+            // SAFETY: a counting sort: bucket b's count of entries went to
+            // its own slots start(b)..start(b + 1), so each of the `total`
+            // slots was written exactly once. Not zeroed first: that was a
+            // pass over fresh memory.
+            unsafe { sorted.set_len(total) };
             (sorted, start)
         })
         .collect();
@@ -332,10 +357,11 @@ where
                 }
                 if scratch.len() >= RADIX_FROM {
                     radix_sort_voxels(&mut scratch, &mut spare, shift);
-                } else if !scratch.is_sorted_by_key(|e| e.0) {
-                    scratch.sort_unstable_by_key(|e| e.0);
+                } else if !scratch.is_sorted_by_key(|e| e.voxel) {
+                    // Stable: a voxel's points stay in input order.
+                    scratch.sort_by_key(|e| e.voxel);
                 }
-                push_centroids(&scratch, |e| e.0 >> 32, |e| e.1, &mut out);
+                push_centroids(&scratch, |e| e.voxel, |e| e.point, &mut out);
             }
             out
         })
@@ -347,20 +373,18 @@ where
 /// a comparison sort is quicker).
 const RADIX_FROM: usize = 32;
 
-/// Sorts `entries` (voxel index in the high half of the key, point index
-/// in the low half, ascending among equal voxels) by the low `bits` bits
-/// of their voxel index, the rest being equal: a stable least-significant-
-/// digit radix sort on digits of 8 bits (a digit all entries share is
-/// passed over), so each voxel's points keep their order. `spare` is
-/// scratch.
+/// Sorts `entries` by the low `bits` bits of their voxel index: a stable
+/// least-significant-digit radix sort on digits of 8 bits (a digit all
+/// entries share is passed over), so each voxel's points keep their order.
+/// `spare` is scratch.
 #[inline]
-fn radix_sort_voxels(entries: &mut Vec<(u64, Point)>, spare: &mut Vec<(u64, Point)>, bits: u32) {
+fn radix_sort_voxels(entries: &mut Vec<Entry>, spare: &mut Vec<Entry>, bits: u32) {
     let mut count = [0u32; 257];
     let mut at = 0;
     while at < bits {
-        let (from, width) = (32 + at, (bits - at).min(8));
+        let (from, width) = (at, (bits - at).min(8));
         let digits = 1 << width;
-        let digit = |e: &(u64, Point)| ((e.0 >> from) & (digits as u64 - 1)) as usize;
+        let digit = |e: &Entry| ((e.voxel >> from) & (digits as u32 - 1)) as usize;
         count[..=digits].fill(0);
         for e in entries.iter() {
             count[digit(e) + 1] += 1;
@@ -376,7 +400,13 @@ fn radix_sort_voxels(entries: &mut Vec<(u64, Point)>, spare: &mut Vec<(u64, Poin
             count[d + 1] += count[d];
         }
         spare.clear();
-        spare.resize(entries.len(), (0, [0.0; 3]));
+        spare.resize(
+            entries.len(),
+            Entry {
+                voxel: 0,
+                point: [0.0; 3],
+            },
+        );
         for e in entries.iter() {
             let slot = &mut count[digit(e)];
             spare[*slot as usize] = *e;
@@ -451,26 +481,25 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{floor_i64, radix_sort_voxels};
+    use super::{floor_i64, radix_sort_voxels, Entry};
 
     #[test]
     fn radix_sort_orders_voxels_and_keeps_each_voxels_points_in_order() {
         let mut next = super::super::common::below(9);
         for trial in 0..2_000 {
-            let bits = 1 + (trial % 20) as u32;
-            let high = next(1 << 10) << bits;
+            let bits = 1 + (trial % 31) as u32;
             let n = next(300) as usize;
-            // Ascending point indices, voxels at random within the bucket
-            // (from few distinct to all different).
+            // Voxels at random below 2^bits (from few distinct to all
+            // different), each point marked with its place in the input.
             let spread = 1 + next(1 << bits);
-            let mut entries: Vec<(u64, [f32; 3])> = (0..n)
-                .map(|i| {
-                    let voxel = high | next(spread);
-                    ((voxel << 32) | i as u64, [i as f32, 0.0, 0.0])
+            let mut entries: Vec<Entry> = (0..n)
+                .map(|i| Entry {
+                    voxel: next(spread) as u32,
+                    point: [i as f32, 0.0, 0.0],
                 })
                 .collect();
             let mut want = entries.clone();
-            want.sort_by_key(|e| e.0);
+            want.sort_by_key(|e| e.voxel);
             radix_sort_voxels(&mut entries, &mut Vec::new(), bits);
             assert!(entries == want, "bits {bits}, {n} entries");
         }

@@ -271,6 +271,8 @@ impl<'s> Points<'s> {
         let n = claimed.min(possible);
         if let Ok(n) = usize::try_from(n) {
             self.points.reserve(n);
+            // Its pages mapped now, in one call, not by a fault a page.
+            crate::room::populate(&mut self.points.spare_capacity_mut()[..n]);
         }
     }
 
