@@ -23,32 +23,44 @@ const FROM_BYTES: usize = 1 << 16;
 /// offers it (Linux 5.14 and later); elsewhere, or on a refusal, it does
 /// nothing and the pages come by faults as usual. Only the whole pages inside
 /// `room` are asked for. The contents stay as they were (uninitialised).
-pub(crate) fn populate<T>(room: &mut [MaybeUninit<T>]) {
+/// Returns whether the kernel mapped them (false below [`FROM_BYTES`], off
+/// Linux, or on a kernel without the call).
+pub(crate) fn populate<T>(room: &mut [MaybeUninit<T>]) -> bool {
     let bytes = std::mem::size_of_val(room);
     if bytes < FROM_BYTES {
-        return;
+        return false;
     }
     #[cfg(target_os = "linux")]
     {
-        const PAGE: usize = 4096;
-        let start = room.as_mut_ptr() as usize;
-        let first = start.next_multiple_of(PAGE);
-        let end = (start + bytes) / PAGE * PAGE;
+        let (first, end) = whole_pages(room.as_mut_ptr() as usize, bytes);
         if end > first {
             // SAFETY: [first, end) lies inside `room`, memory this process
             // owns and may write; MADV_POPULATE_WRITE only maps its pages
             // (as a write would, contents unchanged) and changes no data
-            // the program can see. Its result is only a hint's: on an error
-            // (EINVAL before Linux 5.14) nothing was changed.
-            unsafe {
+            // the program can see. On an error (EINVAL before Linux 5.14)
+            // nothing was changed, and the pages come by faults.
+            let done = unsafe {
                 libc::madvise(
                     first as *mut libc::c_void,
                     end - first,
                     libc::MADV_POPULATE_WRITE,
-                );
-            }
+                )
+            };
+            return done == 0;
         }
     }
+    false
+}
+
+/// Bytes in a page, the unit `madvise` works in.
+#[cfg(target_os = "linux")]
+const PAGE: usize = 4096;
+
+/// The first and end addresses of the whole pages within `bytes` from
+/// `start`.
+#[cfg(target_os = "linux")]
+fn whole_pages(start: usize, bytes: usize) -> (usize, usize) {
+    (start.next_multiple_of(PAGE), (start + bytes) / PAGE * PAGE)
 }
 
 /// Room for `n` values of `T`, its pages mapped by [`populate`]: the
@@ -78,6 +90,32 @@ mod tests {
             populate(&mut u.spare_capacity_mut()[1..]);
             u.resize(n, 7);
             assert!(u.iter().all(|&b| b == 7));
+        }
+    }
+
+    #[cfg(target_os = "linux")]
+    #[test]
+    fn populated_pages_are_resident() {
+        // 8 MB just mapped (beyond the allocator's reuse): none of it is
+        // resident until written or populated.
+        let n = 1 << 21;
+        let mut v: Vec<u32> = Vec::with_capacity(n);
+        let room = &mut v.spare_capacity_mut()[..n];
+        let (first, end) = whole_pages(room.as_mut_ptr() as usize, n * 4);
+        let resident = |first: usize, end: usize| {
+            let mut flags = vec![0u8; (end - first) / PAGE];
+            // SAFETY: [first, end) is page-aligned memory of this process
+            // (inside `v`'s allocation) and `flags` has a byte a page.
+            let r = unsafe {
+                libc::mincore(first as *mut libc::c_void, end - first, flags.as_mut_ptr())
+            };
+            assert_eq!(r, 0);
+            flags.iter().filter(|&&f| f & 1 == 1).count()
+        };
+        if populate(room) {
+            assert_eq!(resident(first, end), (end - first) / PAGE);
+        } else {
+            eprintln!("this kernel has no MADV_POPULATE_WRITE: nothing to check");
         }
     }
 }
