@@ -270,9 +270,9 @@ impl<'s> Points<'s> {
         let possible = bytes_left / min_bytes_per_point.max(1);
         let n = claimed.min(possible);
         if let Ok(n) = usize::try_from(n) {
+            // Not populated (`crate::room`): a text file's bound is loose,
+            // and the read stage gained nothing measurable from it.
             self.points.reserve(n);
-            // Its pages mapped now, in one call, not by a fault a page.
-            crate::room::populate(&mut self.points.spare_capacity_mut()[..n]);
         }
     }
 
