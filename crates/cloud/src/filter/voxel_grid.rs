@@ -263,7 +263,7 @@ const MAX_CHUNK: usize = 1 << 17;
 /// not kept: every step keeps a voxel's points in input order (chunks in
 /// order, each counting-sorted stably, each bucket sorted stably), and the
 /// entries are most of the memory the grid writes at 20 M points.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Entry {
     voxel: u32,
     point: Point,
@@ -400,13 +400,7 @@ fn radix_sort_voxels(entries: &mut Vec<Entry>, spare: &mut Vec<Entry>, bits: u32
             count[d + 1] += count[d];
         }
         spare.clear();
-        spare.resize(
-            entries.len(),
-            Entry {
-                voxel: 0,
-                point: [0.0; 3],
-            },
-        );
+        spare.resize(entries.len(), Entry::default());
         for e in entries.iter() {
             let slot = &mut count[digit(e)];
             spare[*slot as usize] = *e;

@@ -28,9 +28,9 @@
 //! columns searched nearest box first, and a block's columns nearest
 //! first (a k-d tree built for them at 2 M points and more answered them
 //! more slowly since, and took 0.8 GB more at 20 M). A grid searched once
-//! may be searched again with
-//! some points dropped (`Grid::retain`: the statistical filter on what
-//! the radius filter kept, on columns sized for both). In place of the
+//! may be searched again with some points dropped (`Grid::retain`: the
+//! statistical filter on what the radius filter kept, on columns sized for
+//! both). In place of the
 //! tree's walk with a branch a node, a query costs a few look-ups and
 //! some six times k distances:
 //! the statistical filter on the 1 M-point bench pile fell from 2.15 s
