@@ -41,8 +41,9 @@
 //! same way. The cleaned cloud is handed on tile by tile, and a height
 //! model (mean height per cell) is kept over the whole survey.
 //!
-//! **Memory.** One tile and its halo at a time (their points and the
-//! filters' structures, about [`BYTES_PER_POINT`] bytes a point), the
+//! **Memory.** The tiles running at once with their halos (their points
+//! and the filters' structures, about [`BYTES_PER_POINT`] bytes a point,
+//! together within [`TileOptions::memory_limit`] in [`InProcess`]), the
 //! sample, the height model, and per tile a buffer of points on their way
 //! to disk; a tile that would need more than [`TileOptions::memory_limit`]
 //! is an error that names it. The working files live in a folder of their
@@ -56,8 +57,9 @@
 //! a [`TileExecutor`] and waits for all of them before the next; the
 //! statistical filter is two rounds, the mean distances and then the cut,
 //! with the sums of [RS eq. 14] added in survey order by the driver
-//! between them. [`perceive_tiled`] runs the tasks one after another here
-//! ([`InProcess`]); the Python package's Ray executor spreads them over a
+//! between them. [`perceive_tiled`] runs the tasks here ([`InProcess`]:
+//! as many tiles at once as there are cores, while they fit the memory
+//! limit together); the Python package's Ray executor spreads them over a
 //! cluster, with the same result bit for bit.
 
 mod store;
@@ -519,7 +521,7 @@ pub fn peak_memory() -> Option<u64> {
 }
 
 /// The pipeline of [`crate::perceive`] on a survey by tiles (module docs),
-/// each stage's tiles one after another in this process.
+/// each stage's tiles run in this process ([`InProcess`]).
 /// `progress(what, done, total)` reports each pass; `on_tile` receives each
 /// tile's cleaned points as they are done (its error stops the run).
 pub fn perceive_tiled(

@@ -1,12 +1,13 @@
 //! A stage's work on one tile as a unit that can run anywhere that sees
 //! the run's working folder: [`TileTask`] in, [`TileReport`] out, through
 //! [`run_tile_task`]. The driver ([`super::perceive_tiled_with`]) makes a
-//! stage's tasks, hands them to a [`TileExecutor`] (this process, one
-//! after another: [`InProcess`]; or another machine's workers, as the
+//! stage's tasks, hands them to a [`TileExecutor`] (this process, a tile
+//! per core: [`InProcess`]; or another machine's workers, as the
 //! Python package's Ray executor does), and waits for every report before
 //! the next stage.
 
 use std::path::PathBuf;
+use std::sync::{mpsc, Condvar, Mutex};
 
 use autoshovel_cloud::filter::{
     bilateral_normal_smoothing, mean_distances_and_reach, mean_distances_and_reach_at,
@@ -93,6 +94,12 @@ impl TileTask {
     pub fn points(&self) -> u64 {
         self.own[self.tile] + self.halo.iter().map(|h| h.1).sum::<u64>()
     }
+
+    /// Working memory the task needs [bytes] (its points at
+    /// [`BYTES_PER_POINT`]).
+    pub fn need(&self) -> u64 {
+        self.points().saturating_mul(BYTES_PER_POINT)
+    }
 }
 
 /// What a task did.
@@ -125,7 +132,13 @@ pub trait TileExecutor {
     ) -> Result<Vec<TileReport>>;
 }
 
-/// Tasks one after another in this process, each tile on every core.
+/// Tasks in this process: as many at once as rayon has threads, while
+/// the tiles running fit the memory limit together (each tile's loaded
+/// points at [`BYTES_PER_POINT`]); a tile too large to share the limit
+/// runs alone. Each tile's filters use every core too, so one tile's
+/// serial parts (reading and writing its files, merging its halo) overlap
+/// another's parallel ones. A failed task stops the handing out; the
+/// error of the first failed task in the stage's order is returned.
 #[derive(Debug, Clone, Copy, Default)]
 pub struct InProcess;
 
@@ -137,13 +150,107 @@ impl TileExecutor for InProcess {
         progress: &mut dyn FnMut(&str, u64, u64),
     ) -> Result<Vec<TileReport>> {
         let n = tasks.len() as u64;
-        let mut reports = Vec::with_capacity(tasks.len());
-        for (i, task) in tasks.iter().enumerate() {
-            progress(stage, i as u64, n);
-            reports.push(run_tile_task(task)?);
+        progress(stage, 0, n);
+        let workers = rayon::current_num_threads().min(tasks.len());
+        if workers <= 1 {
+            let mut reports = Vec::with_capacity(tasks.len());
+            for (i, task) in tasks.iter().enumerate() {
+                reports.push(run_tile_task(task)?);
+                progress(stage, i as u64 + 1, n);
+            }
+            return Ok(reports);
         }
-        progress(stage, n, n);
-        Ok(reports)
+        let limit = tasks.iter().map(|t| t.memory_limit).min().unwrap_or(0);
+        let gate = Gate::new(tasks.iter().map(TileTask::need).collect(), limit);
+        let (sent, got) = mpsc::channel();
+        std::thread::scope(|scope| {
+            for _ in 0..workers {
+                let sent = sent.clone();
+                let (gate, tasks) = (&gate, &tasks);
+                scope.spawn(move || {
+                    while let Some(i) = gate.claim() {
+                        let report = run_tile_task(&tasks[i]);
+                        gate.release(i, report.is_err());
+                        if sent.send((i, report)).is_err() {
+                            return;
+                        }
+                    }
+                });
+            }
+            drop(sent);
+            let mut reports = Vec::with_capacity(tasks.len());
+            let mut failed: Option<(usize, SurfaceError)> = None;
+            for (i, report) in got {
+                match report {
+                    Ok(r) => reports.push(r),
+                    Err(e) if failed.as_ref().is_none_or(|f| i < f.0) => failed = Some((i, e)),
+                    Err(_) => {}
+                }
+                progress(stage, reports.len() as u64, n);
+            }
+            match failed {
+                Some((_, e)) => Err(e),
+                None => Ok(reports),
+            }
+        })
+    }
+}
+
+/// Hands out [`InProcess`]'s tasks in order, each when its memory fits
+/// beside those running (or nothing runs).
+struct Gate {
+    need: Vec<u64>,
+    limit: u64,
+    state: Mutex<GateState>,
+    freed: Condvar,
+}
+
+#[derive(Default)]
+struct GateState {
+    next: usize,
+    running: usize,
+    in_use: u64,
+    failed: bool,
+}
+
+impl Gate {
+    fn new(need: Vec<u64>, limit: u64) -> Self {
+        Self {
+            need,
+            limit,
+            state: Mutex::new(GateState::default()),
+            freed: Condvar::new(),
+        }
+    }
+
+    /// The next task to run, once it fits; `None` when all are handed out
+    /// or one failed.
+    fn claim(&self) -> Option<usize> {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        loop {
+            if s.failed || s.next >= self.need.len() {
+                return None;
+            }
+            let need = self.need[s.next];
+            if s.running == 0 || s.in_use.saturating_add(need) <= self.limit {
+                let i = s.next;
+                s.next += 1;
+                s.running += 1;
+                s.in_use += need;
+                return Some(i);
+            }
+            s = self.freed.wait(s).unwrap_or_else(|e| e.into_inner());
+        }
+    }
+
+    /// Task `i` is done (or failed).
+    fn release(&self, i: usize, failed: bool) {
+        let mut s = self.state.lock().unwrap_or_else(|e| e.into_inner());
+        s.running -= 1;
+        s.in_use -= self.need[i];
+        s.failed |= failed;
+        drop(s);
+        self.freed.notify_all();
     }
 }
 
@@ -242,7 +349,7 @@ fn too_large(task: &TileTask, tile: String, points: u64) -> SurfaceError {
 fn load(task: &TileTask) -> Result<Loaded> {
     let t = task.tile;
     let points = task.points();
-    if points * BYTES_PER_POINT > task.memory_limit {
+    if task.need() > task.memory_limit {
         return Err(too_large(task, task.grid.name(t), points));
     }
     let own = read_checked(&own_path(&task.input, t), task.own[t])?;
@@ -431,4 +538,72 @@ fn voxels_of_tile(
         .collect();
     out.sort_unstable_by_key(|r| r.id);
     Ok(out)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use std::sync::atomic::{AtomicU64, AtomicUsize, Ordering};
+
+    /// Runs `need`'s tasks through a gate of `limit` on `workers` threads,
+    /// failing task `fail`; returns how often each ran and the most memory
+    /// in use while more than one ran.
+    fn through_gate(
+        need: &[u64],
+        limit: u64,
+        workers: usize,
+        fail: Option<usize>,
+    ) -> (Vec<usize>, u64) {
+        let gate = Gate::new(need.to_vec(), limit);
+        let ran: Vec<AtomicUsize> = need.iter().map(|_| AtomicUsize::new(0)).collect();
+        let (in_use, running, shared_peak) =
+            (AtomicU64::new(0), AtomicUsize::new(0), AtomicU64::new(0));
+        std::thread::scope(|scope| {
+            for _ in 0..workers {
+                scope.spawn(|| {
+                    while let Some(i) = gate.claim() {
+                        let now = in_use.fetch_add(need[i], Ordering::SeqCst) + need[i];
+                        if running.fetch_add(1, Ordering::SeqCst) > 0 {
+                            shared_peak.fetch_max(now, Ordering::SeqCst);
+                        }
+                        ran[i].fetch_add(1, Ordering::SeqCst);
+                        // The failing task ends at once, the others later.
+                        if fail != Some(i) {
+                            std::thread::sleep(std::time::Duration::from_millis(10));
+                        }
+                        running.fetch_sub(1, Ordering::SeqCst);
+                        in_use.fetch_sub(need[i], Ordering::SeqCst);
+                        gate.release(i, fail == Some(i));
+                    }
+                });
+            }
+        });
+        (
+            ran.iter().map(|r| r.load(Ordering::SeqCst)).collect(),
+            shared_peak.load(Ordering::SeqCst),
+        )
+    }
+
+    #[test]
+    fn the_gate_hands_out_every_task_once_and_shares_only_what_fits() {
+        // Tasks 3 and 6 alone exceed the limit: they run, but alone.
+        let need = [30, 50, 20, 120, 10, 60, 140, 40, 70, 5];
+        let (ran, peak) = through_gate(&need, 100, 4, None);
+        assert_eq!(ran, vec![1; need.len()]);
+        assert!(
+            peak <= 100,
+            "{peak} bytes in use by tasks sharing a limit of 100"
+        );
+    }
+
+    #[test]
+    fn a_failed_task_stops_the_handing_out() {
+        let need = [10; 40];
+        let (ran, _) = through_gate(&need, 1000, 2, Some(3));
+        assert!(ran.iter().all(|&r| r <= 1));
+        assert_eq!(ran[3], 1);
+        // Once task 3 failed, only a task already claimed beside it may run.
+        let after: usize = ran[4..].iter().sum();
+        assert!(after <= 1, "{after} tasks ran after the failure");
+    }
 }
