@@ -1,10 +1,13 @@
 //! The perception pipeline on a survey larger than memory, by tiles.
 //!
-//! A survey (one LAS/LAZ file or many, in order) is read twice, a chunk at
-//! a time. The first pass finds its bounds and count (the scale and
-//! spacing of [`crate::perceive::scale_and_spacing`]) and keeps every n-th
-//! point as a sample, on which the floor is found and roll and pitch are
-//! estimated ([RS eq. 11]–[RS eq. 12]). The second pass levels each point,
+//! A survey (one LAS/LAZ file or many, in order) is decoded once, a chunk
+//! at a time, and passed over twice. The first pass finds its bounds and
+//! count (the scale and spacing of [`crate::perceive::scale_and_spacing`]),
+//! keeps every n-th point as a sample, on which the floor is found and
+//! roll and pitch are estimated ([RS eq. 11]–[RS eq. 12]), and writes every
+//! point as read to the working folder (12 bytes a point: decoding LAZ
+//! again would cost more than reading them back). The second pass reads
+//! them back, levels each point,
 //! removes the floor (the ground pass-through) and files it under the tile
 //! of the levelled (x, y) grid its position falls in. Then each stage of
 //! the pipeline ([RS eq. 13]–[RS eq. 20]) runs tile by tile, each tile
@@ -48,7 +51,8 @@
 //! to disk; a tile that would need more than [`TileOptions::memory_limit`]
 //! is an error that names it. The working files live in a folder of their
 //! own under [`TileOptions::work_dir`], removed when the run ends, failed
-//! or not.
+//! or not: on disk, about 12 bytes per point read until the second pass
+//! ends, and a stage's points with their halo copies (20 bytes a point).
 //!
 //! **Anywhere.** Within a stage, tiles are independent: each is a
 //! [`TileTask`] (serialisable) that [`run_tile_task`] runs wherever the
@@ -80,7 +84,7 @@ use autoshovel_cloud::{CloudError, Point, PointCloud};
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use store::{dist_path, Filing, Grid, Rec, Stage, DIST_RECORD};
+use store::{dist_path, Filing, Grid, RawSpill, Rec, Stage, DIST_RECORD};
 use task::{filter_err, Step};
 pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
@@ -332,7 +336,8 @@ pub struct TiledPerceived {
     /// Statistical-filter points searched again past the halo.
     pub statistical_researched: u64,
     /// Each stage's count and time, as [`crate::perceive::Perceived::stages`]
-    /// ("read" is both passes over the files; "write" hands the cleaned
+    /// ("read" is both passes over the points, decoding and filing by
+    /// tile; "write" hands the cleaned
     /// tiles on and fills the height model).
     pub stages: Vec<StageRecord>,
     /// Points of the cleaned survey.
@@ -574,6 +579,11 @@ pub fn perceive_tiled_with(
     let mut sample: Vec<Point> = Vec::new();
     let threads = rayon::current_num_threads();
     let origin = survey.origin();
+    let work = tempdir_in(&options.work_dir)?;
+    // The points as read, for the second pass (decoding a LAZ survey
+    // again costs more than reading them back).
+    let mut raw = RawSpill::create(work.0.join("read"))?;
+    let mut spill_failed: Option<SurfaceError> = None;
     let reports = read_files_in_order(
         &survey.files,
         origin,
@@ -581,7 +591,7 @@ pub fn perceive_tiled_with(
         threads,
         LOOKAHEAD,
         &mut |done, _| progress("reading (1 of 2)", done, claimed),
-        &mut |_, chunk: &[Point]| {
+        &mut |f, chunk: &[Point]| {
             for q in chunk {
                 for a in 0..3 {
                     lo[a] = lo[a].min(q[a]);
@@ -592,9 +602,21 @@ pub fn perceive_tiled_with(
                 }
                 n += 1;
             }
+            if let Err(e) = raw.put(chunk) {
+                spill_failed = Some(e);
+                return Err(CloudError::Format {
+                    path: survey.files[f].clone(),
+                    what: "stopped: the working copy of the points failed".into(),
+                });
+            }
             Ok(())
         },
-    )?;
+    );
+    if let Some(e) = spill_failed.take() {
+        return Err(e);
+    }
+    let reports = reports?;
+    let mut raw = raw.finish()?;
     let non_finite: u64 = reports.iter().map(|r| r.non_finite_dropped as u64).sum();
     let format = reports.first().map_or("", |r| r.format);
     if n == 0 {
@@ -672,7 +694,6 @@ pub fn perceive_tiled_with(
     }
     // Rounding of f32 positions far from the origin.
     let halo = halo * (1.0 + 1e-6) + 1e-6 * (grid.origin[0].abs() + grid.origin[1].abs());
-    let work = tempdir_in(&options.work_dir)?;
     // Pass 2: level, remove the floor, file by tile.
     let t1 = Instant::now();
     let threshold = floor.floor_height_m + p.ground.margin_m * scale;
@@ -681,52 +702,42 @@ pub fn perceive_tiled_with(
     let mut id = 0u64;
     let mut by_tile: Vec<Vec<Rec>> = vec![Vec::new(); grid.tiles()];
     let mut level_ms = 0.0;
-    let mut failed: Option<SurfaceError> = None;
-    let read = read_files_in_order(
-        &survey.files,
-        origin,
-        READ_CHUNK,
-        threads,
-        LOOKAHEAD,
-        &mut |done, _| progress("reading (2 of 2)", done, n),
-        &mut |f, chunk: &[Point]| {
-            let t = Instant::now();
-            let levelled = PointCloud::new(chunk.iter().map(|q| rotate_point(&r, q)).collect());
-            level_ms += elapsed_ms(t);
-            // A chunk wholly at or below the floor keeps nothing (an
-            // error only if the whole survey does).
-            let kept = match pass_through_indices(&levelled, &ground) {
-                Ok(k) => k,
-                Err(CloudError::Emptied { .. }) => Vec::new(),
-                Err(e) => return Err(e),
-            };
-            for i in kept {
-                let q = levelled.points[i];
-                by_tile[grid.tile_of(&q)].push(Rec {
-                    id: id + i as u64,
-                    p: q,
-                });
+    let mut chunk = Vec::with_capacity(READ_CHUNK);
+    while raw.next_chunk(&mut chunk, READ_CHUNK)? {
+        progress("reading (2 of 2)", id, n);
+        let t = Instant::now();
+        let levelled = PointCloud::new(chunk.iter().map(|q| rotate_point(&r, q)).collect());
+        level_ms += elapsed_ms(t);
+        // A chunk wholly at or below the floor keeps nothing (an error
+        // only if the whole survey does).
+        let kept = match pass_through_indices(&levelled, &ground) {
+            Ok(k) => k,
+            Err(CloudError::Emptied { .. }) => Vec::new(),
+            Err(e) => return Err(e.into()),
+        };
+        for i in kept {
+            let q = levelled.points[i];
+            by_tile[grid.tile_of(&q)].push(Rec {
+                id: id + i as u64,
+                p: q,
+            });
+        }
+        id += chunk.len() as u64;
+        for (t, pending) in by_tile.iter_mut().enumerate() {
+            if !pending.is_empty() {
+                let recs = std::mem::take(pending);
+                lists.put(&grid, t, &recs, halo)?;
             }
-            id += chunk.len() as u64;
-            for (t, pending) in by_tile.iter_mut().enumerate() {
-                if !pending.is_empty() {
-                    let recs = std::mem::take(pending);
-                    if let Err(e) = lists.put(&grid, t, &recs, halo) {
-                        failed = Some(e);
-                        return Err(CloudError::Format {
-                            path: survey.files[f].clone(),
-                            what: "stopped: a tile's working file failed".into(),
-                        });
-                    }
-                }
-            }
-            Ok(())
-        },
-    );
-    if let Some(e) = failed.take() {
-        return Err(e);
+        }
     }
-    read?;
+    progress("reading (2 of 2)", n, n);
+    if id != n {
+        return Err(SurfaceError::TileFile {
+            path: raw.path.clone(),
+            problem: format!("holds {id} points where {n} were written"),
+        });
+    }
+    raw.remove();
     let mut lists = lists.finish()?;
     let read2_ms = elapsed_ms(t1);
 

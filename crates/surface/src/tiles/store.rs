@@ -10,9 +10,14 @@
 //! lost) leaves the same file. Every file's count is recorded by whoever
 //! wrote it and checked by whoever reads it: a worker that does not see
 //! the run's folder fails naming the file rather than reading nothing.
+//!
+//! The first pass over the survey also keeps every point it read, as read
+//! (x, y, z as f32, 12 bytes a point), in `read` under the run's folder:
+//! the second pass reads them back rather than decoding the files again
+//! ([`RawSpill`], [`RawBack`]).
 
-use std::fs::{self, OpenOptions};
-use std::io::Write;
+use std::fs::{self, File, OpenOptions};
+use std::io::{BufReader, BufWriter, Read, Write};
 use std::path::{Path, PathBuf};
 
 use autoshovel_cloud::{Point, PointCloud};
@@ -29,6 +34,106 @@ pub(super) const DIST_RECORD: usize = 12;
 
 /// Points the driver buffers per tile before appending them to its file.
 const FLUSH_POINTS: usize = 1 << 14;
+
+/// Bytes of a point as read: x, y, z (f32), little-endian.
+const RAW_RECORD: usize = 12;
+
+/// The points of the first pass, written as they come ([`RawSpill::put`]).
+pub(super) struct RawSpill {
+    path: PathBuf,
+    file: BufWriter<File>,
+    bytes: Vec<u8>,
+    points: u64,
+}
+
+impl RawSpill {
+    pub fn create(path: PathBuf) -> Result<Self> {
+        let file = File::create(&path).map_err(spill(&path))?;
+        Ok(Self {
+            file: BufWriter::with_capacity(1 << 20, file),
+            path,
+            bytes: Vec::new(),
+            points: 0,
+        })
+    }
+
+    /// Appends `points`.
+    pub fn put(&mut self, points: &[Point]) -> Result<()> {
+        self.bytes.clear();
+        for q in points {
+            for c in q {
+                self.bytes.extend_from_slice(&c.to_le_bytes());
+            }
+        }
+        self.file
+            .write_all(&self.bytes)
+            .map_err(spill(&self.path))?;
+        self.points += points.len() as u64;
+        Ok(())
+    }
+
+    /// Ends the writing; the file, to read back from its start.
+    pub fn finish(self) -> Result<RawBack> {
+        let file = self
+            .file
+            .into_inner()
+            .map_err(|e| spill(&self.path)(e.into_error()))?;
+        drop(file);
+        let file = File::open(&self.path).map_err(spill(&self.path))?;
+        let len = file.metadata().map_err(spill(&self.path))?.len();
+        if len != self.points * RAW_RECORD as u64 {
+            return Err(SurfaceError::TileFile {
+                path: self.path,
+                problem: format!(
+                    "holds {len} bytes where {} points were written",
+                    self.points
+                ),
+            });
+        }
+        Ok(RawBack {
+            file: BufReader::with_capacity(1 << 20, file),
+            path: self.path,
+            left: self.points,
+            bytes: Vec::new(),
+        })
+    }
+}
+
+/// The first pass's points read back, a chunk at a time.
+pub(super) struct RawBack {
+    pub path: PathBuf,
+    file: BufReader<File>,
+    left: u64,
+    bytes: Vec<u8>,
+}
+
+impl RawBack {
+    /// The next (up to) `max` points into `chunk`; false when none are left.
+    pub fn next_chunk(&mut self, chunk: &mut Vec<Point>, max: usize) -> Result<bool> {
+        chunk.clear();
+        let take = self.left.min(max as u64) as usize;
+        if take == 0 {
+            return Ok(false);
+        }
+        self.bytes.resize(take * RAW_RECORD, 0);
+        self.file
+            .read_exact(&mut self.bytes)
+            .map_err(spill(&self.path))?;
+        let f = |b: &[u8], at: usize| f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+        chunk.extend(
+            self.bytes
+                .chunks_exact(RAW_RECORD)
+                .map(|b| [f(b, 0), f(b, 4), f(b, 8)]),
+        );
+        self.left -= take as u64;
+        Ok(true)
+    }
+
+    /// Removes the file.
+    pub fn remove(self) {
+        let _ = fs::remove_file(&self.path);
+    }
+}
 
 /// A point on its way: its index in the survey and its position.
 #[derive(Debug, Clone, Copy, PartialEq)]
@@ -412,5 +517,58 @@ impl Loaded {
             }
         }
         Self { recs, own }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn points_spilled_come_back_the_same_in_any_chunks() {
+        let dir = std::env::temp_dir().join(format!("autoshovel-raw-{}", std::process::id()));
+        fs::create_dir_all(&dir).unwrap();
+        let points: Vec<Point> = (0..1000)
+            .map(|i| {
+                let t = i as f32;
+                [t * 0.37 - 100.0, (t * 1.3).sin() * 1e4, -t * 1e-7]
+            })
+            .collect();
+        let mut raw = RawSpill::create(dir.join("read")).unwrap();
+        for c in points.chunks(333) {
+            raw.put(c).unwrap();
+        }
+        raw.put(&[]).unwrap();
+        let mut back = raw.finish().unwrap();
+        let (mut got, mut chunk) = (Vec::new(), Vec::new());
+        while back.next_chunk(&mut chunk, 64).unwrap() {
+            assert!(!chunk.is_empty() && chunk.len() <= 64);
+            got.extend_from_slice(&chunk);
+        }
+        assert_eq!(got, points);
+        back.remove();
+        assert!(!dir.join("read").exists());
+
+        // A copy cut short is an error naming it, not fewer points.
+        let mut raw = RawSpill::create(dir.join("short")).unwrap();
+        raw.put(&points).unwrap();
+        let path = raw.path.clone();
+        raw.file.flush().unwrap();
+        OpenOptions::new()
+            .write(true)
+            .open(&path)
+            .unwrap()
+            .set_len(100)
+            .unwrap();
+        let err = raw
+            .finish()
+            .err()
+            .expect("a short copy is refused")
+            .to_string();
+        assert!(
+            err.contains("short") && err.contains("1000 points"),
+            "{err}"
+        );
+        fs::remove_dir_all(&dir).unwrap();
     }
 }
