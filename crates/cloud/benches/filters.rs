@@ -20,6 +20,9 @@
 //! (`DIR/ours_NAME_SIZE.pcd`), for `peer/bench_peers.py`, which runs PCL and
 //! Open3D on the same clouds and compares. `FILTER_BENCH_ONLY=NAME:SIZE`
 //! (e.g. `statistical:1m`) runs one filter on one cloud, `clouds` none.
+//! `FILTER_BENCH_LEAF=M` sets the voxel grid's leaf [m] (e.g. the
+//! `perceive` voxel stage's, two spacings, on that stage's input given as
+//! `FILTER_BENCH_INPUT`).
 
 use std::io::Write;
 
@@ -28,6 +31,16 @@ use autoshovel_cloud::filter::{
 };
 use autoshovel_cloud::{Point, PointCloud};
 use criterion::{BenchmarkId, Criterion};
+
+/// The voxel leaf [m]: 0.05, or `FILTER_BENCH_LEAF`.
+fn voxel_leaf() -> f64 {
+    static LEAF: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
+    *LEAF.get_or_init(|| {
+        std::env::var("FILTER_BENCH_LEAF").map_or(0.05, |v| {
+            v.parse().expect("FILTER_BENCH_LEAF: a leaf in metres")
+        })
+    })
+}
 
 /// The synthetic pile scan of `n` points.
 pub fn pile(n: usize, seed: u64) -> PointCloud {
@@ -92,7 +105,7 @@ const FILTERS: [(&str, Run); 4] = [
         filter::pass_through(c, &PassThroughParams::ground_removal(0.1)).unwrap()
     }),
     ("voxel_grid", |c| {
-        filter::voxel_grid(c, &VoxelGridParams::cube(0.05)).unwrap()
+        filter::voxel_grid(c, &VoxelGridParams::cube(voxel_leaf())).unwrap()
     }),
     ("radius", |c| {
         filter::radius_outlier_removal(

@@ -688,13 +688,13 @@ fn the_two_sided_rule_also_drops_what_is_unusually_dense() {
     assert!(what(e.unwrap_err()).contains("sides = both"));
 }
 
-/// A cloud large enough to be cut into many chunks and buckets gives the
-/// map of voxels bit for bit (each voxel's points summed in f64 in input
-/// order), whatever the number of threads: points through a cube, and
-/// points on a gentle slope in a box of air (a scan's case: few buckets
-/// occupied, each with many voxels, radix-sorted), and the slope in a box
-/// made 40 m long by one far point (buckets of 2¹⁰ voxel indices: two
-/// radix passes).
+/// A cloud large enough to be cut into many chunks and super-buckets
+/// gives the map of voxels bit for bit (each voxel's points summed in f64
+/// in input order), whatever the number of threads: points through a cube,
+/// and points on a gentle slope in a box of air (a scan's case: few
+/// super-buckets occupied, each with many voxels), and the slope in a box
+/// made 40 m long by one far point (super-buckets of 2²¹ voxel indices:
+/// two radix passes).
 #[test]
 fn a_large_voxel_grid_is_the_map_of_voxels_bit_for_bit() {
     let cube = lcg_cloud(300_000, 3.0, 11);

@@ -133,29 +133,40 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
         }
         Ok(v.map(floor_i64))
     };
-    // Bounds in voxels ([RS eq. 17]), in one parallel pass over the
-    // scaled coordinates (min and max vectorise; ⌊·⌋ is monotonic, so the
-    // bounds' voxels are the voxels' bounds), checked once at the end.
-    let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    let (vlo, vhi) = points
-        .par_chunks(1 << 14)
-        .map(|chunk| {
-            let (mut lo, mut hi) = none();
-            for p in chunk.iter().filter(|p| is_finite(p)) {
-                let v = scaled(p);
-                for a in 0..3 {
-                    lo[a] = lo[a].min(v[a]);
-                    hi[a] = hi[a].max(v[a]);
-                }
-            }
-            (lo, hi)
-        })
-        .reduce(none, |(l1, h1), (l2, h2)| {
-            (
-                [0, 1, 2].map(|a| l1[a].min(l2[a])),
-                [0, 1, 2].map(|a| h1[a].max(h2[a])),
-            )
-        });
+    // Bounds in voxels ([RS eq. 17]), in one parallel pass (⌊·⌋ is
+    // monotonic, so the bounds' voxels are the voxels' bounds; so is
+    // rounding v · (1 / leaf), so the bounds of the points scale to those
+    // of the scaled points), checked once at the end.
+    let (vlo, vhi) = match coordinate_bounds(points) {
+        Some((lo, hi)) => (
+            [0, 1, 2].map(|a| lo[a] * inv[a]),
+            [0, 1, 2].map(|a| hi[a] * inv[a]),
+        ),
+        None => {
+            // A coordinate is not finite: its point's others are passed
+            // over too.
+            let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            points
+                .par_chunks(1 << 14)
+                .map(|chunk| {
+                    let (mut lo, mut hi) = none();
+                    for p in chunk.iter().filter(|p| is_finite(p)) {
+                        let v = scaled(p);
+                        for a in 0..3 {
+                            lo[a] = lo[a].min(v[a]);
+                            hi[a] = hi[a].max(v[a]);
+                        }
+                    }
+                    (lo, hi)
+                })
+                .reduce(none, |(l1, h1), (l2, h2)| {
+                    (
+                        [0, 1, 2].map(|a| l1[a].min(l2[a])),
+                        [0, 1, 2].map(|a| h1[a].max(h2[a])),
+                    )
+                })
+        }
+    };
     if vlo[0] > vhi[0] {
         return Err(super::common::emptied(
             FILTER,
@@ -215,6 +226,53 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
     Ok(PointCloud::new(centroids))
 }
 
+/// The smallest and largest coordinate per axis of `points`, all of whose
+/// coordinates are finite; `None` if one is not. One pass over the
+/// coordinates as a flat array, 16 points a step in lanes that vectorise
+/// (a point at a time, skipping non-finite points, did not: 45 ms of the
+/// 20 M pipeline's voxel stage, 13 M points).
+fn coordinate_bounds(points: &[Point]) -> Option<([f32; 3], [f32; 3])> {
+    const W: usize = 48; // 16 points; lane j holds axis j % 3
+    let (lo, hi, poison) = points
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            let flat = chunk.as_flattened();
+            let (mut lo, mut hi, mut poison) =
+                ([f32::INFINITY; W], [f32::NEG_INFINITY; W], [0.0_f32; W]);
+            let mut blocks = flat.chunks_exact(W);
+            for b in &mut blocks {
+                for j in 0..W {
+                    lo[j] = lo[j].min(b[j]);
+                    hi[j] = hi[j].max(b[j]);
+                    // 0 · v is NaN for an infinite or NaN v, and stays so.
+                    poison[j] += b[j] * 0.0;
+                }
+            }
+            for (j, &v) in blocks.remainder().iter().enumerate() {
+                lo[j] = lo[j].min(v);
+                hi[j] = hi[j].max(v);
+                poison[j] += v * 0.0;
+            }
+            let (mut l, mut h) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+            for j in 0..W {
+                l[j % 3] = l[j % 3].min(lo[j]);
+                h[j % 3] = h[j % 3].max(hi[j]);
+            }
+            (l, h, poison.iter().any(|v| v.is_nan()))
+        })
+        .reduce(
+            || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], false),
+            |(l1, h1, p1), (l2, h2, p2)| {
+                (
+                    [0, 1, 2].map(|a| l1[a].min(l2[a])),
+                    [0, 1, 2].map(|a| h1[a].max(h2[a])),
+                    p1 || p2,
+                )
+            },
+        );
+    (!poison).then_some((lo, hi))
+}
+
 /// The voxel of a point as [`voxel_grid`] computes it (PCL's
 /// `floor(p · (1 / leaf))` in f32), for a caller that must know which
 /// points share a voxel before calling it (a tile deciding which voxels
@@ -239,18 +297,14 @@ impl VoxelCells {
     }
 }
 
-/// Points a bucket of [`bucketed_centroids`] holds on average (at most):
-/// every chunk keeps a start a bucket, and every bucket gathers from every
-/// chunk, so fewer buckets mean fewer starts and gathers, and a bucket's
-/// sort stays in the first-level cache (1 M bench pile: 15.8–17.3 ms with
-/// 128, 16.3–17.7 with 8).
-const BUCKET: usize = 128;
+/// Points a super-bucket of [`bucketed_centroids`] holds on average (at
+/// most): it is gathered into one buffer and sorted there, which with a
+/// second buffer of its size stays in the second-level cache.
+const SUPER: usize = 1 << 14;
 
-/// Most buckets of [`bucketed_centroids`] (2¹⁷): on a large cloud more
-/// buckets cost more than their sorts save (the 20 M bench pile, 2²²
-/// buckets: 0.75–0.99 s; 2¹⁶ or 2¹⁷: 0.41–0.49 s with [`MAX_CHUNK`], with
-/// entries of 24 bytes then).
-const MAX_BUCKET_BITS: u32 = 17;
+/// Most super-buckets of [`bucketed_centroids`] (2¹²): each chunk keeps a
+/// start a super-bucket.
+const MAX_SUPER_BITS: u32 = 12;
 
 /// Most points of a chunk of [`bucketed_centroids`]: a chunk's entries
 /// stay within the caches' reach and the allocator's reuse, where an
@@ -259,10 +313,11 @@ const MAX_BUCKET_BITS: u32 = 17;
 const MAX_CHUNK: usize = 1 << 17;
 
 /// A point filed by [`bucketed_centroids`]: its voxel's linear index less
-/// the bucket's bits, and the point itself (16 bytes). The point's index is
-/// not kept: every step keeps a voxel's points in input order (chunks in
-/// order, each counting-sorted stably, each bucket sorted stably), and the
-/// entries are most of the memory the grid writes at 20 M points.
+/// the super-bucket's bits, and the point itself (16 bytes). The point's
+/// index is not kept: every step keeps a voxel's points in input order
+/// (chunks in order, each counting-sorted stably, each super-bucket and
+/// bucket sorted stably), and the entries are most of the memory the grid
+/// writes at 20 M points.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Entry {
     voxel: u32,
@@ -273,33 +328,37 @@ struct Entry {
 /// of at most 2³² `voxels`; `linear` gives a finite point's voxel index.
 /// Why not one sort of all keys: the cloud is cut into chunks (a few a
 /// thread, at most [`MAX_CHUNK`] points), and each chunk is counting-sorted
-/// on its own (in cache, in parallel) into buckets by the voxel index's top
-/// bits (a few points a bucket, at most 2^[`MAX_BUCKET_BITS`] buckets); then
-/// each bucket's parts (in chunk order) are gathered, sorted stably by voxel
-/// and summed, buckets in parallel. No pass over the whole cloud is serial,
-/// and the centroids read the points from the gathered parts, not at random
-/// from the cloud.
+/// on its own (in cache, in parallel) into super-buckets by the voxel
+/// index's top bits (about [`SUPER`] points each, over all chunks); then
+/// each super-bucket's parts (in chunk order, whole runs of entries) are
+/// gathered into a buffer in the second-level cache, where
+/// [`sort_and_sum`] sorts and sums them, super-buckets in parallel. No pass
+/// over the whole cloud is serial, the gathering reads long runs (with
+/// one level of a few points a bucket, it read one or two entries from
+/// each chunk in turn, which on the 20 M pipeline's voxel stage was half
+/// its time), and the centroids read the points from the gathered parts,
+/// not at random from the cloud.
 fn bucketed_centroids<L>(points: &[Point], voxels: u64, linear: &L) -> Vec<Point>
 where
     L: Fn(&Point) -> u64 + Sync,
 {
     let n = points.len();
     let voxel_bits = 64 - (voxels.max(2) - 1).leading_zeros();
-    let bucket_bits = (usize::BITS - (n / BUCKET).max(1).leading_zeros())
+    let super_bits = (usize::BITS - (n / SUPER).max(1).leading_zeros())
         .min(voxel_bits)
-        .min(MAX_BUCKET_BITS);
-    // At most 31: `voxels` ≤ 2³² and at least one bucket bit.
-    let shift = voxel_bits - bucket_bits;
+        .min(MAX_SUPER_BITS);
+    // At most 31: `voxels` ≤ 2³² and at least one super-bucket bit.
+    let shift = voxel_bits - super_bits;
     let low = (1u64 << shift) - 1;
-    let buckets = 1usize << bucket_bits;
+    let supers = 1usize << super_bits;
     let bucket = |key: u64| (key >> shift) as usize;
     const NOT_FINITE: u64 = u64::MAX;
     let chunk = n
         .div_ceil(rayon::current_num_threads() * 4)
         .clamp(1 << 12, MAX_CHUNK);
-    // Per chunk: its entries by bucket, and `start`, where bucket b's
-    // entries are `start[b]..start[b + 1]`. Each thread reuses one buffer
-    // for its chunks' voxel indices.
+    // Per chunk: its entries by super-bucket, and `start`, where
+    // super-bucket b's entries are `start[b]..start[b + 1]`. Each thread
+    // reuses one buffer for its chunks' voxel indices.
     type Part = (Vec<Entry>, Vec<u32>);
     let parts: Vec<Part> = points
         .par_chunks(chunk)
@@ -309,17 +368,11 @@ where
                 ps.iter()
                     .map(|p| if is_finite(p) { linear(p) } else { NOT_FINITE }),
             );
-            // Counted at b + 2, summed so that start[b + 1] is bucket b's
-            // start, which the filing below moves on to its end (the next
-            // bucket's start), leaving start[b] as bucket b's start.
-            let mut start = vec![0u32; buckets + 2];
+            let mut start = vec![0u32; supers + 2];
             for &k in keys.iter().filter(|&&k| k != NOT_FINITE) {
                 start[bucket(k) + 2] += 1;
             }
-            for b in 1..buckets + 2 {
-                start[b] += start[b - 1];
-            }
-            let total = start[buckets + 1] as usize;
+            let total = counts_to_starts(&mut start);
             let mut sorted: Vec<Entry> = crate::room::with_room(total);
             let room = &mut sorted.spare_capacity_mut()[..total];
             for (&k, p) in keys.iter().zip(ps).filter(|(&k, _)| k != NOT_FINITE) {
@@ -338,76 +391,112 @@ where
             (sorted, start)
         })
         .collect();
-    // Buckets in parallel ranges; each bucket gathered, sorted, summed.
-    // A bucket's voxels differ in the low `shift` bits of their index
-    // only; where the points lie on a surface in a box of air (a scan)
-    // most buckets are empty and the others hold many voxels, so a large
-    // bucket is radix-sorted on those bits, a small one sorted unless it is
-    // in order.
-    let per_task = buckets.div_ceil(rayon::current_num_threads() * 8).max(1);
-    let out: Vec<Vec<Point>> = (0..buckets.div_ceil(per_task))
+    let out: Vec<Vec<Point>> = (0..supers)
         .into_par_iter()
-        .map(|t| {
-            let mut out = Vec::new();
-            let (mut scratch, mut spare) = (Vec::new(), Vec::new());
-            for b in t * per_task..((t + 1) * per_task).min(buckets) {
-                scratch.clear();
-                for (sorted, start) in &parts {
-                    scratch.extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
-                }
-                if scratch.len() >= RADIX_FROM {
-                    radix_sort_voxels(&mut scratch, &mut spare, shift);
-                } else if !scratch.is_sorted_by_key(|e| e.voxel) {
-                    // Stable: a voxel's points stay in input order.
-                    scratch.sort_by_key(|e| e.voxel);
-                }
-                push_centroids(&scratch, |e| e.voxel, |e| e.point, &mut out);
+        .map_init(Buffers::default, |buf, b| {
+            buf.gathered.clear();
+            for (sorted, start) in &parts {
+                buf.gathered
+                    .extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
             }
+            let mut out = Vec::new();
+            sort_and_sum(buf, shift, &mut out);
             out
         })
         .collect();
     out.concat()
 }
 
-/// Entries in a bucket from which [`radix_sort_voxels`] sorts them (below,
-/// a comparison sort is quicker).
+/// Counts at `b + 2` (bucket b's count) into starts in place: after it,
+/// `start[b + 1]` is bucket b's start, which a counting sort's filing moves
+/// on to its end (the next bucket's start), leaving `start[b]` as bucket
+/// b's start. Returns the total.
+fn counts_to_starts(start: &mut [u32]) -> usize {
+    for b in 1..start.len() {
+        start[b] += start[b - 1];
+    }
+    start.last().map_or(0, |&t| t as usize)
+}
+
+/// The working buffers of one thread of [`bucketed_centroids`].
+#[derive(Default)]
+struct Buffers {
+    gathered: Vec<Entry>,
+    spare: Vec<Entry>,
+}
+
+/// Pushes the centroids of the entries in `buf.gathered` (voxel indices
+/// below 2^`bits`, each voxel's points in input order) onto `out`, in
+/// voxel order: sorted stably by voxel (a radix sort, or a comparison
+/// sort for a few entries unless they are in order) and summed.
+fn sort_and_sum(buf: &mut Buffers, bits: u32, out: &mut Vec<Point>) {
+    let len = buf.gathered.len();
+    let sorted: &[Entry] = if len >= RADIX_FROM {
+        if buf.spare.len() < len {
+            buf.spare.resize(len, Entry::default());
+        }
+        radix_sort_voxels(&mut buf.gathered, &mut buf.spare[..len], bits)
+    } else {
+        if !buf.gathered.is_sorted_by_key(|e| e.voxel) {
+            // Stable: a voxel's points stay in input order.
+            buf.gathered.sort_by_key(|e| e.voxel);
+        }
+        &buf.gathered
+    };
+    push_centroids(sorted, |e| e.voxel, |e| e.point, out);
+}
+
+/// Entries from which [`radix_sort_voxels`] sorts them (below, a
+/// comparison sort is quicker).
 const RADIX_FROM: usize = 32;
 
+/// Bits of a digit of [`radix_sort_voxels`]: its counts (8 KiB) stay in
+/// the first-level cache, and 22 bits take two passes.
+const DIGIT_BITS: u32 = 11;
+
 /// Sorts `entries` by the low `bits` bits of their voxel index: a stable
-/// least-significant-digit radix sort on digits of 8 bits (a digit all
-/// entries share is passed over), so each voxel's points keep their order.
-/// `spare` is scratch.
+/// least-significant-digit radix sort on digits of [`DIGIT_BITS`], every
+/// digit counted in one pass first (a digit all entries share is passed
+/// over), so each voxel's points keep their order. `spare` (as long as
+/// `entries`) is scratch; returns whichever of the two holds the sorted
+/// entries.
 #[inline]
-fn radix_sort_voxels(entries: &mut Vec<Entry>, spare: &mut Vec<Entry>, bits: u32) {
-    let mut count = [0u32; 257];
-    let mut at = 0;
-    while at < bits {
-        let (from, width) = (at, (bits - at).min(8));
-        let digits = 1 << width;
-        let digit = |e: &Entry| ((e.voxel >> from) & (digits as u32 - 1)) as usize;
-        count[..=digits].fill(0);
-        for e in entries.iter() {
-            count[digit(e) + 1] += 1;
+fn radix_sort_voxels<'a>(
+    mut entries: &'a mut [Entry],
+    mut spare: &'a mut [Entry],
+    bits: u32,
+) -> &'a [Entry] {
+    const DIGITS: usize = 1 << DIGIT_BITS;
+    const MAX_PASSES: usize = 32_usize.div_ceil(DIGIT_BITS as usize);
+    let passes = bits.div_ceil(DIGIT_BITS) as usize;
+    let mut count = [[0u32; DIGITS]; MAX_PASSES];
+    let digit = |e: &Entry, pass: usize| {
+        ((e.voxel >> (pass as u32 * DIGIT_BITS)) & (DIGITS as u32 - 1)) as usize
+    };
+    for e in entries.iter() {
+        for (pass, c) in count.iter_mut().enumerate().take(passes) {
+            c[digit(e, pass)] += 1;
         }
-        at += width;
-        if count[1..=digits]
-            .iter()
-            .any(|&c| c as usize == entries.len())
-        {
+    }
+    for (pass, c) in count.iter_mut().enumerate().take(passes) {
+        if c.iter().any(|&k| k as usize == entries.len()) {
             continue;
         }
-        for d in 0..digits {
-            count[d + 1] += count[d];
+        // Counts to starts.
+        let mut at = 0;
+        for k in c.iter_mut() {
+            let n = *k;
+            *k = at;
+            at += n;
         }
-        spare.clear();
-        spare.resize(entries.len(), Entry::default());
         for e in entries.iter() {
-            let slot = &mut count[digit(e)];
+            let slot = &mut c[digit(e, pass)];
             spare[*slot as usize] = *e;
             *slot += 1;
         }
-        std::mem::swap(entries, spare);
+        std::mem::swap(&mut entries, &mut spare);
     }
+    entries
 }
 
 /// The centroid of each run of equal voxel keys in the sorted `keys`, in
@@ -494,8 +583,9 @@ mod tests {
                 .collect();
             let mut want = entries.clone();
             want.sort_by_key(|e| e.voxel);
-            radix_sort_voxels(&mut entries, &mut Vec::new(), bits);
-            assert!(entries == want, "bits {bits}, {n} entries");
+            let mut spare = vec![Entry::default(); n];
+            let sorted = radix_sort_voxels(&mut entries, &mut spare, bits);
+            assert!(sorted == want, "bits {bits}, {n} entries");
         }
     }
 
