@@ -45,31 +45,59 @@ impl PointCloud {
 }
 
 /// The least and greatest coordinate on each axis of `points` (`None` for
-/// none), non-finite coordinates passed over; the cloud's parts in
-/// parallel (a serial pass was 6 ms of a 1 M-point `perceive`).
+/// none), NaN coordinates passed over (an infinite one is a bound); the
+/// cloud's parts in parallel (a serial pass was 6 ms of a 1 M-point
+/// `perceive`).
 pub fn bounds(points: &[Point]) -> Option<(Point, Point)> {
+    (!points.is_empty()).then(|| {
+        let (lo, hi, _) = lane_bounds(points);
+        (lo, hi)
+    })
+}
+
+/// [`bounds`] of a non-empty cloud, and whether every coordinate is
+/// finite. One pass over the coordinates as a flat array, 16 points a step
+/// in lanes that vectorise (a point at a time did not: 3.5 ns a point, 45
+/// ms of the 20 M pipeline's voxel stage and as much of its radius stage).
+pub(crate) fn lane_bounds(points: &[Point]) -> (Point, Point, bool) {
     use rayon::prelude::*;
-    if points.is_empty() {
-        return None;
-    }
-    let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-    Some(
-        points
-            .par_iter()
-            .fold(none, |(mut lo, mut hi), p| {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a]);
-                    hi[a] = hi[a].max(p[a]);
+    const W: usize = 48; // 16 points; lane j holds axis j % 3
+    let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3], true);
+    points
+        .par_chunks(1 << 14)
+        .map(|chunk| {
+            let flat = chunk.as_flattened();
+            let mut lo = [f32::INFINITY; W];
+            let mut hi = [f32::NEG_INFINITY; W];
+            let mut poison = [0.0_f32; W];
+            let mut blocks = flat.chunks_exact(W);
+            for b in &mut blocks {
+                for j in 0..W {
+                    lo[j] = lo[j].min(b[j]);
+                    hi[j] = hi[j].max(b[j]);
+                    // 0 · v is NaN for an infinite or NaN v, and stays so.
+                    poison[j] += b[j] * 0.0;
                 }
-                (lo, hi)
-            })
-            .reduce(none, |(l1, h1), (l2, h2)| {
-                (
-                    std::array::from_fn(|a| l1[a].min(l2[a])),
-                    std::array::from_fn(|a| h1[a].max(h2[a])),
-                )
-            }),
-    )
+            }
+            for (j, &v) in blocks.remainder().iter().enumerate() {
+                lo[j] = lo[j].min(v);
+                hi[j] = hi[j].max(v);
+                poison[j] += v * 0.0;
+            }
+            let (mut l, mut h, _) = none();
+            for j in 0..W {
+                l[j % 3] = l[j % 3].min(lo[j]);
+                h[j % 3] = h[j % 3].max(hi[j]);
+            }
+            (l, h, !poison.iter().any(|v| v.is_nan()))
+        })
+        .reduce(none, |(l1, h1, f1), (l2, h2, f2)| {
+            (
+                std::array::from_fn(|a| l1[a].min(l2[a])),
+                std::array::from_fn(|a| h1[a].max(h2[a])),
+                f1 && f2,
+            )
+        })
 }
 
 #[cfg(test)]
@@ -99,6 +127,20 @@ mod tests {
                 }
             }
             assert_eq!(cloud.bounds(), Some((lo, hi)), "{n} points");
+            assert!(lane_bounds(&cloud.points).2);
+        }
+        // NaN is passed over, an infinity is a bound; neither is finite.
+        for (at, bad) in [(0, f32::NAN), (1, f32::INFINITY), (2, f32::NEG_INFINITY)] {
+            let mut points = vec![[1.0, 2.0, 3.0]; 100];
+            points[37][at] = bad;
+            let (lo, hi, finite) = lane_bounds(&points);
+            assert!(!finite);
+            let want = if bad.is_nan() { 1.0 + at as f32 } else { bad };
+            assert_eq!(
+                if bad > 0.0 { hi[at] } else { lo[at] },
+                want,
+                "{bad} at axis {at}"
+            );
         }
     }
 }

@@ -44,6 +44,8 @@
 //! relative 1e-4, far above the f32 rounding of a squared distance, so no
 //! point within r is left out of it.
 
+use std::mem::MaybeUninit;
+
 use rayon::prelude::*;
 
 mod far;
@@ -150,11 +152,10 @@ impl Grid {
         // first grid of 16 points a column on the box's floor.
         let area = ((hi[0] - lo[0]) * (hi[1] - lo[1])).max(f64::MIN_POSITIVE);
         let first = (16.0 * area / n as f64).sqrt();
-        let side = match Columns::new(points, lo, hi, first) {
-            Some(columns) => {
+        let side = match Columns::occupied(points, lo, hi, first) {
+            Some((h, occupied)) => {
                 // (A column with one point is a stray's: an outlier's.)
-                let occupied = columns.counts().filter(|&c| c > 1).count();
-                let covered = occupied as f64 * columns.h * columns.h;
+                let covered = occupied as f64 * h * h;
                 (covered * k as f64 / (std::f64::consts::PI * n as f64)).sqrt()
             }
             None => first,
@@ -320,10 +321,16 @@ impl Grid {
                 tally
             })
             .collect();
-        let mut order = vec![0u32; n];
+        // Each point is dealt with its coordinates and column, so that a
+        // row then reads its own points in its own part alone (reading
+        // them by index from the cloud and the columns was a read from
+        // anywhere in 200 MB a point, most of the filing of a 14 M-point
+        // scan).
+        let mut dealt: Vec<Dealt> = crate::room::with_room(n);
         let mut row_first = Vec::with_capacity(rows + 1);
-        let mut pieces: Vec<Vec<&mut [u32]>> = tallies.iter().map(|_| Vec::new()).collect();
-        let (mut rest, mut at) = (order.as_mut_slice(), 0);
+        let mut pieces: Vec<Vec<&mut [MaybeUninit<Dealt>]>> =
+            tallies.iter().map(|_| Vec::new()).collect();
+        let (mut rest, mut at) = (&mut dealt.spare_capacity_mut()[..n], 0);
         for r in 0..rows {
             row_first.push(at);
             for (tally, mine) in tallies.iter().zip(pieces.iter_mut()) {
@@ -334,18 +341,29 @@ impl Grid {
             }
         }
         row_first.push(at);
-        of.par_chunks(chunk)
+        points
+            .par_chunks(chunk)
+            .zip(of.par_chunks(chunk))
             .zip(pieces.par_iter_mut())
             .enumerate()
-            .for_each(|(j, (part, mine))| {
+            .for_each(|(j, ((part, columns), mine))| {
                 let mut fill = vec![0usize; rows];
-                for (i, &c) in part.iter().enumerate() {
+                for (i, (p, &c)) in part.iter().zip(columns).enumerate() {
                     let r = c as usize / row_len;
-                    mine[r][fill[r]] = (j * chunk + i) as u32;
+                    mine[r][fill[r]].write(Dealt {
+                        column: c,
+                        index: (j * chunk + i) as u32,
+                        point: *p,
+                    });
                     fill[r] += 1;
                 }
             });
         drop(pieces);
+        // SAFETY: every point went to one slot of its row's piece of its
+        // chunk, whose length is the chunk's tally of that row: the pieces
+        // tile the n slots, and each slot was written once.
+        unsafe { dealt.set_len(n) };
+        drop(of);
         let mut start = vec![0u32; count + 1];
         start[count] = n as u32;
         // Each row writes its own part of the grid's arrays: the input
@@ -354,15 +372,15 @@ impl Grid {
             (vec![0u32; n], vec![0f32; n], vec![0f32; n], vec![0f32; n]);
         let mut parts = Vec::with_capacity(rows);
         let mut rest = (&mut ids[..], &mut x[..], &mut y[..], &mut z[..]);
-        let mut dealt = order.as_slice();
+        let mut left = dealt.as_slice();
         for (r, starts) in start[..count].chunks_mut(row_len).enumerate() {
             let len = row_first[r + 1] - row_first[r];
             let (ids, x, y, z) = std::mem::take(&mut rest);
             let ((pi, ri), (px, rx)) = (ids.split_at_mut(len), x.split_at_mut(len));
             let ((py, ry), (pz, rz)) = (y.split_at_mut(len), z.split_at_mut(len));
-            let (mine, others) = dealt.split_at(len);
+            let (mine, others) = left.split_at(len);
             parts.push((r, starts, [px, py, pz], pi, mine));
-            (rest, dealt) = ((ri, rx, ry, rz), others);
+            (rest, left) = ((ri, rx, ry, rz), others);
         }
         let isa = Isa::best();
         parts
@@ -370,8 +388,8 @@ impl Grid {
             .for_each_init(Vec::new, |part, (r, starts, xyz, pi, mine)| {
                 let (c0, base) = (r * row_len, row_first[r]);
                 // The row's columns' starts (their counts, summed).
-                for &i in mine {
-                    starts[of[i as usize] as usize - c0] += 1;
+                for d in mine {
+                    starts[d.column as usize - c0] += 1;
                 }
                 let mut sum = base as u32;
                 for s in starts.iter_mut() {
@@ -380,28 +398,29 @@ impl Grid {
                 let mut next = starts.to_vec();
                 part.clear();
                 part.resize(mine.len(), (0u64, 0u32));
-                for &i in mine {
-                    let c = of[i as usize] as usize;
+                for (j, d) in mine.iter().enumerate() {
+                    let c = d.column as usize;
                     let slot = &mut next[c - c0];
                     // Heights ordered as integers (finite f32, sign folded).
-                    let bits = points[i as usize][2].to_bits();
+                    let bits = d.point[2].to_bits();
                     let key = if bits >> 31 == 1 {
                         !bits
                     } else {
                         bits | 1 << 31
                     };
-                    part[*slot as usize - base] = ((c as u64) << 32 | u64::from(key), i);
+                    part[*slot as usize - base] = ((c as u64) << 32 | u64::from(key), j as u32);
                     *slot += 1;
                 }
                 for column in part.chunk_by_mut(|a, b| a.0 >> 32 == b.0 >> 32) {
                     sort_column(isa, column);
                 }
-                // The points in sorted order (one random read a point), split
-                // by axis.
+                // The points in sorted order, from the row's own part,
+                // split by axis.
                 let [px, py, pz] = xyz;
-                for (j, &(_, i)) in part.iter().enumerate() {
-                    let p = points[i as usize];
-                    (pi[j], px[j], py[j], pz[j]) = (i, p[0], p[1], p[2]);
+                for (j, &(_, at)) in part.iter().enumerate() {
+                    let d = &mine[at as usize];
+                    let p = d.point;
+                    (pi[j], px[j], py[j], pz[j]) = (d.index, p[0], p[1], p[2]);
                 }
             });
         let xyz = [x, y, z];
@@ -961,6 +980,15 @@ fn slab_index_of(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
     (slabs, slab_start)
 }
 
+/// A point dealt to its row of blocks by `Grid::new`: its column, input
+/// index and coordinates (20 bytes).
+#[derive(Clone, Copy)]
+struct Dealt {
+    column: u32,
+    index: u32,
+    point: Point,
+}
+
 /// The column of every point on a grid of side `h` over the box.
 struct Columns {
     h: f64,
@@ -973,7 +1001,16 @@ impl Columns {
     /// Columns of side `wanted` (grown until they number at most
     /// `COLUMNS_PER_POINT` a point; `None` past 4× `wanted`).
     fn new(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<Self> {
-        let n = points.len();
+        let (h, nx, ny) = Self::sized(points.len(), lo, hi, wanted)?;
+        let of = points
+            .par_iter()
+            .map(|p| column_of(p, lo, h, (nx, ny)) as u32)
+            .collect();
+        Some(Self { h, nx, ny, of })
+    }
+
+    /// The side and counts along x and y of [`Columns::new`]'s columns.
+    fn sized(n: usize, lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<(f64, usize, usize)> {
         let extent = [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]];
         let largest = extent.iter().cloned().fold(0.0, f64::max);
         if largest <= 0.0 || !wanted.is_finite() {
@@ -992,26 +1029,44 @@ impl Columns {
                 return None;
             }
         }
-        let (nx, ny) = (cells(h, extent[0]), cells(h, extent[1]));
-        let of = points
-            .par_iter()
-            .map(|p| {
-                let cx = (((f64::from(p[0]) - lo[0]) / h) as usize).min(nx - 1);
-                let cy = (((f64::from(p[1]) - lo[1]) / h) as usize).min(ny - 1);
-                block_index(cx, cy, nx) as u32
-            })
-            .collect();
-        Some(Self { h, nx, ny, of })
+        Some((h, cells(h, extent[0]), cells(h, extent[1])))
     }
 
-    /// Points in each column.
-    fn counts(&self) -> impl Iterator<Item = u32> {
-        let mut counts = vec![0u32; block_index(self.nx - 1, self.ny - 1, self.nx) + 1];
-        for &c in &self.of {
-            counts[c as usize] += 1;
-        }
-        counts.into_iter()
+    /// The side of [`Columns::new`]'s columns and how many of them hold
+    /// more than one point, counted by parts in parallel (no column kept
+    /// for each point).
+    fn occupied(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<(f64, usize)> {
+        let (h, nx, ny) = Self::sized(points.len(), lo, hi, wanted)?;
+        let columns = block_index(nx - 1, ny - 1, nx) + 1;
+        let part = points
+            .len()
+            .div_ceil(rayon::current_num_threads())
+            .max(1 << 16);
+        let counts = points
+            .par_chunks(part)
+            .map(|part| {
+                let mut counts = vec![0u32; columns];
+                for p in part {
+                    counts[column_of(p, lo, h, (nx, ny))] += 1;
+                }
+                counts
+            })
+            .reduce_with(|mut a, b| {
+                a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+                a
+            })
+            .unwrap_or_default();
+        Some((h, counts.iter().filter(|&&c| c > 1).count()))
     }
+}
+
+/// The column (numbered by [`block_index`]) of point `p` on columns of
+/// side `h` from `lo`, `nx` × `ny` of them.
+#[inline]
+fn column_of(p: &Point, lo: [f64; 3], h: f64, (nx, ny): (usize, usize)) -> usize {
+    let cx = (((f64::from(p[0]) - lo[0]) / h) as usize).min(nx - 1);
+    let cy = (((f64::from(p[1]) - lo[1]) / h) as usize).min(ny - 1);
+    block_index(cx, cy, nx)
 }
 
 /// Buffers of one task.
