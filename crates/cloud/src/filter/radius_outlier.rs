@@ -174,7 +174,7 @@ pub fn radius_outlier_removal_then(
     };
     // [RS eq. 13] as in `kept_indices`, by sorted position for `retain`.
     let keep = grid.map_has_within_in_grid_order(r2, wanted);
-    let kept = indices_of(&grid.to_input_order(&keep));
+    let kept = grid.kept_inputs(&keep);
     if kept.is_empty() {
         return Err(emptied(FILTER, cloud.len(), HINT));
     }
@@ -231,14 +231,13 @@ fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<us
     // `wanted` points are: count them, stopping at `wanted` (on a grid of
     // columns as wide as the radius when the cloud suits one, `grid/`;
     // else on the k-d tree: the same counts).
-    let keep: Vec<bool> = match Grid::for_radius(points, f64::from(r2).sqrt()) {
-        Some(grid) => grid.map_has_within(r2, wanted),
+    match Grid::for_radius(points, f64::from(r2).sqrt()) {
+        Some(grid) => grid.kept_inputs(&grid.map_has_within_in_grid_order(r2, wanted)),
         None => {
             let tree = KdTree::new(points);
-            tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted))
+            indices_of(&tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted)))
         }
-    };
-    indices_of(&keep)
+    }
 }
 
 /// The positions of the `true`s.
