@@ -41,6 +41,7 @@ use autoshovel_cloud::filter::{
 };
 use autoshovel_cloud::PointCloud;
 use autoshovel_core::config::{self, TomlFile};
+use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::calibrate::level;
@@ -901,7 +902,7 @@ pub fn perceive_after(
                 }
                 // The statistical stage searches the same index next.
                 let first = radius_outlier_removal_then(c, &params, p.statistical.mean_k)?;
-                let kept = PointCloud::new(first.kept.iter().map(|&i| c.points[i]).collect());
+                let kept = PointCloud::new(first.kept.par_iter().map(|&i| c.points[i]).collect());
                 *after_radius.borrow_mut() = Some(first);
                 Ok(kept)
             }),
@@ -919,7 +920,9 @@ pub fn perceive_after(
                 match after_radius.borrow_mut().take() {
                     Some(first) => {
                         let kept = first.statistical_indices(c, &params)?;
-                        Ok(PointCloud::new(kept.iter().map(|&i| c.points[i]).collect()))
+                        Ok(PointCloud::new(
+                            kept.par_iter().map(|&i| c.points[i]).collect(),
+                        ))
                     }
                     None => statistical_outlier_removal(c, &params),
                 }
