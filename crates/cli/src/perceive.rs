@@ -28,14 +28,16 @@ pub struct Args {
     /// Survey mode: perceive a LAS/LAZ survey (a file, or a folder of
     /// files taken as one survey) by tiles with halos, in bounded memory,
     /// with the whole cloud's result; the cleaned tiles go to `--out`'s
-    /// `tiles/`.
+    /// `tiles/`. Working files go to the system's temporary folder (some
+    /// 30 bytes a point read, at the most) and are removed at the end.
     #[arg(long)]
     pub tiles: bool,
     /// Survey mode: tile side [m] (default: from the memory limit and the
     /// survey's density). Implies --tiles.
     #[arg(long)]
     pub tile_size: Option<f64>,
-    /// Survey mode: most working memory of a tile [GiB].
+    /// Survey mode: most working memory of the tiles running at once (a
+    /// tile a core while they fit) [GiB].
     #[arg(long, default_value_t = 2.0)]
     pub memory_limit: f64,
     /// Pipeline settings (TOML); defaults otherwise (`autoshovel perceive --print-config` shows them).

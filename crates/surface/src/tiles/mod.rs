@@ -121,7 +121,8 @@ pub struct TileOptions {
     /// chosen so that a tile takes about a million points (less if a
     /// quarter of the memory limit holds fewer).
     pub tile_m: Option<f64>,
-    /// Most working memory a tile may take [bytes].
+    /// Most working memory a tile may take [bytes]; in [`InProcess`], the
+    /// tiles running at once together.
     pub memory_limit: u64,
     /// Points of the sample for the floor and the tilt, and of the fit.
     pub sample_points: usize,

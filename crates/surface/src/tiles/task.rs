@@ -169,7 +169,19 @@ impl TileExecutor for InProcess {
                 let (gate, tasks) = (&gate, &tasks);
                 scope.spawn(move || {
                     while let Some(i) = gate.claim() {
-                        let report = run_tile_task(&tasks[i]);
+                        // A panic is the task's error, and its memory is
+                        // released: the other workers never wait for it.
+                        let report = std::panic::catch_unwind(|| run_tile_task(&tasks[i]))
+                            .unwrap_or_else(|payload| {
+                                Err(SurfaceError::TileExecutor {
+                                    stage: stage.into(),
+                                    problem: format!(
+                                        "the task of tile {} failed: {}",
+                                        tasks[i].tile,
+                                        panic_words(payload.as_ref())
+                                    ),
+                                })
+                            });
                         gate.release(i, report.is_err());
                         if sent.send((i, report)).is_err() {
                             return;
@@ -194,6 +206,15 @@ impl TileExecutor for InProcess {
             }
         })
     }
+}
+
+/// What a panic's payload says.
+fn panic_words(payload: &(dyn std::any::Any + Send)) -> String {
+    payload
+        .downcast_ref::<&str>()
+        .map(|s| s.to_string())
+        .or_else(|| payload.downcast_ref::<String>().cloned())
+        .unwrap_or_else(|| "a panic".into())
 }
 
 /// Hands out [`InProcess`]'s tasks in order, each when its memory fits

@@ -730,10 +730,7 @@ impl Grid {
     /// filter there).
     pub(crate) fn kept_inputs(&self, keep: &[bool]) -> Vec<usize> {
         let words = self.inputs.div_ceil(64);
-        let part = keep
-            .len()
-            .div_ceil(rayon::current_num_threads())
-            .max(1 << 16);
+        let part = part_a_thread(keep.len());
         let bits = keep
             .par_chunks(part)
             .zip(self.ids.par_chunks(part))
@@ -844,6 +841,12 @@ impl Grid {
         }
         self.runs_in_input_order(runs, Option::unwrap_or_default)
     }
+}
+
+/// Items of a part when `len` are cut into one part a thread (at least
+/// 2¹⁶), each part counted into an array of its own, then merged.
+fn part_a_thread(len: usize) -> usize {
+    len.div_ceil(rayon::current_num_threads()).max(1 << 16)
 }
 
 /// The positions of the set bits of `bits` (bit j of word w: 64 w + j),
@@ -1113,10 +1116,7 @@ impl Columns {
     fn occupied(points: &[Point], lo: [f64; 3], hi: [f64; 3], wanted: f64) -> Option<(f64, usize)> {
         let (h, nx, ny) = Self::sized(points.len(), lo, hi, wanted)?;
         let columns = block_index(nx - 1, ny - 1, nx) + 1;
-        let part = points
-            .len()
-            .div_ceil(rayon::current_num_threads())
-            .max(1 << 16);
+        let part = part_a_thread(points.len());
         let counts = points
             .par_chunks(part)
             .map(|part| {
