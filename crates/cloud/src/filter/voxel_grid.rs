@@ -137,12 +137,12 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
     // monotonic, so the bounds' voxels are the voxels' bounds; so is
     // rounding v · (1 / leaf), so the bounds of the points scale to those
     // of the scaled points), checked once at the end.
-    let (vlo, vhi) = match coordinate_bounds(points) {
-        Some((lo, hi)) => (
+    let (vlo, vhi) = match crate::cloud::lane_bounds(points) {
+        (lo, hi, true) => (
             [0, 1, 2].map(|a| lo[a] * inv[a]),
             [0, 1, 2].map(|a| hi[a] * inv[a]),
         ),
-        None => {
+        _ => {
             // A coordinate is not finite: its point's others are passed
             // over too.
             let none = || ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
@@ -226,13 +226,6 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
     Ok(PointCloud::new(centroids))
 }
 
-/// The smallest and largest coordinate per axis of `points`, all of whose
-/// coordinates are finite; `None` if one is not.
-fn coordinate_bounds(points: &[Point]) -> Option<([f32; 3], [f32; 3])> {
-    let (lo, hi, finite) = crate::cloud::lane_bounds(points);
-    finite.then_some((lo, hi))
-}
-
 /// The voxel of a point as [`voxel_grid`] computes it (PCL's
 /// `floor(p · (1 / leaf))` in f32), for a caller that must know which
 /// points share a voxel before calling it (a tile deciding which voxels
@@ -275,9 +268,9 @@ const MAX_CHUNK: usize = 1 << 17;
 /// A point filed by [`bucketed_centroids`]: its voxel's linear index less
 /// the super-bucket's bits, and the point itself (16 bytes). The point's
 /// index is not kept: every step keeps a voxel's points in input order
-/// (chunks in order, each counting-sorted stably, each super-bucket and
-/// bucket sorted stably), and the entries are most of the memory the grid
-/// writes at 20 M points.
+/// (chunks in order, each counting-sorted stably, each super-bucket sorted
+/// stably), and the entries are most of the memory the grid writes at 20 M
+/// points.
 #[derive(Debug, Clone, Copy, Default, PartialEq)]
 struct Entry {
     voxel: u32,
@@ -311,7 +304,7 @@ where
     let shift = voxel_bits - super_bits;
     let low = (1u64 << shift) - 1;
     let supers = 1usize << super_bits;
-    let bucket = |key: u64| (key >> shift) as usize;
+    let super_of = |key: u64| (key >> shift) as usize;
     const NOT_FINITE: u64 = u64::MAX;
     let chunk = n
         .div_ceil(rayon::current_num_threads() * 4)
@@ -330,13 +323,13 @@ where
             );
             let mut start = vec![0u32; supers + 2];
             for &k in keys.iter().filter(|&&k| k != NOT_FINITE) {
-                start[bucket(k) + 2] += 1;
+                start[super_of(k) + 2] += 1;
             }
             let total = counts_to_starts(&mut start);
             let mut sorted: Vec<Entry> = crate::room::with_room(total);
             let room = &mut sorted.spare_capacity_mut()[..total];
             for (&k, p) in keys.iter().zip(ps).filter(|(&k, _)| k != NOT_FINITE) {
-                let slot = &mut start[bucket(k) + 1];
+                let slot = &mut start[super_of(k) + 1];
                 room[*slot as usize].write(Entry {
                     voxel: (k & low) as u32,
                     point: *p,

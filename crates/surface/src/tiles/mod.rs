@@ -84,7 +84,7 @@ use autoshovel_cloud::{CloudError, Point, PointCloud};
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use store::{dist_path, Filing, Grid, RawSpill, Rec, Stage, DIST_RECORD};
+use store::{dist_path, f32_at, Filing, Grid, RawSpill, Rec, Stage, DIST_RECORD};
 use task::{filter_err, Step};
 pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
@@ -1201,7 +1201,7 @@ fn next_dist(r: &mut BufReader<File>, path: &Path) -> Result<Option<(u64, f32)>>
     match r.read_exact(&mut b) {
         Ok(()) => Ok(Some((
             u64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
-            f32::from_le_bytes([b[8], b[9], b[10], b[11]]),
+            f32_at(&b, 8),
         ))),
         Err(e) if e.kind() == std::io::ErrorKind::UnexpectedEof => Ok(None),
         Err(source) => Err(SurfaceError::Spill {

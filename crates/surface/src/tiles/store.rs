@@ -119,11 +119,10 @@ impl RawBack {
         self.file
             .read_exact(&mut self.bytes)
             .map_err(spill(&self.path))?;
-        let f = |b: &[u8], at: usize| f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
         chunk.extend(
             self.bytes
                 .chunks_exact(RAW_RECORD)
-                .map(|b| [f(b, 0), f(b, 4), f(b, 8)]),
+                .map(|b| [f32_at(b, 0), f32_at(b, 4), f32_at(b, 8)]),
         );
         self.left -= take as u64;
         Ok(true)
@@ -328,9 +327,15 @@ fn encode(recs: &[Rec]) -> Vec<u8> {
     bytes
 }
 
+/// The little-endian f32 at byte `at` of a working file's record.
+#[inline]
+pub(super) fn f32_at(b: &[u8], at: usize) -> f32 {
+    f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]])
+}
+
 #[inline]
 fn decode(b: &[u8]) -> Rec {
-    let f = |at: usize| f32::from_le_bytes([b[at], b[at + 1], b[at + 2], b[at + 3]]);
+    let f = |at: usize| f32_at(b, at);
     Rec {
         id: u64::from_le_bytes(b[..8].try_into().expect("8 bytes")),
         p: [f(8), f(12), f(16)],

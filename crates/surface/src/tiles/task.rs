@@ -19,8 +19,8 @@ use autoshovel_core::config;
 use serde::{Deserialize, Serialize};
 
 use super::store::{
-    dist_path, file_tile, halo_path, own_path, read_bytes_checked, read_checked, write_whole, Grid,
-    Loaded, Rec, Writer, DIST_RECORD,
+    dist_path, f32_at, file_tile, halo_path, own_path, read_bytes_checked, read_checked,
+    write_whole, Grid, Loaded, Rec, Writer, DIST_RECORD,
 };
 use super::BYTES_PER_POINT;
 use crate::error::{Result, SurfaceError};
@@ -324,7 +324,7 @@ pub fn run_tile_task(task: &TileTask) -> Result<TileReport> {
             let kept = own
                 .into_iter()
                 .zip(bytes.chunks_exact(DIST_RECORD))
-                .filter(|(_, b)| cut.keeps(f32::from_le_bytes([b[8], b[9], b[10], b[11]])))
+                .filter(|(_, b)| cut.keeps(f32_at(b, 8)))
                 .map(|(r, _)| r)
                 .collect();
             filed(kept, task.own[t])

@@ -284,21 +284,14 @@ impl Grid {
             }
             at += count;
         }
-        let close_up = |v: &mut [f32]| {
-            for &(from, count, to) in &moves {
-                v.copy_within(from..from + count, to);
-            }
-        };
         rayon::join(
             || {
-                close_up(&mut x);
-                close_up(&mut y);
+                close_up(&mut x, &moves);
+                close_up(&mut y, &moves);
             },
             || {
-                close_up(&mut z);
-                for &(from, count, to) in &moves {
-                    ids.copy_within(from..from + count, to);
-                }
+                close_up(&mut z, &moves);
+                close_up(&mut ids, &moves);
             },
         );
         for v in [&mut x, &mut y, &mut z] {
@@ -720,14 +713,11 @@ impl Grid {
             .collect()
     }
 
-    /// `values` by sorted position put in input order (the places of
-    /// inputs not filed left at the default).
     /// The input indices, ascending, of the points `keep` marks by sorted
-    /// position: through
-    /// a bitmap of the inputs, a bit a point, which stays in cache where a
-    /// byte a point in input order was written at random across 14 MB (at
-    /// 14 M points; with the indices' collection, a seventh of the radius
-    /// filter there).
+    /// position, through a bitmap of the inputs: a bit a point, which stays
+    /// in cache where a byte a point in input order was written at random
+    /// across 14 MB (at 14 M points; with the indices' collection, a
+    /// seventh of the radius filter there).
     pub(crate) fn kept_inputs(&self, keep: &[bool]) -> Vec<usize> {
         let words = self.inputs.div_ceil(64);
         let part = part_a_thread(keep.len());
@@ -840,6 +830,15 @@ impl Grid {
             runs[p / RUN][p % RUN] = Some(value);
         }
         self.runs_in_input_order(runs, Option::unwrap_or_default)
+    }
+}
+
+/// Moves each run `(from, count, to)` of `v` down to `to`, in order (no
+/// run's place is written before it is read: `to ≤ from`, and earlier
+/// runs end below later runs' places).
+fn close_up<T: Copy>(v: &mut [T], moves: &[(usize, usize, usize)]) {
+    for &(from, count, to) in moves {
+        v.copy_within(from..from + count, to);
     }
 }
 
