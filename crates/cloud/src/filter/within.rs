@@ -136,13 +136,14 @@ pub(super) fn count(isa: Isa, q: [f32; 3], run: Run, cap: f32) -> usize {
 /// k: a comparison sort or a quickselect of a few dozen branches on every
 /// comparison, which mispredicts on distances in no order (about 300 and
 /// 190 ns for 21 of 21–32 on the Xeon VM; 560 and 240 for 51 of 51–64).
-/// Up to 64 of them (96 on AVX-512) are ranked instead, branch-free: each
-/// value's rank is the count of values below it, a vector compare and add
-/// per value (`smallest` on AVX-512 and AVX2: 80 and 130 ns for 21 of
-/// 21–32, 160 and 250 ns for 51 of 51–64, 250 ns for 51 of 60–80 against
-/// 335 there), and those ranked below k are kept. Where the k-th value is
-/// tied (more than k are ranked below k), past those counts, and on the
-/// portable path, a quickselect (`select_nth_unstable`) does it.
+/// On AVX-512 up to 128 of them are sorted by a network instead, branch-free
+/// (`avx512::sort`): 24 ns for 21 of 21–32, 41 for 51 of 51–64, 95 for 51
+/// of 60–80 (ranking them, each value's rank the count of values below it,
+/// took 80, 160 and 250 ns; measured on the model-167 VM, 2026-12-05).
+/// On AVX2 up to 64 are ranked (112 and 188 ns), and those ranked below k
+/// are kept. Where the k-th value is tied (more than k are ranked below
+/// k), past those counts, and on the portable path, a quickselect
+/// (`select_nth_unstable`) does it.
 pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
     assert!(
         (1..=bits.len()).contains(&k),
@@ -158,17 +159,34 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 if bits.len() <= 64 => unsafe { avx2::smallest::<8>(bits, k) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if bits.len() <= 32 => unsafe { avx512::smallest::<2>(bits, k) },
+        Isa::Avx512 => sort_by_network(bits),
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if bits.len() <= 64 => unsafe { avx512::smallest::<4>(bits, k) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if bits.len() <= 96 => unsafe { avx512::smallest::<6>(bits, k) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 | Isa::Avx512 => false,
+        Isa::Avx2 => false,
     };
     if !ranked {
         bits.select_nth_unstable(k - 1);
     }
+}
+
+/// Sorts `values` ascending by `avx512::sort` when there are at most 128
+/// of them; `false`, with them untouched, when there are more.
+///
+/// Only where the machine has AVX-512: the caller's `Isa::Avx512` says so.
+#[cfg(target_arch = "x86_64")]
+fn sort_by_network(values: &mut [u32]) -> bool {
+    let n = values.len();
+    // SAFETY: `Isa::best` and `Isa::available` give `Isa::Avx512` only
+    // where the machine has AVX-512F; the lengths as `sort` requires.
+    unsafe {
+        match n {
+            0..=16 => avx512::sort::<1>(values),
+            17..=32 => avx512::sort::<2>(values),
+            33..=64 => avx512::sort::<4>(values),
+            65..=128 => avx512::sort::<8>(values),
+            _ => return false,
+        }
+    }
+    true
 }
 
 /// Most values [`ranks`] ranks (on AVX-512; 64 on AVX2).
@@ -207,11 +225,16 @@ pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) ->
 }
 
 /// Sorts `ids` ascending: a search's neighbours into input order (a few
-/// dozen, gathered column by column). Each is stored at its rank
-/// ([`ranks`]): on AVX-512 about a fifth of the time of `sort_unstable`
-/// for 30–60 values, which was a tenth of the smoothing stage's time.
-/// Ties, longer lists and the portable path take `sort_unstable`.
+/// dozen, gathered column by column). On AVX-512 by the network of
+/// `avx512::sort` (42 ns for 30–60 values); on AVX2 each is stored at its
+/// rank ([`ranks`], 125 ns), about half the time of `sort_unstable` (266
+/// ns), which was a tenth of the smoothing stage's time. Ties (on AVX2),
+/// longer lists and the portable path take `sort_unstable`.
 pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 && sort_by_network(ids) {
+        return;
+    }
     let ranked = ids.len() <= MOST_RANKED && {
         let mut keys = [0u32; MOST_RANKED];
         keys[..ids.len()].copy_from_slice(ids);
@@ -624,51 +647,127 @@ mod avx512 {
         }
         found
     }
-    /// The `k` smallest of `bits` (at most `16 · V`, each below 2³¹) by
-    /// rank, as [`super::smallest`]; `false`, with `bits` untouched, when
-    /// the k-th is tied.
+    /// Sorts `values` (at most `16 · V`) ascending as unsigned integers,
+    /// by a bitonic network over `V` registers: every stage compares each
+    /// lane with the lane `j` away (a permutation of the register, or the
+    /// register `j / 16` away), keeping the smaller or the larger by a
+    /// mask; lanes past the values hold `u32::MAX` and sort last. No
+    /// branch depends on the values: 32 of them sort in some 120 vector
+    /// instructions, where ranking them took a compare and an add a value
+    /// and a register (and a branchy sort mispredicts on distances in no
+    /// order). The stages are written out (`network!`) so that the
+    /// registers stay registers.
     ///
     /// # Safety
-    /// AVX-512F; `1 ≤ k ≤ bits.len() ≤ 16 · V ≤ 96`.
+    /// AVX-512F; `values.len() ≤ 16 · V`, `V` one of 1, 2, 4, 8.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn smallest<const V: usize>(bits: &mut [u32], k: usize) -> bool {
-        let n = bits.len();
-        debug_assert!(k >= 1 && k <= n && n <= 16 * V && 16 * V <= 96);
+    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
+        let n = values.len();
+        debug_assert!(n <= 16 * V && V.is_power_of_two() && V <= 8);
         let present: [__mmask16; V] = std::array::from_fn(|c| lanes((16 * c).min(n), n));
-        // SAFETY: masked loads touch only the lanes within `bits`.
-        let values: [__m512i; V] = std::array::from_fn(|c| unsafe {
-            _mm512_maskz_loadu_epi32(present[c], bits.as_ptr().add((16 * c).min(n)).cast())
+        let fill = _mm512_set1_epi32(-1);
+        // SAFETY: masked loads touch only the lanes within `values`.
+        let mut r: [__m512i; V] = std::array::from_fn(|c| unsafe {
+            _mm512_mask_loadu_epi32(
+                fill,
+                present[c],
+                values.as_ptr().add((16 * c).min(n)).cast(),
+            )
         });
-        // Below 2³¹, the values order alike as signed integers.
-        let (mut rank, one) = ([_mm512_setzero_si512(); V], _mm512_set1_epi32(1));
-        for &v in bits.iter() {
-            let v = _mm512_set1_epi32(v as i32);
-            for (rank, &lane) in rank.iter_mut().zip(&values) {
-                let above = _mm512_cmpgt_epi32_mask(lane, v);
-                *rank = _mm512_mask_add_epi32(*rank, above, *rank, one);
+        // Runs of `size` lanes are sorted up where (lane & size) = 0, down
+        // elsewhere (all up in the last round), from runs of half that.
+        macro_rules! network {
+            ($(($size:literal; $($j:literal)*))*) => {
+                $(if $size <= 16 * V {
+                    $(stage::<V, $size, $j>(&mut r);)*
+                })*
+            };
+        }
+        network! {
+            (2; 1) (4; 2 1) (8; 4 2 1) (16; 8 4 2 1) (32; 16 8 4 2 1)
+            (64; 32 16 8 4 2 1) (128; 64 32 16 8 4 2 1)
+        }
+        for (c, lane) in r.iter().enumerate() {
+            // SAFETY: masked stores touch only the lanes within `values`.
+            unsafe {
+                _mm512_mask_storeu_epi32(
+                    values.as_mut_ptr().add((16 * c).min(n)).cast(),
+                    present[c],
+                    *lane,
+                )
+            };
+        }
+    }
+
+    /// One stage of `sort`'s network: each lane against the lane `J` away,
+    /// in runs of `SIZE` sorted up or down.
+    #[inline(always)]
+    fn stage<const V: usize, const SIZE: usize, const J: usize>(r: &mut [__m512i; V]) {
+        // The lanes i of a register with i & j ≠ 0: the upper of each pair.
+        const fn upper(j: usize) -> __mmask16 {
+            match j {
+                1 => 0xAAAA,
+                2 => 0xCCCC,
+                4 => 0xF0F0,
+                _ => 0xFF00,
             }
         }
-        let below = _mm512_set1_epi32(k as i32);
-        let kept: [__mmask16; V] =
-            std::array::from_fn(|c| _mm512_mask_cmplt_epi32_mask(present[c], rank[c], below));
-        if kept.iter().map(|m| m.count_ones() as usize).sum::<usize>() != k {
-            return false;
+        if J >= 16 {
+            let d = J / 16;
+            for c in (0..V).filter(|c| c & d == 0 && (c | d) < V) {
+                // SAFETY: `sort`'s caller has AVX-512F.
+                let (lo, hi) = unsafe {
+                    (
+                        _mm512_min_epu32(r[c], r[c | d]),
+                        _mm512_max_epu32(r[c], r[c | d]),
+                    )
+                };
+                (r[c], r[c | d]) = if (16 * c) & SIZE == 0 {
+                    (lo, hi)
+                } else {
+                    (hi, lo)
+                };
+            }
+            return;
         }
-        // Those ranked below k, packed; then the largest of them last.
-        let mut packed = [0u32; 16 * 6 + 16];
-        let (mut count, mut top) = (0, _mm512_setzero_si512());
-        for c in 0..V {
-            let lanes = _mm512_maskz_compress_epi32(kept[c], values[c]);
-            // SAFETY: count + 16 ≤ 16 · V + 16 ≤ packed.len().
-            unsafe { _mm512_storeu_si512(packed.as_mut_ptr().add(count).cast(), lanes) };
-            count += kept[c].count_ones() as usize;
-            top = _mm512_mask_max_epi32(top, kept[c], top, values[c]);
+        // SAFETY: `sort`'s caller has AVX-512F.
+        unsafe {
+            let across = _mm512_setr_epi32(
+                J as i32,
+                1 ^ J as i32,
+                2 ^ J as i32,
+                3 ^ J as i32,
+                4 ^ J as i32,
+                5 ^ J as i32,
+                6 ^ J as i32,
+                7 ^ J as i32,
+                8 ^ J as i32,
+                9 ^ J as i32,
+                10 ^ J as i32,
+                11 ^ J as i32,
+                12 ^ J as i32,
+                13 ^ J as i32,
+                14 ^ J as i32,
+                15 ^ J as i32,
+            );
+            for (c, lane) in r.iter_mut().enumerate() {
+                let down = if SIZE < 16 {
+                    upper(SIZE)
+                } else if (16 * c) & SIZE != 0 {
+                    0xFFFF
+                } else {
+                    0
+                };
+                let other = _mm512_permutexvar_epi32(across, *lane);
+                let (lo, hi) = (
+                    _mm512_min_epu32(*lane, other),
+                    _mm512_max_epu32(*lane, other),
+                );
+                // The larger where a lane is its pair's upper in a run
+                // sorted up, or its lower in one sorted down.
+                *lane = _mm512_mask_mov_epi32(lo, upper(J) ^ down, hi);
+            }
         }
-        let top = _mm512_reduce_max_epi32(top) as u32;
-        let at = packed[..k].iter().rposition(|&v| v == top).unwrap_or(k - 1);
-        packed.swap(at, k - 1);
-        bits[..k].copy_from_slice(&packed[..k]);
-        true
     }
 
     /// [`super::ranks`] of at most `16 · V` values (ties not checked).
@@ -769,7 +868,7 @@ mod tests {
     fn every_path_leaves_the_k_smallest_with_the_kth_last() {
         let mut next = super::super::common::below(3);
         for trial in 0..20_000 {
-            let n = 1 + trial % 110;
+            let n = 1 + trial % 140;
             // Distances of every spread, ties (duplicates, zeros) among them
             // now and then, up to +∞.
             let spread = [3, 50, 1 << 20, 1 << 31][trial % 4];
@@ -802,7 +901,7 @@ mod tests {
     fn every_path_sorts_ids() {
         let mut next = super::super::common::below(5);
         for trial in 0..20_000 {
-            let n = trial % 110;
+            let n = trial % 140;
             // Distinct mostly, ties now and then, values up to u32::MAX
             // (above 2³¹ the signed compares would misorder them).
             let spread = [5, 1000, 1 << 31, 1 << 32][trial % 4];
