@@ -136,14 +136,13 @@ pub(super) fn count(isa: Isa, q: [f32; 3], run: Run, cap: f32) -> usize {
 /// k: a comparison sort or a quickselect of a few dozen branches on every
 /// comparison, which mispredicts on distances in no order (about 300 and
 /// 190 ns for 21 of 21–32 on the Xeon VM; 560 and 240 for 51 of 51–64).
-/// On AVX-512 up to 128 of them are sorted by a network instead, branch-free
-/// (`avx512::sort`): 24 ns for 21 of 21–32, 41 for 51 of 51–64, 95 for 51
-/// of 60–80 (ranking them, each value's rank the count of values below it,
-/// took 80, 160 and 250 ns; measured on the model-167 VM, 2026-12-05).
-/// On AVX2 up to 64 are ranked (112 and 188 ns), and those ranked below k
-/// are kept. Where the k-th value is tied (more than k are ranked below
-/// k), past those counts, and on the portable path, a quickselect
-/// (`select_nth_unstable`) does it.
+/// Up to 128 of them (64 on AVX2) are sorted by a network instead,
+/// branch-free (`avx512::sort`, `avx2::sort`): on AVX-512 and AVX2 24 and
+/// 49 ns for 21 of 21–32, 41 and 74 for 51 of 51–64, 95 ns for 51 of 60–80
+/// on AVX-512 (ranking them, each value's rank the count of values below
+/// it by a vector compare and add a value, took 80 and 112, 160 and 188,
+/// and 250; measured on the model-167 VM, 2026-12-05). Past those counts,
+/// and on the portable path, a quickselect (`select_nth_unstable`) does it.
 pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
     assert!(
         (1..=bits.len()).contains(&k),
@@ -155,34 +154,31 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
         // SAFETY: `Isa::best` and `Isa::available` give these only where
         // the machine has the instruction set; 1 ≤ k ≤ bits.len() above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if bits.len() <= 32 => unsafe { avx2::smallest::<4>(bits, k) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if bits.len() <= 64 => unsafe { avx2::smallest::<8>(bits, k) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => sort_by_network(bits),
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => false,
+        Isa::Avx2 | Isa::Avx512 => sort_by_network(isa, bits),
     };
     if !ranked {
         bits.select_nth_unstable(k - 1);
     }
 }
 
-/// Sorts `values` ascending by `avx512::sort` when there are at most 128
-/// of them; `false`, with them untouched, when there are more.
-///
-/// Only where the machine has AVX-512: the caller's `Isa::Avx512` says so.
+/// Sorts `values` ascending by the network of `avx512::sort` (at most
+/// 128 of them) or `avx2::sort` (at most 64); `false`, with them
+/// untouched, for more, or on the portable path.
 #[cfg(target_arch = "x86_64")]
-fn sort_by_network(values: &mut [u32]) -> bool {
+fn sort_by_network(isa: Isa, values: &mut [u32]) -> bool {
     let n = values.len();
-    // SAFETY: `Isa::best` and `Isa::available` give `Isa::Avx512` only
-    // where the machine has AVX-512F; the lengths as `sort` requires.
+    // SAFETY: `Isa::best` and `Isa::available` give these only where the
+    // machine has the instruction set; the lengths as `sort` requires.
     unsafe {
-        match n {
-            0..=16 => avx512::sort::<1>(values),
-            17..=32 => avx512::sort::<2>(values),
-            33..=64 => avx512::sort::<4>(values),
-            65..=128 => avx512::sort::<8>(values),
+        match (isa, n) {
+            (Isa::Avx512, 0..=16) => avx512::sort::<1>(values),
+            (Isa::Avx512, 17..=32) => avx512::sort::<2>(values),
+            (Isa::Avx512, 33..=64) => avx512::sort::<4>(values),
+            (Isa::Avx512, 65..=128) => avx512::sort::<8>(values),
+            (Isa::Avx2, 0..=8) => avx2::sort::<1>(values),
+            (Isa::Avx2, 9..=16) => avx2::sort::<2>(values),
+            (Isa::Avx2, 17..=32) => avx2::sort::<4>(values),
+            (Isa::Avx2, 33..=64) => avx2::sort::<8>(values),
             _ => return false,
         }
     }
@@ -225,14 +221,15 @@ pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) ->
 }
 
 /// Sorts `ids` ascending: a search's neighbours into input order (a few
-/// dozen, gathered column by column). On AVX-512 by the network of
-/// `avx512::sort` (42 ns for 30–60 values); on AVX2 each is stored at its
-/// rank ([`ranks`], 125 ns), about half the time of `sort_unstable` (266
-/// ns), which was a tenth of the smoothing stage's time. Ties (on AVX2),
-/// longer lists and the portable path take `sort_unstable`.
+/// dozen, gathered column by column). By the network of [`smallest`]: 42
+/// and 71 ns for 30–60 values on AVX-512 and AVX2, against 266 for
+/// `sort_unstable`, which was a tenth of the smoothing stage's time.
+/// Beyond the network (more than 128, or 64 on AVX2) each is stored at its
+/// rank ([`ranks`]) where it can be; ties, longer lists and the portable
+/// path take `sort_unstable`.
 pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 && sort_by_network(ids) {
+    if sort_by_network(isa, ids) {
         return;
     }
     let ranked = ids.len() <= MOST_RANKED && {
@@ -454,56 +451,101 @@ mod avx2 {
         found + portable::count(q, run.from(i), cap)
     }
 
-    /// The `k` smallest of `bits` (at most `8 · V`, each below 2³¹) by
-    /// rank, as [`super::smallest`]; `false`, with `bits` untouched, when
-    /// the k-th is tied.
+    /// Sorts `values` (at most `8 · V`) ascending as unsigned integers, by
+    /// the bitonic network of `avx512::sort` on registers of 8 lanes
+    /// (lanes picked by a vector mask, AVX2 having no mask registers).
     ///
     /// # Safety
-    /// AVX2; `1 ≤ k ≤ bits.len() ≤ 8 · V ≤ 64`.
+    /// AVX2; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn smallest<const V: usize>(bits: &mut [u32], k: usize) -> bool {
-        let n = bits.len();
-        debug_assert!(k >= 1 && k <= n && n <= 8 * V && 8 * V <= 64);
-        // Below 2³¹, the values order alike as signed integers (AVX2
-        // compares no other); the lanes past n are never read.
-        let mut values = [0i32; 64];
-        for (v, &b) in values.iter_mut().zip(bits.iter()) {
-            *v = b as i32;
-        }
-        // SAFETY: 8 · V ≤ 64 lanes of `values`.
-        let lanes: [__m256i; V] = std::array::from_fn(|c| unsafe {
-            _mm256_loadu_si256(values.as_ptr().add(8 * c).cast())
+    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
+        let n = values.len();
+        debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 8);
+        let mut filled = [u32::MAX; 64];
+        filled[..n].copy_from_slice(values);
+        // SAFETY: 8 · V ≤ 64 lanes of `filled`.
+        let mut r: [__m256i; V] = std::array::from_fn(|c| unsafe {
+            _mm256_loadu_si256(filled.as_ptr().add(8 * c).cast())
         });
-        let mut rank = [_mm256_setzero_si256(); V];
-        for &v in &values[..n] {
-            let v = _mm256_set1_epi32(v);
-            for (rank, &lane) in rank.iter_mut().zip(&lanes) {
-                // −1 where the lane's value is above v
-                *rank = _mm256_sub_epi32(*rank, _mm256_cmpgt_epi32(lane, v));
+        macro_rules! network {
+            ($(($size:literal; $($j:literal)*))*) => {
+                $(if $size <= 8 * V {
+                    $(stage::<V, $size, $j>(&mut r);)*
+                })*
+            };
+        }
+        network! {
+            (2; 1) (4; 2 1) (8; 4 2 1) (16; 8 4 2 1) (32; 16 8 4 2 1)
+            (64; 32 16 8 4 2 1)
+        }
+        for (c, lane) in r.iter().enumerate() {
+            // SAFETY: 8 · V ≤ 64 lanes of `filled`.
+            unsafe { _mm256_storeu_si256(filled.as_mut_ptr().add(8 * c).cast(), *lane) };
+        }
+        values.copy_from_slice(&filled[..n]);
+    }
+
+    /// One stage of `sort`'s network (see `avx512::stage`).
+    #[inline(always)]
+    fn stage<const V: usize, const SIZE: usize, const J: usize>(r: &mut [__m256i; V]) {
+        // Lane i's bit where i & j ≠ 0: the upper of each pair.
+        const fn upper(j: usize) -> u32 {
+            match j {
+                1 => 0xAA,
+                2 => 0xCC,
+                _ => 0xF0,
             }
         }
-        let mut ranks = [0i32; 64];
-        for (c, rank) in rank.iter().enumerate() {
-            // SAFETY: 8 · V ≤ 64 lanes of `ranks`.
-            unsafe { _mm256_storeu_si256(ranks.as_mut_ptr().add(8 * c).cast(), *rank) };
+        if J >= 8 {
+            let d = J / 8;
+            for c in (0..V).filter(|c| c & d == 0 && (c | d) < V) {
+                // SAFETY: `sort`'s caller has AVX2.
+                let (lo, hi) = unsafe {
+                    (
+                        _mm256_min_epu32(r[c], r[c | d]),
+                        _mm256_max_epu32(r[c], r[c | d]),
+                    )
+                };
+                (r[c], r[c | d]) = if (8 * c) & SIZE == 0 {
+                    (lo, hi)
+                } else {
+                    (hi, lo)
+                };
+            }
+            return;
         }
-        // Those ranked below k, packed without a branch, and where the largest of them lies.
-        let mut kept = [0u32; 65];
-        let (mut count, mut top, mut at) = (0, -1, 0);
-        for (&v, &r) in values[..n].iter().zip(&ranks) {
-            kept[count] = v as u32;
-            let keep = r < k as i32;
-            let higher = keep & (v >= top);
-            top = if higher { v } else { top };
-            at = if higher { count } else { at };
-            count += usize::from(keep);
+        let j = J as i32;
+        // SAFETY: `sort`'s caller has AVX2.
+        unsafe {
+            let across = _mm256_setr_epi32(j, 1 ^ j, 2 ^ j, 3 ^ j, 4 ^ j, 5 ^ j, 6 ^ j, 7 ^ j);
+            for (c, lane) in r.iter_mut().enumerate() {
+                let down = if SIZE < 8 {
+                    upper(SIZE)
+                } else if (8 * c) & SIZE != 0 {
+                    0xFF
+                } else {
+                    0
+                };
+                let larger = upper(J) ^ down;
+                let bit = |i: u32| -((larger >> i & 1) as i32);
+                let pick = _mm256_setr_epi32(
+                    bit(0),
+                    bit(1),
+                    bit(2),
+                    bit(3),
+                    bit(4),
+                    bit(5),
+                    bit(6),
+                    bit(7),
+                );
+                let other = _mm256_permutevar8x32_epi32(*lane, across);
+                let (lo, hi) = (
+                    _mm256_min_epu32(*lane, other),
+                    _mm256_max_epu32(*lane, other),
+                );
+                *lane = _mm256_blendv_epi8(lo, hi, pick);
+            }
         }
-        if count != k {
-            return false;
-        }
-        kept.swap(at, k - 1);
-        bits[..k].copy_from_slice(&kept[..k]);
-        true
     }
 
     /// [`super::ranks`] of at most `8 · V` values (ties not checked).
