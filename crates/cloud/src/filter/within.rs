@@ -74,13 +74,16 @@ impl Isa {
         let mut all = vec![Isa::Portable];
         #[cfg(target_arch = "x86_64")]
         {
-            if std::arch::is_x86_feature_detected!("avx2") {
+            // (every machine with AVX2 has POPCNT, which counts the kept
+            // lanes: without it a count is a dozen dependent instructions
+            // on the search loop's critical path; checked all the same)
+            let avx2 = std::arch::is_x86_feature_detected!("avx2")
+                && std::arch::is_x86_feature_detected!("popcnt");
+            if avx2 {
                 all.push(Isa::Avx2);
             }
             // (every AVX-512 machine has AVX2; the other paths rely on it)
-            if std::arch::is_x86_feature_detected!("avx512f")
-                && std::arch::is_x86_feature_detected!("avx2")
-            {
+            if std::arch::is_x86_feature_detected!("avx512f") && avx2 {
                 all.push(Isa::Avx512);
             }
         }
@@ -397,7 +400,7 @@ mod avx2 {
 
     /// # Safety
     /// AVX2; equal axes; `payload` as long as the run when `PAYLOAD`.
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt")]
     pub(super) unsafe fn keep<const PAYLOAD: bool>(
         q: [f32; 3],
         run: Run,
@@ -437,7 +440,7 @@ mod avx2 {
 
     /// # Safety
     /// AVX2; equal axes.
-    #[target_feature(enable = "avx2")]
+    #[target_feature(enable = "avx2,popcnt")]
     pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
         let n = run.x.len();
         let (qv, capv) = (splat(q), _mm256_set1_ps(cap));
@@ -636,7 +639,7 @@ mod avx512 {
 
     /// # Safety
     /// AVX-512F; equal axes; `payload` as long as the run when `PAYLOAD`.
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn keep<const PAYLOAD: bool>(
         q: [f32; 3],
         run: Run,
@@ -675,7 +678,7 @@ mod avx512 {
 
     /// # Safety
     /// AVX-512F; equal axes.
-    #[target_feature(enable = "avx512f")]
+    #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
         let n = run.x.len();
         let (qv, capv) = (splat(q), _mm512_set1_ps(cap));
