@@ -188,6 +188,29 @@ fn sort_by_network(isa: Isa, values: &mut [u32]) -> bool {
     true
 }
 
+/// Sorts `values` ascending by the network of `avx512::sort_wide` (at most
+/// 128 of them, on AVX-512); `false`, with them untouched, elsewhere.
+pub(super) fn sort_wide(isa: Isa, values: &mut [u64]) -> bool {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        // SAFETY: `Isa::best` and `Isa::available` give `Isa::Avx512` only
+        // where the machine has AVX-512F; the lengths as `sort_wide` requires.
+        unsafe {
+            match values.len() {
+                0..=8 => avx512::sort_wide::<1>(values),
+                9..=16 => avx512::sort_wide::<2>(values),
+                17..=32 => avx512::sort_wide::<4>(values),
+                33..=64 => avx512::sort_wide::<8>(values),
+                65..=128 => avx512::sort_wide::<16>(values),
+                _ => return false,
+            }
+        }
+        return true;
+    }
+    let _ = (isa, values);
+    false
+}
+
 /// Most values [`ranks`] ranks (on AVX-512; 64 on AVX2).
 pub(super) const MOST_RANKED: usize = 96;
 
@@ -294,6 +317,107 @@ fn check(run: Run) {
 fn squared(q: [f32; 3], x: f32, y: f32, z: f32) -> f32 {
     let (dx, dy, dz) = (q[0] - x, q[1] - y, q[2] - z);
     dx * dx + dy * dy + dz * dz
+}
+
+/// A vector register of unsigned lanes that [`network`] sorts.
+#[cfg(target_arch = "x86_64")]
+trait Network: Copy {
+    /// Lanes a register.
+    const LANES: usize;
+    /// The lane-wise smaller and larger of `a` and `b`.
+    ///
+    /// # Safety
+    /// The register's instruction set.
+    unsafe fn min_max(a: Self, b: Self) -> (Self, Self);
+    /// Lane i holding lane i ^ j (`j` below `LANES`).
+    ///
+    /// # Safety
+    /// The register's instruction set.
+    unsafe fn partner(self, j: usize) -> Self;
+    /// `hi`'s lanes where `mask` has their bit, `lo`'s elsewhere.
+    ///
+    /// # Safety
+    /// The register's instruction set.
+    unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self;
+}
+
+/// Sorts the lanes of `r` ascending, register after register: a bitonic
+/// network, each stage comparing every lane with the lane `j` away (a
+/// permutation of the register, or the register `j / LANES` away) and
+/// keeping the smaller or the larger by a mask. No branch depends on the
+/// values, where a comparison sort mispredicts on distances in no order;
+/// 32 lanes of u32 sort in some 120 instructions, where ranking them took a
+/// compare and an add a value and a register. The stages are written out
+/// (`stages!`), with constant masks and permutations, so that the
+/// registers stay registers.
+///
+/// # Safety
+/// The register's instruction set; `V` a power of two, `LANES · V ≤ 128`.
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn network<R: Network, const V: usize>(r: &mut [R; V]) {
+    macro_rules! stages {
+        ($(($size:literal; $($j:literal)*))*) => {
+            $(if $size <= R::LANES * V {
+                // SAFETY: as this function's.
+                $(unsafe { stage::<R, V, $size, $j>(r) };)*
+            })*
+        };
+    }
+    stages! {
+        (2; 1) (4; 2 1) (8; 4 2 1) (16; 8 4 2 1) (32; 16 8 4 2 1)
+        (64; 32 16 8 4 2 1) (128; 64 32 16 8 4 2 1)
+    }
+}
+
+/// One stage of [`network`]: runs of `SIZE` lanes sorted up where
+/// (lane & SIZE) = 0 and down elsewhere (all up in the last round), each
+/// lane against the lane `J` away.
+///
+/// # Safety
+/// As [`network`].
+#[cfg(target_arch = "x86_64")]
+#[inline(always)]
+unsafe fn stage<R: Network, const V: usize, const SIZE: usize, const J: usize>(r: &mut [R; V]) {
+    let all = (1u32 << R::LANES) - 1;
+    // A register's lanes i with i & j ≠ 0: the upper of each pair.
+    let upper = |j: usize| -> u32 {
+        all & match j {
+            1 => 0xAAAA,
+            2 => 0xCCCC,
+            4 => 0xF0F0,
+            _ => 0xFF00,
+        }
+    };
+    if J >= R::LANES {
+        let d = J / R::LANES;
+        for c in (0..V).filter(|c| c & d == 0 && (c | d) < V) {
+            // SAFETY: as this function's.
+            let (lo, hi) = unsafe { R::min_max(r[c], r[c | d]) };
+            (r[c], r[c | d]) = if (R::LANES * c) & SIZE == 0 {
+                (lo, hi)
+            } else {
+                (hi, lo)
+            };
+        }
+        return;
+    }
+    for (c, lane) in r.iter_mut().enumerate() {
+        let down = if SIZE < R::LANES {
+            upper(SIZE)
+        } else if (R::LANES * c) & SIZE != 0 {
+            all
+        } else {
+            0
+        };
+        // SAFETY: as this function's.
+        unsafe {
+            let (lo, hi) = R::min_max(*lane, lane.partner(J));
+            // The larger where a lane is its pair's upper in a run sorted
+            // up, or its lower in one sorted down.
+            *lane = R::pick(lo, hi, upper(J) ^ down);
+        }
+    }
 }
 
 mod portable {
@@ -454,83 +578,37 @@ mod avx2 {
         found + portable::count(q, run.from(i), cap)
     }
 
-    /// Sorts `values` (at most `8 · V`) ascending as unsigned integers, by
-    /// the bitonic network of `avx512::sort` on registers of 8 lanes
-    /// (lanes picked by a vector mask, AVX2 having no mask registers).
-    ///
-    /// # Safety
-    /// AVX2; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8.
-    #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
-        let n = values.len();
-        debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 8);
-        let mut filled = [u32::MAX; 64];
-        filled[..n].copy_from_slice(values);
-        // SAFETY: 8 · V ≤ 64 lanes of `filled`.
-        let mut r: [__m256i; V] = std::array::from_fn(|c| unsafe {
-            _mm256_loadu_si256(filled.as_ptr().add(8 * c).cast())
-        });
-        macro_rules! network {
-            ($(($size:literal; $($j:literal)*))*) => {
-                $(if $size <= 8 * V {
-                    $(stage::<V, $size, $j>(&mut r);)*
-                })*
-            };
-        }
-        network! {
-            (2; 1) (4; 2 1) (8; 4 2 1) (16; 8 4 2 1) (32; 16 8 4 2 1)
-            (64; 32 16 8 4 2 1)
-        }
-        for (c, lane) in r.iter().enumerate() {
-            // SAFETY: 8 · V ≤ 64 lanes of `filled`.
-            unsafe { _mm256_storeu_si256(filled.as_mut_ptr().add(8 * c).cast(), *lane) };
-        }
-        values.copy_from_slice(&filled[..n]);
-    }
+    /// A register of 8 lanes of u32 for [`super::network`] (lanes picked
+    /// by a vector mask, AVX2 having no mask registers).
+    #[derive(Clone, Copy)]
+    pub(super) struct Lanes(__m256i);
 
-    /// One stage of `sort`'s network (see `avx512::stage`).
-    #[inline(always)]
-    fn stage<const V: usize, const SIZE: usize, const J: usize>(r: &mut [__m256i; V]) {
-        // Lane i's bit where i & j ≠ 0: the upper of each pair.
-        const fn upper(j: usize) -> u32 {
-            match j {
-                1 => 0xAA,
-                2 => 0xCC,
-                _ => 0xF0,
+    impl super::Network for Lanes {
+        const LANES: usize = 8;
+        #[inline(always)]
+        unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
+            // SAFETY: the caller has AVX2.
+            unsafe {
+                (
+                    Self(_mm256_min_epu32(a.0, b.0)),
+                    Self(_mm256_max_epu32(a.0, b.0)),
+                )
             }
         }
-        if J >= 8 {
-            let d = J / 8;
-            for c in (0..V).filter(|c| c & d == 0 && (c | d) < V) {
-                // SAFETY: `sort`'s caller has AVX2.
-                let (lo, hi) = unsafe {
-                    (
-                        _mm256_min_epu32(r[c], r[c | d]),
-                        _mm256_max_epu32(r[c], r[c | d]),
-                    )
-                };
-                (r[c], r[c | d]) = if (8 * c) & SIZE == 0 {
-                    (lo, hi)
-                } else {
-                    (hi, lo)
-                };
+        #[inline(always)]
+        unsafe fn partner(self, j: usize) -> Self {
+            let j = j as i32;
+            // SAFETY: the caller has AVX2.
+            unsafe {
+                let across = _mm256_setr_epi32(j, 1 ^ j, 2 ^ j, 3 ^ j, 4 ^ j, 5 ^ j, 6 ^ j, 7 ^ j);
+                Self(_mm256_permutevar8x32_epi32(self.0, across))
             }
-            return;
         }
-        let j = J as i32;
-        // SAFETY: `sort`'s caller has AVX2.
-        unsafe {
-            let across = _mm256_setr_epi32(j, 1 ^ j, 2 ^ j, 3 ^ j, 4 ^ j, 5 ^ j, 6 ^ j, 7 ^ j);
-            for (c, lane) in r.iter_mut().enumerate() {
-                let down = if SIZE < 8 {
-                    upper(SIZE)
-                } else if (8 * c) & SIZE != 0 {
-                    0xFF
-                } else {
-                    0
-                };
-                let larger = upper(J) ^ down;
-                let bit = |i: u32| -((larger >> i & 1) as i32);
+        #[inline(always)]
+        unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
+            let bit = |i: u32| -((mask >> i & 1) as i32);
+            // SAFETY: the caller has AVX2.
+            unsafe {
                 let pick = _mm256_setr_epi32(
                     bit(0),
                     bit(1),
@@ -541,14 +619,33 @@ mod avx2 {
                     bit(6),
                     bit(7),
                 );
-                let other = _mm256_permutevar8x32_epi32(*lane, across);
-                let (lo, hi) = (
-                    _mm256_min_epu32(*lane, other),
-                    _mm256_max_epu32(*lane, other),
-                );
-                *lane = _mm256_blendv_epi8(lo, hi, pick);
+                Self(_mm256_blendv_epi8(lo.0, hi.0, pick))
             }
         }
+    }
+
+    /// Sorts `values` (at most `8 · V`) ascending as unsigned integers by
+    /// [`super::network`].
+    ///
+    /// # Safety
+    /// AVX2; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
+        let n = values.len();
+        debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 8);
+        let mut filled = [u32::MAX; 64];
+        filled[..n].copy_from_slice(values);
+        // SAFETY: 8 · V ≤ 64 lanes of `filled`.
+        let mut r: [Lanes; V] = std::array::from_fn(|c| unsafe {
+            Lanes(_mm256_loadu_si256(filled.as_ptr().add(8 * c).cast()))
+        });
+        // SAFETY: AVX2, as the network's registers need.
+        unsafe { super::network(&mut r) };
+        for (c, lane) in r.iter().enumerate() {
+            // SAFETY: 8 · V ≤ 64 lanes of `filled`.
+            unsafe { _mm256_storeu_si256(filled.as_mut_ptr().add(8 * c).cast(), lane.0) };
+        }
+        values.copy_from_slice(&filled[..n]);
     }
 
     /// [`super::ranks`] of at most `8 · V` values (ties not checked).
@@ -692,16 +789,72 @@ mod avx512 {
         }
         found
     }
-    /// Sorts `values` (at most `16 · V`) ascending as unsigned integers,
-    /// by a bitonic network over `V` registers: every stage compares each
-    /// lane with the lane `j` away (a permutation of the register, or the
-    /// register `j / 16` away), keeping the smaller or the larger by a
-    /// mask; lanes past the values hold `u32::MAX` and sort last. No
-    /// branch depends on the values: 32 of them sort in some 120 vector
-    /// instructions, where ranking them took a compare and an add a value
-    /// and a register (and a branchy sort mispredicts on distances in no
-    /// order). The stages are written out (`network!`) so that the
-    /// registers stay registers.
+    /// A register of 16 lanes of u32 for [`super::network`].
+    #[derive(Clone, Copy)]
+    pub(super) struct Lanes(__m512i);
+
+    impl super::Network for Lanes {
+        const LANES: usize = 16;
+        #[inline(always)]
+        unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
+            // SAFETY: the caller has AVX-512F.
+            unsafe {
+                (
+                    Self(_mm512_min_epu32(a.0, b.0)),
+                    Self(_mm512_max_epu32(a.0, b.0)),
+                )
+            }
+        }
+        #[inline(always)]
+        unsafe fn partner(self, j: usize) -> Self {
+            let across: [i32; 16] = std::array::from_fn(|i| (i ^ j) as i32);
+            // SAFETY: the caller has AVX-512F; 16 lanes read.
+            unsafe {
+                let across = _mm512_loadu_si512(across.as_ptr().cast());
+                Self(_mm512_permutexvar_epi32(across, self.0))
+            }
+        }
+        #[inline(always)]
+        unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
+            // SAFETY: the caller has AVX-512F.
+            unsafe { Self(_mm512_mask_mov_epi32(lo.0, mask as __mmask16, hi.0)) }
+        }
+    }
+
+    /// A register of 8 lanes of u64 for [`super::network`].
+    #[derive(Clone, Copy)]
+    pub(super) struct Wide(__m512i);
+
+    impl super::Network for Wide {
+        const LANES: usize = 8;
+        #[inline(always)]
+        unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
+            // SAFETY: the caller has AVX-512F.
+            unsafe {
+                (
+                    Self(_mm512_min_epu64(a.0, b.0)),
+                    Self(_mm512_max_epu64(a.0, b.0)),
+                )
+            }
+        }
+        #[inline(always)]
+        unsafe fn partner(self, j: usize) -> Self {
+            let across: [i64; 8] = std::array::from_fn(|i| (i ^ j) as i64);
+            // SAFETY: the caller has AVX-512F; 8 lanes read.
+            unsafe {
+                let across = _mm512_loadu_si512(across.as_ptr().cast());
+                Self(_mm512_permutexvar_epi64(across, self.0))
+            }
+        }
+        #[inline(always)]
+        unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
+            // SAFETY: the caller has AVX-512F.
+            unsafe { Self(_mm512_mask_mov_epi64(lo.0, mask as __mmask8, hi.0)) }
+        }
+    }
+
+    /// Sorts `values` (at most `16 · V`) ascending as unsigned integers by
+    /// [`super::network`].
     ///
     /// # Safety
     /// AVX-512F; `values.len() ≤ 16 · V`, `V` one of 1, 2, 4, 8.
@@ -712,106 +865,51 @@ mod avx512 {
         let present: [__mmask16; V] = std::array::from_fn(|c| lanes((16 * c).min(n), n));
         let fill = _mm512_set1_epi32(-1);
         // SAFETY: masked loads touch only the lanes within `values`.
-        let mut r: [__m512i; V] = std::array::from_fn(|c| unsafe {
-            _mm512_mask_loadu_epi32(
-                fill,
-                present[c],
-                values.as_ptr().add((16 * c).min(n)).cast(),
-            )
+        let mut r: [Lanes; V] = std::array::from_fn(|c| unsafe {
+            let at = values.as_ptr().add((16 * c).min(n));
+            Lanes(_mm512_mask_loadu_epi32(fill, present[c], at.cast()))
         });
-        // Runs of `size` lanes are sorted up where (lane & size) = 0, down
-        // elsewhere (all up in the last round), from runs of half that.
-        macro_rules! network {
-            ($(($size:literal; $($j:literal)*))*) => {
-                $(if $size <= 16 * V {
-                    $(stage::<V, $size, $j>(&mut r);)*
-                })*
-            };
-        }
-        network! {
-            (2; 1) (4; 2 1) (8; 4 2 1) (16; 8 4 2 1) (32; 16 8 4 2 1)
-            (64; 32 16 8 4 2 1) (128; 64 32 16 8 4 2 1)
-        }
+        // SAFETY: AVX-512F, as the network's registers need.
+        unsafe { super::network(&mut r) };
         for (c, lane) in r.iter().enumerate() {
             // SAFETY: masked stores touch only the lanes within `values`.
             unsafe {
-                _mm512_mask_storeu_epi32(
-                    values.as_mut_ptr().add((16 * c).min(n)).cast(),
-                    present[c],
-                    *lane,
-                )
+                let at = values.as_mut_ptr().add((16 * c).min(n));
+                _mm512_mask_storeu_epi32(at.cast(), present[c], lane.0)
             };
         }
     }
 
-    /// One stage of `sort`'s network: each lane against the lane `J` away,
-    /// in runs of `SIZE` sorted up or down.
-    #[inline(always)]
-    fn stage<const V: usize, const SIZE: usize, const J: usize>(r: &mut [__m512i; V]) {
-        // The lanes i of a register with i & j ≠ 0: the upper of each pair.
-        const fn upper(j: usize) -> __mmask16 {
-            match j {
-                1 => 0xAAAA,
-                2 => 0xCCCC,
-                4 => 0xF0F0,
-                _ => 0xFF00,
+    /// Sorts `values` (at most `8 · V`) ascending by [`super::network`].
+    ///
+    /// # Safety
+    /// AVX-512F; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8, 16.
+    #[target_feature(enable = "avx512f")]
+    pub(super) unsafe fn sort_wide<const V: usize>(values: &mut [u64]) {
+        let n = values.len();
+        debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 16);
+        let present: [__mmask8; V] = std::array::from_fn(|c| {
+            let left = n - (8 * c).min(n);
+            if left >= 8 {
+                u8::MAX
+            } else {
+                (1u8 << left) - 1
             }
-        }
-        if J >= 16 {
-            let d = J / 16;
-            for c in (0..V).filter(|c| c & d == 0 && (c | d) < V) {
-                // SAFETY: `sort`'s caller has AVX-512F.
-                let (lo, hi) = unsafe {
-                    (
-                        _mm512_min_epu32(r[c], r[c | d]),
-                        _mm512_max_epu32(r[c], r[c | d]),
-                    )
-                };
-                (r[c], r[c | d]) = if (16 * c) & SIZE == 0 {
-                    (lo, hi)
-                } else {
-                    (hi, lo)
-                };
-            }
-            return;
-        }
-        // SAFETY: `sort`'s caller has AVX-512F.
-        unsafe {
-            let across = _mm512_setr_epi32(
-                J as i32,
-                1 ^ J as i32,
-                2 ^ J as i32,
-                3 ^ J as i32,
-                4 ^ J as i32,
-                5 ^ J as i32,
-                6 ^ J as i32,
-                7 ^ J as i32,
-                8 ^ J as i32,
-                9 ^ J as i32,
-                10 ^ J as i32,
-                11 ^ J as i32,
-                12 ^ J as i32,
-                13 ^ J as i32,
-                14 ^ J as i32,
-                15 ^ J as i32,
-            );
-            for (c, lane) in r.iter_mut().enumerate() {
-                let down = if SIZE < 16 {
-                    upper(SIZE)
-                } else if (16 * c) & SIZE != 0 {
-                    0xFFFF
-                } else {
-                    0
-                };
-                let other = _mm512_permutexvar_epi32(across, *lane);
-                let (lo, hi) = (
-                    _mm512_min_epu32(*lane, other),
-                    _mm512_max_epu32(*lane, other),
-                );
-                // The larger where a lane is its pair's upper in a run
-                // sorted up, or its lower in one sorted down.
-                *lane = _mm512_mask_mov_epi32(lo, upper(J) ^ down, hi);
-            }
+        });
+        let fill = _mm512_set1_epi64(-1);
+        // SAFETY: masked loads touch only the lanes within `values`.
+        let mut r: [Wide; V] = std::array::from_fn(|c| unsafe {
+            let at = values.as_ptr().add((8 * c).min(n));
+            Wide(_mm512_mask_loadu_epi64(fill, present[c], at.cast()))
+        });
+        // SAFETY: AVX-512F, as the network's registers need.
+        unsafe { super::network(&mut r) };
+        for (c, lane) in r.iter().enumerate() {
+            // SAFETY: masked stores touch only the lanes within `values`.
+            unsafe {
+                let at = values.as_mut_ptr().add((8 * c).min(n));
+                _mm512_mask_storeu_epi64(at.cast(), present[c], lane.0)
+            };
         }
     }
 
@@ -965,6 +1063,32 @@ mod tests {
                 let mut got = ids.clone();
                 sort_ids(isa, &mut got);
                 assert_eq!(got, want, "{isa:?} {ids:?}");
+            }
+        }
+    }
+
+    #[test]
+    fn every_path_sorts_wide_keys_or_declines() {
+        let mut next = super::super::common::below(11);
+        for trial in 0..20_000 {
+            let n = trial % 140;
+            // Keys of every spread up to u64::MAX, ties now and then.
+            let spread = [5, 1 << 20, 1 << 40, u64::MAX][trial % 4];
+            let keys: Vec<u64> = (0..n)
+                .map(|_| match next(30) {
+                    0 => u64::MAX,
+                    _ => next(spread),
+                })
+                .collect();
+            let mut want = keys.clone();
+            want.sort_unstable();
+            for isa in Isa::available() {
+                let mut got = keys.clone();
+                if sort_wide(isa, &mut got) {
+                    assert_eq!(got, want, "{isa:?} {keys:?}");
+                } else {
+                    assert_eq!(got, keys, "{isa:?} declined, untouched");
+                }
             }
         }
     }

@@ -890,16 +890,37 @@ fn set_bits(bits: &[u64]) -> Vec<usize> {
 }
 
 /// A column's entries (column above, height key below; point index) by
-/// height, ties by index: by rank ([`within::ranks`]) where the heights are
-/// distinct and a few dozen (a comparison sort of a column was half of
-/// filing a scan), else by a comparison sort.
+/// height, ties by index: on AVX-512 by a sorting network
+/// ([`within::sort_wide`]) of a key a point (height key above, index
+/// below) where a column holds at most 128; else by rank
+/// ([`within::ranks`]) where the heights are distinct and a few dozen (a
+/// comparison sort of a column was half of filing a scan), else by a
+/// comparison sort.
 fn sort_column(isa: Isa, column: &mut [(u64, u32)]) {
+    let n = column.len();
+    if n < 2 {
+        return;
+    }
+    #[cfg(target_arch = "x86_64")]
+    if n <= 128 && isa == Isa::Avx512 {
+        let mut keys = [0u64; 128];
+        for (key, &(c, i)) in keys.iter_mut().zip(column.iter()) {
+            *key = (c & u64::from(u32::MAX)) << 32 | u64::from(i);
+        }
+        if within::sort_wide(isa, &mut keys[..n]) {
+            let filed = column[0].0 & !u64::from(u32::MAX);
+            for (e, &key) in column.iter_mut().zip(&keys) {
+                *e = (filed | key >> 32, key as u32);
+            }
+            return;
+        }
+    }
     let mut heights = [0u32; within::MOST_RANKED];
-    let ranked = column.len() <= within::MOST_RANKED && {
+    let ranked = n <= within::MOST_RANKED && {
         for (h, e) in heights.iter_mut().zip(column.iter()) {
             *h = e.0 as u32;
         }
-        within::order_by_rank(isa, &heights[..column.len()], column)
+        within::order_by_rank(isa, &heights[..n], column)
     };
     if !ranked {
         column.sort_unstable();
@@ -1214,7 +1235,7 @@ mod tests {
     fn a_column_sorts_by_height_then_index_on_every_path() {
         let mut u = super::super::common::uniform(5);
         for trial in 0..3_000 {
-            let n = trial % 120;
+            let n = trial % 140;
             let column = 0x0000_0123_u64 << 32;
             // Distinct heights mostly, ties (a few values) now and then.
             let spread = if trial % 3 == 0 { 4.0 } else { 4e9 };
