@@ -299,43 +299,30 @@ pub(crate) fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> 
     use rayon::prelude::*;
     const PART: usize = 1 << 16;
     if points.len() <= PART {
-        let mut kept = Vec::new();
-        inliers_into(points, 0, plane, threshold, &mut kept);
-        return kept;
+        return inliers_from(points, 0, plane, threshold);
     }
     let parts: Vec<Vec<usize>> = points
         .par_chunks(PART)
         .enumerate()
-        .map(|(j, part)| {
-            let mut kept = Vec::new();
-            inliers_into(part, j * PART, plane, threshold, &mut kept);
-            kept
-        })
+        .map(|(j, part)| inliers_from(part, j * PART, plane, threshold))
         .collect();
     parts.concat()
 }
 
-/// Appends to `kept` `first + i` for each point `i` of `points` within
-/// `threshold` of `plane`. Every index is written and the count moves on
-/// by the test, with no branch on it: a floor's inliers and the pile's
-/// points come mixed, and a filter's branch mispredicted on them (the
+/// `first + i` for each point `i` of `points` within `threshold` of
+/// `plane`, ascending. Every index is written and the count moves on by
+/// the test, with no branch on it: a floor's inliers and the pile's points
+/// come mixed, and a filter's branch mispredicted on them (the
 /// hypotheses' inliers were most of the floor search of a 100 k-point frame).
-fn inliers_into(
-    points: &[[f64; 3]],
-    first: usize,
-    plane: &Plane,
-    threshold: f64,
-    kept: &mut Vec<usize>,
-) {
-    let start = kept.len();
-    kept.resize(start + points.len(), 0);
-    let slots = &mut kept[start..];
+fn inliers_from(points: &[[f64; 3]], first: usize, plane: &Plane, threshold: f64) -> Vec<usize> {
+    let mut kept = vec![0; points.len()];
     let mut count = 0;
     for (i, p) in points.iter().enumerate() {
-        slots[count] = first + i;
+        kept[count] = first + i;
         count += usize::from(plane.signed_distance(*p).abs() <= threshold);
     }
-    kept.truncate(start + count);
+    kept.truncate(count);
+    kept
 }
 
 fn distinct_triple(rng: &mut ChaCha8Rng, n: usize) -> (usize, usize, usize) {
