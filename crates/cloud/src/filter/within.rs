@@ -211,13 +211,14 @@ pub(super) fn sort_wide(isa: Isa, values: &mut [u64]) -> bool {
     false
 }
 
-/// Most values [`ranks`] ranks (on AVX-512; 64 on AVX2).
-pub(super) const MOST_RANKED: usize = 96;
+/// Most values [`ranks`] ranks.
+pub(super) const MOST_RANKED: usize = 64;
 
 /// Each of `values`' rank (the count of values below it, as unsigned
-/// integers) in `ranks[..n]`, by vector compares as in [`smallest`]; `false`
-/// where two are equal (no rank is then unique), for more than
-/// [`MOST_RANKED`] (64 on AVX2) values, and on the portable path.
+/// integers) in `ranks[..n]`, by vector compares (AVX2's, on AVX-512
+/// machines too, which sort by their network where this would serve);
+/// `false` where two are equal (no rank is then unique), for more than
+/// [`MOST_RANKED`] values, and on the portable path.
 pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) -> bool {
     let n = values.len();
     let ranked = match isa {
@@ -227,17 +228,11 @@ pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) ->
             true
         }
         // SAFETY: `Isa::best` and `Isa::available` give these only where
-        // the machine has the instruction set; the lengths as required.
+        // the machine has AVX2 (AVX-512 only with it); the lengths as required.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if n <= 32 => unsafe { avx2::ranks::<4>(values, ranks) },
+        Isa::Avx2 | Isa::Avx512 if n <= 32 => unsafe { avx2::ranks::<4>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 if n <= 64 => unsafe { avx2::ranks::<8>(values, ranks) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if n <= 32 => unsafe { avx512::ranks::<2>(values, ranks) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if n <= 64 => unsafe { avx512::ranks::<4>(values, ranks) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 if n <= 96 => unsafe { avx512::ranks::<6>(values, ranks) },
+        Isa::Avx2 | Isa::Avx512 if n <= 64 => unsafe { avx2::ranks::<8>(values, ranks) },
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 | Isa::Avx512 => false,
     };
@@ -250,22 +245,15 @@ pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) ->
 /// dozen, gathered column by column). By the network of [`smallest`]: 42
 /// and 71 ns for 30–60 values on AVX-512 and AVX2, against 266 for
 /// `sort_unstable`, which was a tenth of the smoothing stage's time.
-/// Beyond the network (more than 128, or 64 on AVX2) each is stored at its
-/// rank ([`ranks`]) where it can be; ties, longer lists and the portable
-/// path take `sort_unstable`.
+/// Longer lists (more than 128, or 64 on AVX2) and the portable path take
+/// `sort_unstable`.
 pub(super) fn sort_ids(isa: Isa, ids: &mut [u32]) {
     #[cfg(target_arch = "x86_64")]
     if sort_by_network(isa, ids) {
         return;
     }
-    let ranked = ids.len() <= MOST_RANKED && {
-        let mut keys = [0u32; MOST_RANKED];
-        keys[..ids.len()].copy_from_slice(ids);
-        order_by_rank(isa, &keys[..ids.len()], ids)
-    };
-    if !ranked {
-        ids.sort_unstable();
-    }
+    let _ = isa;
+    ids.sort_unstable();
 }
 
 /// Puts `items` in the order of their `keys` (one an item) where [`ranks`]
@@ -653,7 +641,7 @@ mod avx2 {
     /// # Safety
     /// AVX2; `values.len() ≤ 8 · V ≤ 64`.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 96]) -> bool {
+    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 64]) -> bool {
         let n = values.len();
         debug_assert!(n <= 8 * V && 8 * V <= 64);
         // AVX2 compares signed integers only: the sign bit flipped, they
@@ -675,7 +663,7 @@ mod avx2 {
             }
         }
         for (c, rank) in rank.iter().enumerate() {
-            // SAFETY: 8 · V ≤ 64 ≤ 96 lanes of `ranks`.
+            // SAFETY: 8 · V ≤ 64 lanes of `ranks`.
             unsafe { _mm256_storeu_si256(ranks.as_mut_ptr().add(8 * c).cast(), *rank) };
         }
         true
@@ -911,34 +899,6 @@ mod avx512 {
                 _mm512_mask_storeu_epi64(at.cast(), present[c], lane.0)
             };
         }
-    }
-
-    /// [`super::ranks`] of at most `16 · V` values (ties not checked).
-    ///
-    /// # Safety
-    /// AVX-512F; `values.len() ≤ 16 · V ≤ 96`.
-    #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 96]) -> bool {
-        let n = values.len();
-        debug_assert!(n <= 16 * V && 16 * V <= 96);
-        let present: [__mmask16; V] = std::array::from_fn(|c| lanes((16 * c).min(n), n));
-        // SAFETY: masked loads touch only the lanes within `values`.
-        let lanes: [__m512i; V] = std::array::from_fn(|c| unsafe {
-            _mm512_maskz_loadu_epi32(present[c], values.as_ptr().add((16 * c).min(n)).cast())
-        });
-        let (mut rank, one) = ([_mm512_setzero_si512(); V], _mm512_set1_epi32(1));
-        for &v in values {
-            let v = _mm512_set1_epi32(v as i32);
-            for (rank, &lane) in rank.iter_mut().zip(&lanes) {
-                let above = _mm512_cmpgt_epu32_mask(lane, v);
-                *rank = _mm512_mask_add_epi32(*rank, above, *rank, one);
-            }
-        }
-        for (c, rank) in rank.iter().enumerate() {
-            // SAFETY: 16 · V ≤ 96 lanes of `ranks`.
-            unsafe { _mm512_storeu_si512(ranks.as_mut_ptr().add(16 * c).cast(), *rank) };
-        }
-        true
     }
 }
 

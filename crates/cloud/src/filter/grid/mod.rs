@@ -15,8 +15,8 @@
 //! within the box's, as on a surface; else each column by two look-ups in
 //! its slabs), and one vector pass over those contiguous runs
 //! (`within.rs`) gives their squared distances and keeps those within r.
-//! If k of them lie within r, they hold the k nearest (kept by rank,
-//! `within::smallest`); otherwise r grows
+//! If k of them lie within r, they hold the k nearest (kept by a sorting
+//! network, `within::smallest`); otherwise r grows
 //! (by the count found, as on a surface) and the query is repeated. The
 //! queries are the grid's own points, a column's after one another, so the
 //! 3 × 3 columns round a column are described once for its queries and a
