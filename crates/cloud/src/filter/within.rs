@@ -777,69 +777,51 @@ mod avx512 {
         }
         found
     }
-    /// A register of 16 lanes of u32 for [`super::network`].
-    #[derive(Clone, Copy)]
-    pub(super) struct Lanes(__m512i);
+    /// A register type of AVX-512 for [`super::network`]: `$lanes` lanes
+    /// of `$index` (the permutation's lane type), compared, permuted and
+    /// picked by the instructions named.
+    macro_rules! network_register {
+        ($(#[$doc:meta])* $name:ident, $lanes:literal, $index:ty, $mask:ty,
+         $min:ident, $max:ident, $permute:ident, $mov:ident) => {
+            $(#[$doc])*
+            #[derive(Clone, Copy)]
+            pub(super) struct $name(__m512i);
 
-    impl super::Network for Lanes {
-        const LANES: usize = 16;
-        #[inline(always)]
-        unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
-            // SAFETY: the caller has AVX-512F.
-            unsafe {
-                (
-                    Self(_mm512_min_epu32(a.0, b.0)),
-                    Self(_mm512_max_epu32(a.0, b.0)),
-                )
+            impl super::Network for $name {
+                const LANES: usize = $lanes;
+                #[inline(always)]
+                unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
+                    // SAFETY: the caller has AVX-512F.
+                    unsafe { (Self($min(a.0, b.0)), Self($max(a.0, b.0))) }
+                }
+                #[inline(always)]
+                unsafe fn partner(self, j: usize) -> Self {
+                    let across: [$index; $lanes] = std::array::from_fn(|i| (i ^ j) as $index);
+                    // SAFETY: the caller has AVX-512F; one register's bytes read.
+                    unsafe {
+                        let across = _mm512_loadu_si512(across.as_ptr().cast());
+                        Self($permute(across, self.0))
+                    }
+                }
+                #[inline(always)]
+                unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
+                    // SAFETY: the caller has AVX-512F.
+                    unsafe { Self($mov(lo.0, mask as $mask, hi.0)) }
+                }
             }
-        }
-        #[inline(always)]
-        unsafe fn partner(self, j: usize) -> Self {
-            let across: [i32; 16] = std::array::from_fn(|i| (i ^ j) as i32);
-            // SAFETY: the caller has AVX-512F; 16 lanes read.
-            unsafe {
-                let across = _mm512_loadu_si512(across.as_ptr().cast());
-                Self(_mm512_permutexvar_epi32(across, self.0))
-            }
-        }
-        #[inline(always)]
-        unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
-            // SAFETY: the caller has AVX-512F.
-            unsafe { Self(_mm512_mask_mov_epi32(lo.0, mask as __mmask16, hi.0)) }
-        }
+        };
     }
 
-    /// A register of 8 lanes of u64 for [`super::network`].
-    #[derive(Clone, Copy)]
-    pub(super) struct Wide(__m512i);
-
-    impl super::Network for Wide {
-        const LANES: usize = 8;
-        #[inline(always)]
-        unsafe fn min_max(a: Self, b: Self) -> (Self, Self) {
-            // SAFETY: the caller has AVX-512F.
-            unsafe {
-                (
-                    Self(_mm512_min_epu64(a.0, b.0)),
-                    Self(_mm512_max_epu64(a.0, b.0)),
-                )
-            }
-        }
-        #[inline(always)]
-        unsafe fn partner(self, j: usize) -> Self {
-            let across: [i64; 8] = std::array::from_fn(|i| (i ^ j) as i64);
-            // SAFETY: the caller has AVX-512F; 8 lanes read.
-            unsafe {
-                let across = _mm512_loadu_si512(across.as_ptr().cast());
-                Self(_mm512_permutexvar_epi64(across, self.0))
-            }
-        }
-        #[inline(always)]
-        unsafe fn pick(lo: Self, hi: Self, mask: u32) -> Self {
-            // SAFETY: the caller has AVX-512F.
-            unsafe { Self(_mm512_mask_mov_epi64(lo.0, mask as __mmask8, hi.0)) }
-        }
-    }
+    network_register!(
+        /// A register of 16 lanes of u32 for [`super::network`].
+        Lanes, 16, i32, __mmask16,
+        _mm512_min_epu32, _mm512_max_epu32, _mm512_permutexvar_epi32, _mm512_mask_mov_epi32
+    );
+    network_register!(
+        /// A register of 8 lanes of u64 for [`super::network`].
+        Wide, 8, i64, __mmask8,
+        _mm512_min_epu64, _mm512_max_epu64, _mm512_permutexvar_epi64, _mm512_mask_mov_epi64
+    );
 
     /// Sorts `values` (at most `16 · V`) ascending as unsigned integers by
     /// [`super::network`].
