@@ -175,10 +175,7 @@ fn guarded<E: std::fmt::Display>(
         Ok(Ok(())) => Ok(()),
         Ok(Err(e)) => Err(plot_error(e.to_string())),
         Err(panic) => {
-            let detail = panic
-                .downcast_ref::<&str>()
-                .map(|s| (*s).to_string())
-                .or_else(|| panic.downcast_ref::<String>().cloned())
+            let detail = autoshovel_core::panic_message(panic.as_ref())
                 .unwrap_or_else(|| "unknown cause".to_string());
             Err(plot_error(format!(
                 "the plotting library panicked: {detail}"

@@ -152,14 +152,12 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
         "k = {k} of {} distances",
         bits.len()
     );
-    let ranked = match isa {
+    let sorted = match isa {
         Isa::Portable => false,
-        // SAFETY: `Isa::best` and `Isa::available` give these only where
-        // the machine has the instruction set; 1 ≤ k ≤ bits.len() above.
         #[cfg(target_arch = "x86_64")]
         Isa::Avx2 | Isa::Avx512 => sort_by_network(isa, bits),
     };
-    if !ranked {
+    if !sorted {
         bits.select_nth_unstable(k - 1);
     }
 }

@@ -440,11 +440,7 @@ impl<R: Seek> Seek for Patched<R> {
 /// the panic hook (stderr by default).
 fn without_panics<T>(path: &Path, f: impl FnOnce() -> crate::Result<T>) -> crate::Result<T> {
     std::panic::catch_unwind(std::panic::AssertUnwindSafe(f)).unwrap_or_else(|payload| {
-        let msg = payload
-            .downcast_ref::<&str>()
-            .map(|s| s.to_string())
-            .or_else(|| payload.downcast_ref::<String>().cloned())
-            .unwrap_or_default();
+        let msg = autoshovel_core::panic_message(payload.as_ref()).unwrap_or_default();
         Err(CloudError::Format {
             path: path.to_path_buf(),
             what: format!("LAS/LAZ decoder failed on malformed data: {msg}"),

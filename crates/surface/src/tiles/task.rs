@@ -178,7 +178,8 @@ impl TileExecutor for InProcess {
                                     problem: format!(
                                         "the task of tile {} failed: {}",
                                         tasks[i].tile,
-                                        panic_words(payload.as_ref())
+                                        autoshovel_core::panic_message(payload.as_ref())
+                                            .unwrap_or_else(|| "a panic".into())
                                     ),
                                 })
                             });
@@ -206,15 +207,6 @@ impl TileExecutor for InProcess {
             }
         })
     }
-}
-
-/// What a panic's payload says.
-fn panic_words(payload: &(dyn std::any::Any + Send)) -> String {
-    payload
-        .downcast_ref::<&str>()
-        .map(|s| s.to_string())
-        .or_else(|| payload.downcast_ref::<String>().cloned())
-        .unwrap_or_else(|| "a panic".into())
 }
 
 /// Hands out [`InProcess`]'s tasks in order, each when its memory fits
