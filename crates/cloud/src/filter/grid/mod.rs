@@ -1346,6 +1346,34 @@ mod tests {
     }
 
     #[test]
+    fn a_layer_thicker_than_a_column_is_wide_agrees_too() {
+        // A scan whose noise is several columns thick (`near.rs` reads a
+        // tall column whole when it holds few points, else cuts it by its
+        // slabs), dense on one side and sparse on the other, so that the
+        // tall columns come in both kinds.
+        let mut u = super::super::common::uniform(12);
+        let points: Vec<Point> = (0..24_000)
+            .map(|i| {
+                let x = if i < 20_000 {
+                    u() * 10.0
+                } else {
+                    10.0 + u() * 10.0
+                };
+                [x, u() * 5.0, 2.0 * u()]
+            })
+            .collect();
+        let grid = Grid::for_k_nearest(&points, 21).expect("a grid");
+        let tall: Vec<u32> = (0..grid.slabs.len())
+            .filter(|&c| f64::from(grid.slabs[c].top - grid.slabs[c].base) > near::WHOLE * grid.h)
+            .map(|c| grid.start[c + 1] - grid.start[c])
+            .collect();
+        let few = |&n: &u32| n <= near::WHOLE_POINTS;
+        assert!(tall.iter().any(few) && !tall.iter().all(few));
+        let (grid, tree) = both(&points, 21);
+        assert_eq!(grid, tree);
+    }
+
+    #[test]
     fn set_bits_are_found_in_order_in_any_parts() {
         let mut state = 3u64;
         let bits: Vec<u64> = (0..20_000)

@@ -13,16 +13,27 @@
 //! filing's rounding needs) only decides which side columns its box
 //! reaches: four comparisons, then one run a row wherever the row's
 //! columns lie next to each other in memory. A column whose heights span
-//! more than [`WHOLE`] sides (a wall, or an outlier high above the scan) is
-//! still cut to the box's heights by its slabs. A larger radius (a sparse
+//! more than [`WHOLE`] sides (a wall, or an outlier high above the scan)
+//! and that holds more than [`WHOLE_POINTS`] points is still cut to the
+//! box's heights by its slabs. A larger radius (a sparse
 //! spot, a far point) goes to `Grid::runs`. Either way every point within
 //! the radius is in some run, so the results are the same, bit for bit.
 
 use super::{block_index, gap, heights_within, Grid, BLOCK, MARGIN, SLACK};
 
 /// A column is read whole when its heights span at most this many
-/// sides, else cut by its slabs.
-const WHOLE: f64 = 2.0;
+/// sides, else cut by its slabs ...
+pub(super) const WHOLE: f64 = 2.0;
+
+/// ... unless it holds at most this many points: a few vector steps, which
+/// cost less than a run of its own (a cut column is one, where whole ones
+/// side by side are read as one). On a dense scan whose range noise is
+/// several column sides thick (the bench pile at 20 M points: columns of
+/// 2.9 cm, a noise of centimetres) most columns span more than [`WHOLE`]
+/// sides, and cutting them made twice the runs a query of the 1 M-point
+/// scan: the statistical filter there 1.96–2.11 s against 1.77–1.84 s
+/// read whole (BENCHMARKS.md, 2026-12-05).
+pub(super) const WHOLE_POINTS: u32 = 64;
 
 /// The 3 × 3 columns round one column (see the module docs).
 #[derive(Debug, Clone, Default)]
@@ -89,12 +100,13 @@ impl Grid {
                         let column = block_index(x, y, self.nx);
                         let slabs = &self.slabs[column];
                         let (low, top) = (f64::from(slabs.base), f64::from(slabs.top));
+                        let (s, e) = (self.start[column], self.start[column + 1]);
                         Cell {
                             column,
-                            span: (self.start[column] as usize, self.start[column + 1] as usize),
+                            span: (s as usize, e as usize),
                             low,
                             top,
-                            whole: top - low <= WHOLE * self.h,
+                            whole: top - low <= WHOLE * self.h || e - s <= WHOLE_POINTS,
                         }
                     }
                     // Past the grid: no points.
