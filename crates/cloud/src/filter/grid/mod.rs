@@ -809,7 +809,7 @@ impl Grid {
                 // send through `Grid::runs` (at 20 M points on the bench
                 // pile, 11 % of the searches; 6 % so).
                 *guess = (f64::from(kth).sqrt() * GUESS)
-                    .min(GUESS_REACH * self.h)
+                    .min(GUESS_REACH * self.near_width())
                     .max(self.h * 1e-3);
                 Some(answer(scratch))
             },
@@ -957,8 +957,8 @@ const RUN: usize = 4096;
 /// The next query's radius: this times the k-th distance of the last ...
 const GUESS: f64 = 1.1;
 
-/// ... at most this many column sides: within the reach of the columns
-/// round a query's own (`near.rs`).
+/// ... at most this share of [`Grid::near_width`]: within the reach of the
+/// columns round a query's own (`near.rs`).
 const GUESS_REACH: f64 = 0.99;
 
 /// The side of columns for searches within `radius`: a hair wider, so
@@ -1374,8 +1374,8 @@ mod tests {
             .collect();
         let few = |&n: &u32| n <= near::WHOLE_POINTS;
         assert!(tall.iter().any(few) && !tall.iter().all(few));
-        let (grid, tree) = both(&points, 21);
-        assert_eq!(grid, tree);
+        let tree = KdTree::new(&points).map_k_nearest_distances(21, bits);
+        assert_eq!(grid.map_k_nearest_distances(21, bits), tree);
     }
 
     #[test]
@@ -1388,8 +1388,8 @@ mod tests {
             .collect();
         let grid = Grid::for_k_nearest(&points, 11).expect("a grid");
         assert!(grid.ny.div_ceil(BLOCK) > DEAL_ROWS, "{} rows", grid.ny);
-        let (grid, tree) = both(&points, 11);
-        assert_eq!(grid, tree);
+        let tree = KdTree::new(&points).map_k_nearest_distances(11, bits);
+        assert_eq!(grid.map_k_nearest_distances(11, bits), tree);
     }
 
     #[test]

@@ -116,6 +116,13 @@ impl Grid {
         }
     }
 
+    /// The widest box (a radius widened by `SLACK`) that the columns round
+    /// a query's own answer: points of the columns two away lie more than
+    /// h − 2·margin off.
+    pub(super) fn near_width(&self) -> f64 {
+        self.h * (1.0 - 4.0 * MARGIN)
+    }
+
     /// As [`Grid::runs`], for the grid's own point at sorted position `p`
     /// (`q` its coordinates), with the columns round it kept in `near`.
     pub(super) fn runs_near(
@@ -127,8 +134,7 @@ impl Grid {
         mut visit: impl FnMut(usize, usize) -> bool,
     ) {
         let wide = r * (1.0 + SLACK);
-        // Points of the columns two away lie more than h − 2·margin off.
-        if wide >= self.h * (1.0 - 4.0 * MARGIN) {
+        if wide >= self.near_width() {
             self.runs(q, r, visit);
             return;
         }
