@@ -39,6 +39,7 @@ mod ransac;
 mod sample;
 pub mod tiles;
 mod volume;
+mod wide;
 
 pub use calibrate::{angles_from_normal, level, level_from_sensor, sensor_from_level, tilt};
 pub use error::{Result, SurfaceError};

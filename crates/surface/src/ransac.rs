@@ -18,6 +18,7 @@
 //!    covariance, which minimises Σ (n·p − d)² — then inliers are collected
 //!    again and the fit repeated ([`RansacParams::refine_rounds`] times).
 
+use autoshovel_cloud::filter::Isa;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
@@ -315,6 +316,24 @@ pub(crate) fn inliers_of(points: &[[f64; 3]], plane: &Plane, threshold: f64) -> 
 /// come mixed, and a filter's branch mispredicted on them (the
 /// hypotheses' inliers were most of the floor search of a 100 k-point frame).
 fn inliers_from(points: &[[f64; 3]], first: usize, plane: &Plane, threshold: f64) -> Vec<usize> {
+    inliers_from_on(Isa::best(), points, first, plane, threshold)
+}
+
+/// [`inliers_from`] on the path of `isa` (AVX-512: `wide::avx512`).
+fn inliers_from_on(
+    isa: Isa,
+    points: &[[f64; 3]],
+    first: usize,
+    plane: &Plane,
+    threshold: f64,
+) -> Vec<usize> {
+    #[cfg(target_arch = "x86_64")]
+    if isa == Isa::Avx512 {
+        // SAFETY: `Isa::best` and `Isa::available` give AVX-512 only where
+        // the machine has AVX-512F (and POPCNT).
+        return unsafe { crate::wide::avx512::inliers(points, first, plane, threshold) };
+    }
+    let _ = isa;
     let mut kept = vec![0; points.len()];
     let mut count = 0;
     for (i, p) in points.iter().enumerate() {
@@ -347,6 +366,49 @@ mod tests {
     use super::*;
     use approx::assert_relative_eq;
     use rand_distr::{Distribution, Normal};
+
+    /// Points near a tilted plane, some exactly a threshold off it (where
+    /// `<=` decides), some not numbers, in every count of a step's tail.
+    fn near_a_plane(n: usize, seed: u64) -> (Vec<[f64; 3]>, Plane) {
+        let plane = Plane::from_point_normal([0.0, 0.0, 1.5], [0.1, -0.05, 1.0]).unwrap();
+        let mut rng = ChaCha8Rng::seed_from_u64(seed);
+        let points = (0..n)
+            .map(|i| match i % 7 {
+                // On the plane's axis, exactly 0.05 above or below it.
+                0 => [0.0, 0.0, if i % 2 == 0 { 1.55 } else { 1.45 }],
+                1 if i % 3 == 0 => [f64::NAN, 1.0, 2.0],
+                _ => {
+                    let (x, y) = (rng.gen_range(-5.0..5.0), rng.gen_range(-5.0..5.0));
+                    [x, y, 1.5 - 0.1 * x + 0.05 * y + rng.gen_range(-0.2..0.2)]
+                }
+            })
+            .collect();
+        (points, plane)
+    }
+
+    #[test]
+    fn inliers_are_the_same_on_every_path() {
+        // The plane's normal is unit, so the points 0.05 off along z are a
+        // little less than 0.05 off it: the threshold is set to their own
+        // distance, to be met exactly.
+        for n in (0..=40).chain([1000, 4099]) {
+            let (points, plane) = near_a_plane(n, n as u64);
+            let on_edge = plane.signed_distance([0.0, 0.0, 1.55]).abs();
+            for threshold in [0.05, on_edge] {
+                let portable = inliers_from_on(Isa::Portable, &points, 3, &plane, threshold);
+                assert!(portable.iter().all(|&i| i >= 3 && i < n + 3));
+                for isa in Isa::available() {
+                    let got = inliers_from_on(isa, &points, 3, &plane, threshold);
+                    assert_eq!(got, portable, "{isa:?}, {n} points, threshold {threshold}");
+                }
+            }
+            // The edge case occurs: points exactly at the threshold kept.
+            if n > 0 {
+                let kept = inliers_from_on(Isa::Portable, &points, 0, &plane, on_edge);
+                assert!(kept.contains(&0), "{n} points");
+            }
+        }
+    }
 
     /// Points on z = 0.1 x − 0.05 y + 2 with noise, plus gross outliers above.
     fn noisy_plane(n: usize, outliers: usize, seed: u64) -> Vec<[f64; 3]> {

@@ -50,3 +50,4 @@ pub use statistical_outlier::{
     StatisticalOutlierParams,
 };
 pub use voxel_grid::{voxel_grid, VoxelCells, VoxelGridParams};
+pub use within::Isa;

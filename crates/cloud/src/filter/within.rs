@@ -41,12 +41,16 @@ impl Run<'_> {
     }
 }
 
-/// The instruction sets with a path of their own.
+/// The instruction sets with a path of their own (the filters' and the
+/// floor search's): every path gives the same bits.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub(super) enum Isa {
+pub enum Isa {
+    /// The target's baseline (SSE2 on x86-64).
     Portable,
+    /// AVX2 (with POPCNT).
     #[cfg(target_arch = "x86_64")]
     Avx2,
+    /// AVX-512F (with AVX2).
     #[cfg(target_arch = "x86_64")]
     Avx512,
 }
@@ -55,7 +59,7 @@ impl Isa {
     /// The widest this machine runs (found once), or a narrower one named
     /// by the environment variable `AUTOSHOVEL_ISA` (`portable`, `avx2`):
     /// to measure the paths side by side, or to rule one out.
-    pub(super) fn best() -> Self {
+    pub fn best() -> Self {
         static BEST: OnceLock<Isa> = OnceLock::new();
         *BEST.get_or_init(|| {
             let all = Self::available();
@@ -70,7 +74,7 @@ impl Isa {
     }
 
     /// Every path this machine runs, the portable one first.
-    pub(super) fn available() -> Vec<Self> {
+    pub fn available() -> Vec<Self> {
         let mut all = vec![Isa::Portable];
         #[cfg(target_arch = "x86_64")]
         {
