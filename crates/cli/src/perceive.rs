@@ -129,6 +129,13 @@ pub fn run(args: &Args) -> Result<()> {
         });
     }
     if input.is_dir() {
+        // The first frame's memory mapped now, at start-up (heap::warm).
+        if let Some(first) = autoshovel_surface::frames::frames_in(input)
+            .ok()
+            .and_then(|files| files.into_iter().next())
+        {
+            crate::heap::warm(std::fs::metadata(first).map_or(0, |m| m.len()));
+        }
         let options = autoshovel_surface::frames::FrameOptions {
             relevel_every: args.relevel_every,
             model_cell_m: args.model_cell,
