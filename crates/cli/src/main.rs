@@ -23,6 +23,7 @@ mod pile;
 mod plan_dig;
 mod plan_excavate;
 mod plan_path;
+mod sched;
 mod shift;
 mod study;
 mod study_boulders;

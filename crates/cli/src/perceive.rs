@@ -21,6 +21,12 @@ pub struct Args {
     /// Frame mode: search the floor and level again every N frames (0: once).
     #[arg(long, default_value_t = 0)]
     pub relevel_every: usize,
+    /// Frame mode: run under real-time scheduling (SCHED_FIFO) at this
+    /// priority, 1–99 (10 when given bare), so that other tasks on the
+    /// machine wait for a frame rather than a frame for them; needs root or
+    /// CAP_SYS_NICE.
+    #[arg(long, num_args = 0..=1, default_missing_value = "10", value_name = "PRIORITY")]
+    pub realtime: Option<u8>,
     /// Frame mode: cell edge of the running height model [m] (default: 4 × the
     /// point spacing); survey mode: of the survey's height model (default 1 m).
     #[arg(long)]
@@ -72,8 +78,8 @@ pub fn run(args: &Args) -> Result<()> {
         args.output.force,
     )?;
     if args.tiles || args.tile_size.is_some() {
-        if args.relevel_every != 0 {
-            anyhow::bail!("--relevel-every is for a folder of frames, not --tiles");
+        if args.relevel_every != 0 || args.realtime.is_some() {
+            anyhow::bail!("--relevel-every and --realtime are for a folder of frames, not --tiles");
         }
         if !(args.memory_limit.is_finite() && args.memory_limit > 0.0) {
             anyhow::bail!(
@@ -129,6 +135,9 @@ pub fn run(args: &Args) -> Result<()> {
         });
     }
     if input.is_dir() {
+        if let Some(priority) = args.realtime {
+            crate::sched::realtime(priority)?;
+        }
         // The first frame's memory mapped now, at start-up (heap::warm).
         if let Some(first) = autoshovel_surface::frames::frames_in(input)
             .ok()
@@ -139,6 +148,7 @@ pub fn run(args: &Args) -> Result<()> {
         let options = autoshovel_surface::frames::FrameOptions {
             relevel_every: args.relevel_every,
             model_cell_m: args.model_cell,
+            realtime_priority: args.realtime,
         };
         let job = autoshovel_jobs::perceive_frames(
             input,
@@ -159,12 +169,14 @@ pub fn run(args: &Args) -> Result<()> {
                 crate::say!("  skipped frame {} ({}): {}", k.index, k.file, k.reason);
             }
             crate::say!(
-                "  latency: first {:.1} ms, then median {:.1} ms, 95 % {:.1} ms, max {:.1} ms ({:.1} frames/s)",
+                "  latency: first {:.1} ms, then median {:.1} ms, 95 % {:.1} ms, max {:.1} ms ({:.1} frames/s{})",
                 s.latency.first_ms,
                 s.latency.median_ms,
                 s.latency.p95_ms,
                 s.latency.max_ms,
-                s.frames_per_s
+                s.frames_per_s,
+                s.realtime_priority
+                    .map_or(String::new(), |p| format!(", SCHED_FIFO priority {p}"))
             );
             for stage in autoshovel_surface::perceive::STAGES {
                 if let Some(ms) = s.timings_ms.get(stage) {
@@ -183,9 +195,9 @@ pub fn run(args: &Args) -> Result<()> {
             );
         });
     }
-    if args.relevel_every != 0 || args.model_cell.is_some() {
+    if args.relevel_every != 0 || args.model_cell.is_some() || args.realtime.is_some() {
         anyhow::bail!(
-            "--relevel-every and --model-cell are for a folder of frames; {} is a file",
+            "--relevel-every, --model-cell and --realtime are for a folder of frames; {} is a file",
             input.display()
         );
     }

@@ -271,6 +271,7 @@ fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
         "{reason}"
     );
     assert_eq!(s["relevelled_frames"], 1);
+    assert!(s["realtime_priority"].is_null(), "ordinary scheduling");
     for key in [
         "roll_deg",
         "pitch_deg",
@@ -328,6 +329,67 @@ fn a_folder_of_frames_is_perceived_frame_by_frame_past_a_broken_one() {
         "{}",
         e.error_message()
     );
+}
+
+/// `--realtime`: a priority outside 1–99, or a single file, is refused by
+/// name; on a folder the frames run under SCHED_FIFO and the summary says
+/// so or, where the system refuses it (not root, no CAP_SYS_NICE), the
+/// error says what to do and nothing is written.
+#[test]
+fn frames_run_under_real_time_scheduling_or_say_why_not() {
+    let dir = TempDir::new("realtime");
+    let seq = dir.path().join("seq");
+    run(&[
+        "generate-pile".as_ref(),
+        "--points".as_ref(),
+        "20000".as_ref(),
+        "--frames".as_ref(),
+        "2".as_ref(),
+        "--out".as_ref(),
+        seq.join("frame.pcd").as_os_str(),
+    ])
+    .ok();
+    let perceive = |input: &std::path::Path, more: &[&str]| {
+        let mut args: Vec<&std::ffi::OsStr> =
+            vec!["perceive".as_ref(), "--input".as_ref(), input.as_os_str()];
+        args.extend(more.iter().map(std::ffi::OsStr::new));
+        run(&args)
+    };
+    for bad in ["0", "100"] {
+        let e = perceive(&seq, &["--realtime", bad]).fails();
+        assert!(
+            e.error_message().contains(&format!("--realtime {bad}"))
+                && e.error_message().contains("from 1 to 99"),
+            "{}",
+            e.error_message()
+        );
+    }
+    let e = perceive(&seq.join("frame-0000.pcd"), &["--realtime"]).fails();
+    assert!(
+        e.error_message().contains("--realtime"),
+        "{}",
+        e.error_message()
+    );
+    let out = dir.path().join("out");
+    let got = perceive(
+        &seq,
+        &["--realtime", "20", "--out", out.to_str().unwrap(), "--json"],
+    );
+    if got.code() == Some(0) {
+        let s = got.json();
+        assert_eq!(s["realtime_priority"], 20);
+        assert_eq!(s["frames_ok"], 2);
+        assert!(out.join("frames.csv").exists());
+    } else {
+        let e = got.fails();
+        assert!(
+            e.error_message().contains("--realtime 20")
+                && e.error_message().contains("CAP_SYS_NICE"),
+            "{}",
+            e.error_message()
+        );
+        assert!(!out.exists(), "nothing written");
+    }
 }
 
 #[test]

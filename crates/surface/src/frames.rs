@@ -143,6 +143,11 @@ pub struct FrameOptions {
     /// Edge of a cell of the running height model [m]; `None` (the
     /// default): four times the first frame's point spacing.
     pub model_cell_m: Option<f64>,
+    /// The real-time (`SCHED_FIFO`) priority the caller runs the frames'
+    /// threads at, for the summary; `None`: ordinary scheduling. The
+    /// library does not set it: a process's scheduling is its owner's
+    /// (`autoshovel perceive --realtime`).
+    pub realtime_priority: Option<u8>,
 }
 
 /// The running height model of the pile: a grid over the first perceived
@@ -377,6 +382,9 @@ pub struct FramesSummary {
     pub relevelled_frames: usize,
     /// Re-level every this many frames (0: once).
     pub relevel_every: usize,
+    /// The real-time (`SCHED_FIFO`) priority the frames ran at (`None`:
+    /// ordinary scheduling).
+    pub realtime_priority: Option<u8>,
     /// The height model's cell edge [m].
     pub model_cell_m: f64,
     /// Its cells along x and y.
@@ -615,6 +623,7 @@ impl FramePerceiver {
             r2: last.fit.r2,
             relevelled_frames: ok.iter().filter(|r| r.relevelled).count(),
             relevel_every: self.options.relevel_every,
+            realtime_priority: self.options.realtime_priority,
             model_cell_m: model.cell_m,
             model_size: model.size,
             model_coverage: model.coverage(),
