@@ -50,9 +50,35 @@ import pcd  # noqa: E402
 
 ROOT = os.path.normpath(os.path.join(HERE, "..", "..", ".."))
 
+# The voxel edge of every peer's voxel grid [m].
+VOXEL_LEAF = 0.05
+
+
+def exact_voxel_means(pts, leaf):
+    """The exact (f64) mean of each of PCL's voxels, in PCL's order.
+
+    A point's voxel is floor(p * (1 / leaf)) computed in f32, as PCL 1.13
+    computes it; the voxels are ordered by PCL's linear index (x fastest).
+    The independent reference for both PCL's centroids (summed in f32) and
+    ours (summed in f64).
+    """
+    pts = pts[np.isfinite(pts).all(axis=1)]
+    inv = np.float32(1.0) / np.float32(leaf)
+    ijk = np.floor(pts * inv).astype(np.int64)
+    lo = ijk.min(axis=0)
+    ext = ijk.max(axis=0) - lo + 1
+    rel = ijk - lo
+    lin = rel[:, 0] + rel[:, 1] * ext[0] + rel[:, 2] * ext[0] * ext[1]
+    order = np.argsort(lin, kind="stable")
+    _, start = np.unique(lin[order], return_index=True)
+    sums = np.add.reduceat(pts[order].astype(np.float64), start, axis=0)
+    counts = np.diff(np.append(start, len(order)))
+    return sums / counts[:, None]
+
+
 FILTERS = [
     ("pass_through", "pcl_passthrough_filter", ["-field", "z", "-min", "0.1", "-max", "1e30", "-keep", "0"]),
-    ("voxel_grid", "pcl_voxel_grid", ["-leaf", "0.05,0.05,0.05"]),
+    ("voxel_grid", "pcl_voxel_grid", ["-leaf", ",".join([str(VOXEL_LEAF)] * 3)]),
     ("radius", "pcl_outlier_removal", ["-method", "radius", "-radius", "0.05", "-min_pts", "5"]),
     ("statistical", "pcl_outlier_removal", ["-method", "statistical", "-mean_k", "50", "-std_dev_mul", "1.0"]),
 ]
@@ -86,7 +112,7 @@ def open3d_time(o3d, cloud, name, tensor):
             box = o3d.geometry.AxisAlignedBoundingBox(lo, hi)
         out = cloud.crop(box)
     elif name == "voxel_grid":
-        out = cloud.voxel_down_sample(0.05)
+        out = cloud.voxel_down_sample(VOXEL_LEAF)
     elif name == "radius" and tensor:
         out, _ = cloud.remove_radius_outliers(nb_points=5, search_radius=0.05)
     elif name == "radius":
@@ -153,7 +179,7 @@ def open3d_one(argv):
 # `autoshovel filter` flags of each filter, for the whole-process timing.
 OUR_FLAGS = {
     "pass_through": ["--pass", "z:0.1:1e30"],
-    "voxel_grid": ["--voxel", "0.05"],
+    "voxel_grid": ["--voxel", str(VOXEL_LEAF)],
     "radius": ["--radius", "0.05,5"],
     "statistical": ["--statistical", "50,1.0"],
 }
@@ -272,14 +298,18 @@ def main():
             pcl_ms = statistics.median(pcl_runs)
             mine = pcd.read_pcd(os.path.join(args.dir, f"ours_{name}_{size}.pcd"))
             if name == "voxel_grid":
-                # PCL sums a voxel's points in f32, we in f64: centroids
-                # differ by a few f32 ulps of the coordinates (1e-6 relative).
-                if len(mine) == len(kept) and len(mine) > 0:
-                    gap = float(np.abs(mine - kept).max())
-                    tol = max(1e-5, 1e-6 * float(np.abs(kept).max()))
-                    same = f"yes (same voxels in order, centroids within {gap:.1e} m)" if gap <= tol else f"NO ({gap:.1e} m)"
+                # PCL sums a voxel's points in f32, we in f64: both are held
+                # to the exact mean (f64) of PCL's voxels, in PCL's order.
+                exact = exact_voxel_means(pcd.read_pcd(inp), VOXEL_LEAF)
+                if len(mine) == len(kept) == len(exact) and len(mine) > 0:
+                    ours_gap = float(np.abs(mine - exact).max())
+                    pcl_gap = float(np.abs(kept - exact).max())
+                    tol = max(1e-5, 1e-6 * float(np.abs(exact).max()), pcl_gap)
+                    same = (f"yes (same voxels in order; centroids within {ours_gap:.1e} m of the exact "
+                            f"means, PCL's within {pcl_gap:.1e} m)") if ours_gap <= tol else \
+                        f"NO (centroids {ours_gap:.1e} m off the exact means, PCL's {pcl_gap:.1e} m)"
                 else:
-                    same = "NO (voxel counts differ)"
+                    same = f"NO (voxel counts differ: exact {len(exact)})"
             else:
                 same = "yes (bit for bit, in order)" if np.array_equal(mine.view(np.uint32), kept.view(np.uint32)) else "NO"
             peers = [pcl_ms]
