@@ -250,10 +250,22 @@ impl VoxelCells {
     }
 }
 
-/// Points a super-bucket of [`bucketed_centroids`] holds on average (at
-/// most): it is gathered into one buffer and sorted there, which with a
-/// second buffer of its size stays in the second-level cache.
+/// Fewest points a task of [`bucketed_centroids`] gathers (neighbouring
+/// super-buckets taken together): a task's super-buckets are gathered and
+/// sorted one after another in one buffer, which with a second of its size
+/// stays in the second-level cache.
 const SUPER: usize = 1 << 14;
+
+/// Points a super-bucket of [`bucketed_centroids`] holds on average: a
+/// sixteenth of a task, so that a slab of the box where most points lie (a
+/// scan's floor, a camera's wall at one depth) is cut into many
+/// super-buckets, which tasks share out, where super-buckets of a task's
+/// size left one task with a fifth of the points (1.2 M points of PCL's
+/// RGB-D scans: 19–20 → 16–17 ms; the raw 1 M scan at 5 cm, floor and
+/// all: 16–17 → 11–12 ms, and `perceive`'s voxel stage on it 15.3 → 13.2
+/// ms; the bench pile of `benches/filters.rs`, whose points are spread
+/// more evenly, 13.3–13.5 → 14.2–14.6 ms, BENCHMARKS.md).
+const BUCKET_POINTS: usize = 1 << 10;
 
 /// Most super-buckets of [`bucketed_centroids`] (2¹²): each chunk keeps a
 /// start a super-bucket.
@@ -282,10 +294,12 @@ struct Entry {
 /// Why not one sort of all keys: the cloud is cut into chunks (a few a
 /// thread, at most [`MAX_CHUNK`] points), and each chunk is counting-sorted
 /// on its own (in cache, in parallel) into super-buckets by the voxel
-/// index's top bits (about [`SUPER`] points each, over all chunks); then
-/// each super-bucket's parts (in chunk order, whole runs of entries) are
-/// gathered into a buffer in the second-level cache, where
-/// [`sort_and_sum`] sorts and sums them, super-buckets in parallel. No pass
+/// index's top bits (about [`BUCKET_POINTS`] points each, over all
+/// chunks); then neighbouring super-buckets are taken together into tasks
+/// of at least [`SUPER`] points, and each super-bucket's parts (in chunk
+/// order, whole runs of entries) are gathered into a buffer in the
+/// second-level cache, where [`sort_and_sum`] sorts and sums them, tasks
+/// in parallel. No pass
 /// over the whole cloud is serial, the gathering reads long runs (with
 /// one level of a few points a bucket, it read one or two entries from
 /// each chunk in turn, which on the 20 M pipeline's voxel stage was half
@@ -297,7 +311,7 @@ where
 {
     let n = points.len();
     let voxel_bits = 64 - (voxels.max(2) - 1).leading_zeros();
-    let super_bits = (usize::BITS - (n / SUPER).max(1).leading_zeros())
+    let super_bits = (usize::BITS - (n / BUCKET_POINTS).max(1).leading_zeros())
         .min(voxel_bits)
         .min(MAX_SUPER_BITS);
     // At most 31: `voxels` ≤ 2³² and at least one super-bucket bit.
@@ -344,16 +358,39 @@ where
             (sorted, start)
         })
         .collect();
-    let out: Vec<Vec<Point>> = (0..supers)
+    // Tasks: runs of neighbouring super-buckets of at least SUPER points.
+    let mut total = vec![0usize; supers];
+    for (_, start) in &parts {
+        for (b, t) in total.iter_mut().enumerate() {
+            *t += (start[b + 1] - start[b]) as usize;
+        }
+    }
+    let mut tasks: Vec<(usize, usize)> = Vec::new();
+    let (mut from, mut held) = (0, 0);
+    for (b, &t) in total.iter().enumerate() {
+        held += t;
+        if held >= SUPER {
+            tasks.push((from, b + 1));
+            (from, held) = (b + 1, 0);
+        }
+    }
+    if from < supers {
+        tasks.push((from, supers));
+    }
+    let out: Vec<Vec<Point>> = tasks
         .into_par_iter()
-        .map_init(Buffers::default, |buf, b| {
-            buf.gathered.clear();
-            for (sorted, start) in &parts {
-                buf.gathered
-                    .extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
-            }
+        .map_init(Buffers::default, |buf, (first, end)| {
             let mut out = Vec::new();
-            sort_and_sum(buf, shift, &mut out);
+            for b in first..end {
+                buf.gathered.clear();
+                for (sorted, start) in &parts {
+                    buf.gathered
+                        .extend_from_slice(&sorted[start[b] as usize..start[b + 1] as usize]);
+                }
+                if !buf.gathered.is_empty() {
+                    sort_and_sum(buf, shift, &mut out);
+                }
+            }
             out
         })
         .collect();
