@@ -260,7 +260,7 @@ const SUPER: usize = 1 << 14;
 /// sixteenth of a task, so that a slab of the box where most points lie (a
 /// scan's floor, a camera's wall at one depth) is cut into many
 /// super-buckets, which tasks share out, where super-buckets of a task's
-/// size left one task with a fifth of the points (1.2 M points of PCL's
+/// size left one task with a sixth of the points (1.2 M points of PCL's
 /// RGB-D scans: 19–20 → 16–17 ms; the raw 1 M scan at 5 cm, floor and
 /// all: 16–17 → 11–12 ms, and `perceive`'s voxel stage on it 15.3 → 13.2
 /// ms; the bench pile of `benches/filters.rs`, whose points are spread
