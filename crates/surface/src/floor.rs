@@ -356,7 +356,7 @@ impl Split {
                             chunk,
                             cells,
                             base,
-                            plane,
+                            (plane.normal, plane.offset_m),
                             [threshold, rise, below_m],
                         )
                     };

@@ -331,7 +331,9 @@ fn inliers_from_on(
     if isa == Isa::Avx512 {
         // SAFETY: `Isa::best` and `Isa::available` give AVX-512 only where
         // the machine has AVX-512F (and POPCNT).
-        return unsafe { crate::wide::avx512::inliers(points, first, plane, threshold) };
+        return unsafe {
+            crate::wide::avx512::inliers(points, first, (plane.normal, plane.offset_m), threshold)
+        };
     }
     let _ = isa;
     let mut kept = vec![0; points.len()];

@@ -14,7 +14,9 @@
 pub(crate) mod avx512 {
     use std::arch::x86_64::*;
 
-    use crate::ransac::Plane;
+    /// A plane n · p = d as (n, d), n of unit length (`ransac::Plane`'s
+    /// normal and offset).
+    pub(crate) type Coefficients = ([f64; 3], f64);
 
     /// The plane's coefficients, each in every lane.
     struct Lanes {
@@ -25,10 +27,10 @@ pub(crate) mod avx512 {
     impl Lanes {
         #[inline]
         #[target_feature(enable = "avx512f")]
-        fn of(plane: &Plane) -> Self {
+        fn of((normal, offset): Coefficients) -> Self {
             Self {
-                n: plane.normal.map(|v| _mm512_set1_pd(v)),
-                offset: _mm512_set1_pd(plane.offset_m),
+                n: normal.map(|v| _mm512_set1_pd(v)),
+                offset: _mm512_set1_pd(offset),
             }
         }
 
@@ -77,6 +79,16 @@ pub(crate) mod avx512 {
         _mm512_permutex2var_pd(_mm512_permutex2var_pd(a, index(ab), b), index(abc), c)
     }
 
+    /// The indices `first`, `first + 1`, … `first + 7`.
+    #[inline]
+    #[target_feature(enable = "avx512f")]
+    fn indices(first: usize) -> __m512i {
+        _mm512_add_epi64(
+            _mm512_set1_epi64(first as i64),
+            _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7),
+        )
+    }
+
     /// The lowest `n` bits (n ≤ 8).
     #[inline]
     fn low(n: usize) -> __mmask8 {
@@ -110,7 +122,7 @@ pub(crate) mod avx512 {
     pub(crate) unsafe fn inliers(
         points: &[[f64; 3]],
         first: usize,
-        plane: &Plane,
+        plane: Coefficients,
         threshold: f64,
     ) -> Vec<usize> {
         let n = points.len();
@@ -120,10 +132,7 @@ pub(crate) mod avx512 {
         let mut out: Vec<usize> = Vec::with_capacity(n + 8);
         let dst = out.as_mut_ptr();
         let flat = points.as_ptr().cast::<f64>();
-        let mut index = _mm512_add_epi64(
-            _mm512_set1_epi64(first as i64),
-            _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7),
-        );
+        let mut index = indices(first);
         let (mut kept, mut i) = (0, 0);
         while i < n {
             let (points, loads) = step(i, n);
@@ -164,7 +173,7 @@ pub(crate) mod avx512 {
         points: &[[f32; 3]],
         cells: &[u32],
         first: usize,
-        plane: &Plane,
+        plane: Coefficients,
         [threshold, rise, below]: [f64; 3],
     ) -> (Vec<usize>, Vec<u32>, usize) {
         let n = points.len();
@@ -177,10 +186,7 @@ pub(crate) mod avx512 {
         let mut inliers: Vec<usize> = Vec::with_capacity(n + 8);
         let dst = inliers.as_mut_ptr();
         let flat = points.as_ptr().cast::<f32>();
-        let mut index = _mm512_add_epi64(
-            _mm512_set1_epi64(first as i64),
-            _mm512_setr_epi64(0, 1, 2, 3, 4, 5, 6, 7),
-        );
+        let mut index = indices(first);
         let (mut kept, mut rising, mut count_below, mut i) = (0, Vec::new(), 0, 0);
         while i < n {
             let (points, loads) = step(i, n);
