@@ -15,7 +15,6 @@ macro_rules! say {
 pub(crate) use say;
 
 mod filter;
-mod heap;
 mod link;
 mod output;
 mod perceive;
@@ -23,7 +22,6 @@ mod pile;
 mod plan_dig;
 mod plan_excavate;
 mod plan_path;
-mod sched;
 mod shift;
 mod study;
 mod study_boulders;
@@ -179,7 +177,7 @@ fn main() -> ExitCode {
     // The matches are kept: `filter` runs its stages in the order given.
     let matches = Cli::command().get_matches();
     let cli = Cli::from_arg_matches(&matches).unwrap_or_else(|e| e.exit());
-    heap::keep_freed_memory();
+    autoshovel_jobs::process::keep_freed_memory();
     // Ctrl-C stops any job at once; what it had staged in the output folder
     // goes with it, so nothing half-written is left there.
     let _ = ctrlc::set_handler(|| {

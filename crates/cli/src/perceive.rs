@@ -136,14 +136,7 @@ pub fn run(args: &Args) -> Result<()> {
     }
     if input.is_dir() {
         if let Some(priority) = args.realtime {
-            crate::sched::realtime(priority)?;
-        }
-        // The first frame's memory mapped now, at start-up (heap::warm).
-        if let Some(first) = autoshovel_surface::frames::frames_in(input)
-            .ok()
-            .and_then(|files| files.into_iter().next())
-        {
-            crate::heap::warm(std::fs::metadata(first).map_or(0, |m| m.len()));
+            autoshovel_jobs::process::realtime(priority)?;
         }
         let options = autoshovel_surface::frames::FrameOptions {
             relevel_every: args.relevel_every,

@@ -19,6 +19,15 @@ pub enum JobError {
         /// What it must satisfy.
         rule: String,
     },
+    /// Real-time scheduling refused (a priority outside 1–99, or by the
+    /// system: not root, no CAP_SYS_NICE).
+    #[error("--realtime {priority}: {problem}")]
+    Realtime {
+        /// The priority asked for.
+        priority: u8,
+        /// Why it was refused, and what to do.
+        problem: String,
+    },
     /// `filter` without a stage.
     #[error("no stage given: add one or more of --voxel, --statistical, --radius, --pass, --level (run in the order given)")]
     NoStage,

@@ -16,6 +16,7 @@ mod dig;
 mod error;
 mod filter;
 mod job;
+pub mod process;
 mod scan;
 mod walk;
 

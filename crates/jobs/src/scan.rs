@@ -75,7 +75,8 @@ pub fn perceive(
 }
 
 /// `perceive` on a folder of frames (frame mode), with a progress bar
-/// over the frames.
+/// over the frames; the memory the first frame will take is mapped first
+/// (`process::warm`, by the first file's size).
 pub fn perceive_frames(
     dir: &Path,
     params: &PerceptionParams,
@@ -87,8 +88,15 @@ pub fn perceive_frames(
         progress,
         "frames [{bar:40}] {pos}/{len} ({per_sec}, {eta}) {msg}",
     );
-    let done =
-        autoshovel_surface::frames::perceive_folder(dir, params, options, &mut |done, total, r| {
+    let files = autoshovel_surface::frames::frames_in(dir)?;
+    crate::process::warm(std::fs::metadata(&files[0]).map_or(0, |m| m.len()));
+    let input = dir.display().to_string();
+    let done = autoshovel_surface::frames::perceive_files(
+        &input,
+        &files,
+        params,
+        options,
+        &mut |done, total, r| {
             bar.set_length(total as u64);
             bar.set_position(done as u64);
             bar.set_message(if r.ok {
@@ -96,7 +104,8 @@ pub fn perceive_frames(
             } else {
                 format!("skipped {}", r.file)
             });
-        });
+        },
+    );
     bar.finish_and_clear();
     let done = done?;
     Job::finish(done.summary.clone(), out, |dir, written| {

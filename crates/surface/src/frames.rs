@@ -96,8 +96,27 @@ pub fn perceive_folder(
     on_frame: &mut dyn FnMut(usize, usize, &FrameRecord),
 ) -> Result<FrameRun> {
     let files = frames_in(dir)?;
-    let mut run =
-        FramePerceiver::new(params.clone(), options).with_input(dir.display().to_string());
+    perceive_files(
+        &dir.display().to_string(),
+        &files,
+        params,
+        options,
+        on_frame,
+    )
+}
+
+/// Perceives the frame files `files` in order with one [`FramePerceiver`]
+/// (`input` names what they came from, for the summary), calling
+/// `on_frame(done, total, record)` after each: [`perceive_folder`] for a
+/// caller that has listed the folder already.
+pub fn perceive_files(
+    input: &str,
+    files: &[PathBuf],
+    params: &PerceptionParams,
+    options: FrameOptions,
+    on_frame: &mut dyn FnMut(usize, usize, &FrameRecord),
+) -> Result<FrameRun> {
+    let mut run = FramePerceiver::new(params.clone(), options).with_input(input);
     for (i, f) in files.iter().enumerate() {
         on_frame(i + 1, files.len(), run.push_file(f));
     }
