@@ -16,12 +16,17 @@
 //! refuses a leaf whose linear voxel index would overflow an `int32`
 //! ("Leaf size is too small for the input dataset. Integer indices would
 //! overflow.") and returns the input unchanged; here voxel coordinates are
-//! i64, and the points are sorted by voxel through their linear voxel
-//! index when the occupied box has at most 2³² voxels (bucketed by its top
-//! bits in parallel chunks, each bucket sorted stably by the rest:
-//! `bucketed_centroids`), through (u64 linear index, point index) pairs
-//! below 2⁶⁴ voxels, and through (z, y, x) i64 triplets beyond, so any leaf
-//! whose products stay finite in f32 works.
+//! i64. When the occupied box has fewer than 2³² voxels, every point's
+//! linear voxel index is computed once as a 32-bit key (`keys.rs`, 16
+//! points a step on AVX-512); then a dense cloud (tens of points a voxel)
+//! is summed into one hash table a thread, each thread owning a range of
+//! keys (`table.rs`), and any other is bucketed by the keys' top bits in
+//! parallel chunks, each bucket sorted stably by the rest
+//! (`bucketed_centroids`). Beyond, the points are sorted through (u64
+//! linear index, point index) pairs below 2⁶⁴ voxels, and through (z, y,
+//! x) i64 triplets beyond that, so any leaf whose products stay finite in
+//! f32 works. Every way sums each voxel's points in f64 in input order,
+//! so the bits depend neither on the way nor on the number of threads.
 //!
 //! Open3D's `voxel_down_sample` anchors its grid at `min_bound − leaf/2`
 //! and computes in f64, so its voxels differ from PCL's.
@@ -29,7 +34,11 @@
 use autoshovel_core::config::short;
 use rayon::prelude::*;
 
+mod keys;
+mod table;
+
 use super::common::{bad, empty_input, is_finite};
+use super::within::Isa;
 use crate::{Point, PointCloud, Result};
 use serde::{Deserialize, Serialize};
 
@@ -108,6 +117,32 @@ fn floor_i64(v: f32) -> i64 {
 /// assert!((down.points[0][0] - 0.2).abs() < 1e-6 && (down.points[1][0] - 1.1).abs() < 1e-6);
 /// ```
 pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointCloud> {
+    let (centroids, _) = centroids(cloud, params, Isa::best(), true)?;
+    Ok(PointCloud::new(centroids))
+}
+
+/// Which way [`centroids`] went.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Way {
+    /// A table a thread (`table.rs`).
+    Table,
+    /// Keys bucketed and sorted ([`bucketed_centroids`]).
+    Buckets,
+    /// (u64 index, point) pairs sorted.
+    Pairs,
+    /// (z, y, x) triplets sorted.
+    Triplets,
+}
+
+/// [`voxel_grid`]'s centroids on the instruction set `isa`, and the way
+/// taken; the tables are tried only where `tables` (the tests compare
+/// the ways).
+fn centroids(
+    cloud: &[Point],
+    params: &VoxelGridParams,
+    isa: Isa,
+    tables: bool,
+) -> Result<(Vec<Point>, Way)> {
     let inv = params.inverse_leaf()?;
     if cloud.is_empty() {
         return Err(empty_input(FILTER));
@@ -196,10 +231,29 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
         let c = [0, 1, 2].map(|a| (floor_i64(v[a]) - lo[a]) as u64);
         c[0] + c[1] * ex + c[2] * exy
     };
-    let centroids = if voxels <= 1 << 32 {
-        // Usual case: bucketed by the voxel index's top bits, each bucket
-        // sorted by the rest.
-        bucketed_centroids(points, voxels as u64, &linear)
+    let centroids = if voxels < 1 << 32 {
+        // Usual case: every point's key once; then a dense cloud summed
+        // into a table a thread, or else the keys bucketed by their top
+        // bits, each bucket sorted by the rest.
+        let grid = keys::Grid {
+            inv,
+            lo,
+            ex,
+            exy,
+            bits: bits_of(voxels as u64),
+            cells_fit_i32: (0..3).all(|a| vlo[a] >= -2_147_483_648.0 && vhi[a] < 2_147_483_648.0),
+        };
+        let keys = grid.keys(points, isa);
+        match tables
+            .then(|| table::centroids(points, &keys, grid.bits, isa))
+            .flatten()
+        {
+            Some(centroids) => (centroids, Way::Table),
+            None => (
+                bucketed_centroids(points, &keys.keys, grid.bits),
+                Way::Buckets,
+            ),
+        }
     } else if voxels <= u128::from(u64::MAX) {
         let mut keys: Vec<(u64, usize)> = points
             .par_iter()
@@ -208,7 +262,10 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
             .map(|(i, p)| (linear(p), i))
             .collect();
         keys.par_sort_unstable();
-        centroids_of_runs(points, &keys, |k| k.0, |k| k.1)
+        (
+            centroids_of_runs(points, &keys, |k| k.0, |k| k.1),
+            Way::Pairs,
+        )
     } else {
         // A box of 2⁶⁴ voxels or more: sort (z, y, x) triplets, same order.
         let mut keys: Vec<([i64; 3], usize)> = points
@@ -221,9 +278,12 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
             })
             .collect();
         keys.par_sort_unstable();
-        centroids_of_runs(points, &keys, |k| k.0, |k| k.1)
+        (
+            centroids_of_runs(points, &keys, |k| k.0, |k| k.1),
+            Way::Triplets,
+        )
     };
-    Ok(PointCloud::new(centroids))
+    Ok(centroids)
 }
 
 /// The voxel of a point as [`voxel_grid`] computes it (PCL's
@@ -289,6 +349,18 @@ struct Entry {
     point: Point,
 }
 
+/// What [`radix_sort_voxels`] sorts by: a voxel's linear index.
+trait Voxel: Copy {
+    fn voxel(&self) -> u32;
+}
+
+impl Voxel for Entry {
+    #[inline(always)]
+    fn voxel(&self) -> u32 {
+        self.voxel
+    }
+}
+
 /// The centroids of the occupied voxels in linear-index order, for a box
 /// of at most 2³² `voxels`; `linear` gives a finite point's voxel index.
 /// Why not one sort of all keys: the cloud is cut into chunks (a few a
@@ -305,36 +377,27 @@ struct Entry {
 /// each chunk in turn, which on the 20 M pipeline's voxel stage was half
 /// its time), and the centroids read the points from the gathered parts,
 /// not at random from the cloud.
-fn bucketed_centroids<L>(points: &[Point], voxels: u64, linear: &L) -> Vec<Point>
-where
-    L: Fn(&Point) -> u64 + Sync,
-{
+fn bucketed_centroids(points: &[Point], keys: &[u32], voxel_bits: u32) -> Vec<Point> {
+    use keys::NOT_FINITE;
     let n = points.len();
-    let voxel_bits = 64 - (voxels.max(2) - 1).leading_zeros();
     let super_bits = (usize::BITS - (n / BUCKET_POINTS).max(1).leading_zeros())
         .min(voxel_bits)
         .min(MAX_SUPER_BITS);
     // At most 31: `voxels` ≤ 2³² and at least one super-bucket bit.
     let shift = voxel_bits - super_bits;
-    let low = (1u64 << shift) - 1;
+    let low = (1u32 << shift) - 1;
     let supers = 1usize << super_bits;
-    let super_of = |key: u64| (key >> shift) as usize;
-    const NOT_FINITE: u64 = u64::MAX;
+    let super_of = |key: u32| (key >> shift) as usize;
     let chunk = n
         .div_ceil(rayon::current_num_threads() * 4)
         .clamp(1 << 12, MAX_CHUNK);
     // Per chunk: its entries by super-bucket, and `start`, where
-    // super-bucket b's entries are `start[b]..start[b + 1]`. Each thread
-    // reuses one buffer for its chunks' voxel indices.
+    // super-bucket b's entries are `start[b]..start[b + 1]`.
     type Part = (Vec<Entry>, Vec<u32>);
     let parts: Vec<Part> = points
         .par_chunks(chunk)
-        .map_init(Vec::new, |keys: &mut Vec<u64>, ps| {
-            keys.clear();
-            keys.extend(
-                ps.iter()
-                    .map(|p| if is_finite(p) { linear(p) } else { NOT_FINITE }),
-            );
+        .zip(keys.par_chunks(chunk))
+        .map(|(ps, keys)| {
             let mut start = vec![0u32; supers + 2];
             for &k in keys.iter().filter(|&&k| k != NOT_FINITE) {
                 start[super_of(k) + 2] += 1;
@@ -345,7 +408,7 @@ where
             for (&k, p) in keys.iter().zip(ps).filter(|(&k, _)| k != NOT_FINITE) {
                 let slot = &mut start[super_of(k) + 1];
                 room[*slot as usize].write(Entry {
-                    voxel: (k & low) as u32,
+                    voxel: k & low,
                     point: *p,
                 });
                 *slot += 1;
@@ -395,6 +458,11 @@ where
         })
         .collect();
     out.concat()
+}
+
+/// Bits of the linear index of a box of `voxels` (at least 1).
+fn bits_of(voxels: u64) -> u32 {
+    64 - (voxels.max(2) - 1).leading_zeros()
 }
 
 /// Counts at `b + 2` (bucket b's count) into starts in place: after it,
@@ -451,17 +519,17 @@ const DIGIT_BITS: u32 = 11;
 /// `entries`) is scratch; returns whichever of the two holds the sorted
 /// entries.
 #[inline]
-fn radix_sort_voxels<'a>(
-    mut entries: &'a mut [Entry],
-    mut spare: &'a mut [Entry],
+fn radix_sort_voxels<'a, T: Voxel>(
+    mut entries: &'a mut [T],
+    mut spare: &'a mut [T],
     bits: u32,
-) -> &'a [Entry] {
+) -> &'a [T] {
     const DIGITS: usize = 1 << DIGIT_BITS;
     const MAX_PASSES: usize = 32_usize.div_ceil(DIGIT_BITS as usize);
     let passes = bits.div_ceil(DIGIT_BITS) as usize;
     let mut count = [[0u32; DIGITS]; MAX_PASSES];
-    let digit = |e: &Entry, pass: usize| {
-        ((e.voxel >> (pass as u32 * DIGIT_BITS)) & (DIGITS as u32 - 1)) as usize
+    let digit = |e: &T, pass: usize| {
+        ((e.voxel() >> (pass as u32 * DIGIT_BITS)) & (DIGITS as u32 - 1)) as usize
     };
     for e in entries.iter() {
         for (pass, c) in count.iter_mut().enumerate().take(passes) {
@@ -554,7 +622,120 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{floor_i64, radix_sort_voxels, Entry};
+    use super::{centroids, floor_i64, radix_sort_voxels, Entry, VoxelGridParams, Way};
+    use crate::filter::within::Isa;
+    use crate::Point;
+
+    /// A camera-like scan: rows of points 2 mm apart over a gentle
+    /// surface (with a step), so tens of points share a 2 cm voxel and
+    /// neighbours in the input are neighbours in space; points on voxel
+    /// faces, non-finite points, and a far corner that widens the box.
+    fn scan(rows: usize, columns: usize, seed: u64) -> Vec<Point> {
+        let mut next = super::super::common::below(seed);
+        let mut points = Vec::with_capacity(rows * columns + 8);
+        for r in 0..rows {
+            for c in 0..columns {
+                let (x, y) = (c as f32 * 0.002 - 1.0, r as f32 * 0.002 - 0.7);
+                let step = if x > 0.3 { 0.25 } else { 0.0 };
+                let noise = next(1000) as f32 * 2e-6;
+                points.push([x, y, 0.1 * x + 0.05 * y + step + noise - 0.5]);
+            }
+        }
+        for i in 0..8 {
+            let at = next(points.len() as u64) as usize;
+            points[at] = match i % 4 {
+                0 => [f32::NAN, 0.0, 0.0],
+                1 => [0.0, f32::INFINITY, 0.0],
+                // On voxel faces (a multiple of the 2 cm leaf).
+                2 => [0.2, -0.4, 0.06],
+                _ => [0.02, 0.04, -0.08],
+            };
+        }
+        points.push([3.0, 2.0, 1.5]);
+        points
+    }
+
+    /// The centroids each voxel's points give when summed in f64 in
+    /// input order (PCL's voxels, (z, y, x) order): the rule both ways
+    /// keep, computed independently.
+    fn map_of_voxels(points: &[Point], leaf: f64) -> Vec<Point> {
+        let inv = 1.0 / leaf as f32;
+        let mut voxels = std::collections::BTreeMap::<[i64; 3], ([f64; 3], f64)>::new();
+        for p in points.iter().filter(|p| p.iter().all(|v| v.is_finite())) {
+            let e = voxels
+                .entry([2, 1, 0].map(|a| (p[a] * inv).floor() as i64))
+                .or_insert(([0.0; 3], 0.0));
+            for (sum, &v) in e.0.iter_mut().zip(p) {
+                *sum += f64::from(v);
+            }
+            e.1 += 1.0;
+        }
+        voxels
+            .values()
+            .map(|(s, n)| [0, 1, 2].map(|a| (s[a] / n) as f32))
+            .collect()
+    }
+
+    fn bits(points: &[Point]) -> Vec<[u32; 3]> {
+        points.iter().map(|p| p.map(f32::to_bits)).collect()
+    }
+
+    #[test]
+    fn the_tables_give_the_sorting_bits_on_every_path_and_thread_count() {
+        let leaf = 0.02;
+        let params = VoxelGridParams::cube(leaf);
+        // 640 k points, 12 k voxels: more than a table first holds, with
+        // one thread or several; and the same points shuffled in blocks of
+        // 15 rows, which cut the 10 rows of a voxel's points apart.
+        let dense = scan(800, 800, 3);
+        let mut blocks: Vec<&[Point]> = dense.chunks(12_000).collect();
+        let mut next = super::super::common::below(4);
+        for i in (1..blocks.len()).rev() {
+            blocks.swap(i, next(i as u64 + 1) as usize);
+        }
+        let shuffled: Vec<Point> = blocks.concat();
+        for cloud in [&dense, &shuffled] {
+            let expected = bits(&map_of_voxels(cloud, leaf));
+            for isa in Isa::available() {
+                for threads in [1, 2, 3] {
+                    let pool = rayon::ThreadPoolBuilder::new()
+                        .num_threads(threads)
+                        .build()
+                        .unwrap();
+                    let (tabled, way) = pool
+                        .install(|| centroids(cloud, &params, isa, true))
+                        .unwrap();
+                    assert_eq!(way, Way::Table, "{isa:?}, {threads} threads");
+                    assert!(bits(&tabled) == expected, "{isa:?}, {threads} threads");
+                    let (sorted, way) = pool
+                        .install(|| centroids(cloud, &params, isa, false))
+                        .unwrap();
+                    assert_eq!(way, Way::Buckets);
+                    assert!(bits(&sorted) == expected, "{isa:?}, {threads} threads");
+                }
+            }
+        }
+    }
+
+    #[test]
+    fn a_sparse_cloud_is_sorted_and_a_dense_one_tabled() {
+        // 100 k points at random in a cube: a few points a voxel at 2 cm
+        // (the tables give way to sorting), one voxel for ten thousand
+        // at 50 cm (the tables keep it).
+        let mut next = super::super::common::below(5);
+        let cloud: Vec<Point> = (0..100_000)
+            .map(|_| [0, 1, 2].map(|_| next(1 << 20) as f32 / (1 << 20) as f32 * 2.0 - 1.0))
+            .collect();
+        for (leaf, want) in [(0.02, Way::Buckets), (0.5, Way::Table)] {
+            let (got, way) =
+                centroids(&cloud, &VoxelGridParams::cube(leaf), Isa::best(), true).unwrap();
+            assert_eq!(way, want, "leaf {leaf}");
+            assert!(
+                bits(&got) == bits(&map_of_voxels(&cloud, leaf)),
+                "leaf {leaf}"
+            );
+        }
+    }
 
     #[test]
     fn radix_sort_orders_voxels_and_keeps_each_voxels_points_in_order() {

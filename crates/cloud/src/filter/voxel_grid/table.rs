@@ -1,0 +1,388 @@
+//! The voxel grid's way for dense clouds (tens of points a voxel, as a
+//! camera's or a terrestrial scanner's scan at a mine-scale leaf). The key
+//! range is cut into one part a thread, each about as much work by the
+//! keys' sampled histogram (a point, and more for a visit to another
+//! voxel than the last point's); each thread picks out the points of its
+//! own keys (a compress instruction on AVX-512) and sums them straight
+//! into a hash table of its voxels, whose sums lie in the order the voxels
+//! were met; its voxels are then put in key order and the parts joined.
+//! The sorting way ([`super::bucketed_centroids`]) writes, gathers and
+//! sorts a 16-byte entry a point; with 38 points a voxel (1.2 M points of
+//! PCL's RGB-D scans) that was most of its time, where a table of 16 k
+//! voxels a thread is little to sort (15.4 → 4.6 ms there, BENCHMARKS.md).
+//!
+//! The bits are the sorting way's: a voxel belongs to one thread, which
+//! sums its points in f64 in input order.
+//!
+//! Which way runs: this one first; a thread whose table holds more than
+//! one voxel for every [`MIN_POINTS_PER_VOXEL`] points it took stops
+//! every thread, and the sorting way runs instead (with the same keys).
+//! The outputs are the same either way.
+
+use std::sync::atomic::{AtomicBool, Ordering};
+
+use rayon::prelude::*;
+
+use super::keys::{Keys, HISTOGRAM_BITS};
+use super::{radix_sort_voxels, Voxel};
+use crate::filter::within::Isa;
+use crate::Point;
+
+/// Fewest points a voxel a thread's table must hold on average, judged
+/// every [`WINDOW`] points it takes, for this path to carry on. Measured
+/// with the tables forced (BENCHMARKS.md): PCL's RGB-D scans (38 points a
+/// voxel, 6.4 a visit) 4.1× quicker than sorting, the 5 M bench pile (32
+/// a voxel, in random order) 1.6× quicker, the 1 M bench pile (9.3)
+/// about as quick, a 1 M rosette scan (3.5) 2.2× slower. A cloud in
+/// random order fills its voxels late, so it is judged sparser than it
+/// is and sorted (the 5 M pile).
+const MIN_POINTS_PER_VOXEL: usize = 12;
+
+/// Points a thread takes before the density is first judged.
+const WINDOW: usize = 1 << 15;
+
+/// Keys a thread reads at a time (below 2³²).
+const BLOCK: usize = 1 << 12;
+
+/// A table slot no voxel holds (no key of a box of fewer than 2³² voxels).
+const EMPTY: u32 = u32::MAX;
+
+/// A voxel of a thread's part, summed: its key, and x, y, z and the
+/// count (exact in f64 below 2⁵³).
+#[derive(Debug, Clone, Copy, Default)]
+struct Slot {
+    key: u32,
+    sum: [f64; 4],
+}
+
+impl Voxel for Slot {
+    #[inline(always)]
+    fn voxel(&self) -> u32 {
+        self.key
+    }
+}
+
+/// An open-addressed table of voxels (linear probing, at most half
+/// full), holding for each voxel its place in `sums`, where voxels are
+/// in the order they were first met: 32 bytes a voxel, neighbours in the
+/// scan mostly neighbours there (a table of the sums themselves, half
+/// empty, left the second-level cache at 30 k voxels: 4.2 → … ms for
+/// that thread's part of PCL's RGB-D scans). `sums[0]` is no voxel's
+/// ([`Table::SPARE`]).
+struct Table {
+    /// Per slot: a voxel's key and its place in `sums`, or [`EMPTY`].
+    slots: Vec<(u32, u32)>,
+    /// Per voxel: x, y, z and the count.
+    sums: Vec<[f64; 4]>,
+    /// Per voxel: its key.
+    keys: Vec<u32>,
+    bits: u32,
+}
+
+impl Table {
+    /// The sums' place that no voxel has.
+    const SPARE: usize = 0;
+
+    fn new(bits: u32) -> Self {
+        let mut sums = Vec::with_capacity(1 << (bits - 1));
+        sums.push([0.0; 4]);
+        Self {
+            slots: vec![(EMPTY, 0); 1 << bits],
+            sums,
+            keys: vec![EMPTY],
+            bits,
+        }
+    }
+
+    /// The voxels held.
+    fn held(&self) -> usize {
+        self.keys.len() - 1
+    }
+
+    /// Where `key` is, or would be taken.
+    #[inline(always)]
+    fn probe(&self, key: u32) -> usize {
+        let mask = self.slots.len() - 1;
+        // Fibonacci hashing: neighbouring voxels land far apart.
+        let mut at = (key.wrapping_mul(0x9E37_79B9) >> (32 - self.bits)) as usize;
+        loop {
+            let held = self.slots[at].0;
+            if held == key || held == EMPTY {
+                return at;
+            }
+            at = (at + 1) & mask;
+        }
+    }
+
+    /// The place in `sums` of `key`'s voxel, taken for it if it has none.
+    #[inline(always)]
+    fn slot(&mut self, key: u32) -> usize {
+        let at = self.probe(key);
+        let (held, place) = self.slots[at];
+        if held == key {
+            place as usize
+        } else {
+            self.take(at, key)
+        }
+    }
+
+    #[cold]
+    #[inline(never)]
+    fn take(&mut self, at: usize, key: u32) -> usize {
+        let place = self.sums.len();
+        self.slots[at] = (key, place as u32);
+        self.sums.push([0.0; 4]);
+        self.keys.push(key);
+        if 2 * self.held() > self.slots.len() {
+            self.bits += 1;
+            self.slots = vec![(EMPTY, 0); 1 << self.bits];
+            for (place, &key) in self.keys.iter().enumerate().skip(1) {
+                let at = self.probe(key);
+                self.slots[at] = (key, place as u32);
+            }
+        }
+        place
+    }
+
+    /// Adds the points `ps[i]` at the positions `own` (ascending) to
+    /// their voxels (keys `block[i]`), each voxel's in input order.
+    fn add(&mut self, isa: Isa, block: &[u32], ps: &[Point], own: &[u32]) {
+        match isa {
+            // SAFETY: `Isa::best` gives these only where the machine has AVX2.
+            #[cfg(target_arch = "x86_64")]
+            Isa::Avx2 | Isa::Avx512 => unsafe { avx2::add(self, block, ps, own) },
+            _ => self.add_portable(block, ps, own),
+        }
+    }
+
+    /// [`Table::add`]: neighbouring points mostly share a voxel, so a run
+    /// of them is summed in registers, in input order, then stored.
+    fn add_portable(&mut self, block: &[u32], ps: &[Point], own: &[u32]) {
+        let mut j = 0;
+        while j < own.len() {
+            let key = block[own[j] as usize];
+            let at = self.slot(key);
+            let mut sum = self.sums[at];
+            while j < own.len() && block[own[j] as usize] == key {
+                let p = ps[own[j] as usize];
+                for a in 0..3 {
+                    sum[a] += f64::from(p[a]);
+                }
+                sum[3] += 1.0;
+                j += 1;
+            }
+            self.sums[at] = sum;
+        }
+    }
+}
+
+/// The centroids of the voxels with keys in `from..to`, in key order, or
+/// `None` where they are too sparse or too many (or another thread found
+/// its own so): then `stop` is set.
+fn own_part(
+    points: &[Point],
+    keys: &[u32],
+    (from, to): (u64, u64),
+    bits: u32,
+    isa: Isa,
+    stop: &AtomicBool,
+) -> Option<Vec<Point>> {
+    let mut table = Table::new(14);
+    let span = to - from;
+    let mut taken = 0;
+    let mut judged = WINDOW;
+    let mut own = [0u32; BLOCK];
+    for (block, ps) in keys.chunks(BLOCK).zip(points.chunks(BLOCK)) {
+        if stop.load(Ordering::Relaxed) {
+            return None;
+        }
+        // This thread's points of the block, without a branch (which
+        // mispredicted where the threads' voxels interleave).
+        let held = owned(isa, block, (from as u32, span as u32), &mut own);
+        table.add(isa, block, ps, &own[..held]);
+        taken += held;
+        if taken >= judged {
+            judged = taken + WINDOW;
+            if table.held() * MIN_POINTS_PER_VOXEL > taken {
+                stop.store(true, Ordering::Relaxed);
+                return None;
+            }
+        }
+    }
+    let mut slots: Vec<Slot> = (table.keys.iter().zip(&table.sums))
+        .skip(1)
+        .map(|(&key, &sum)| Slot { key, sum })
+        .collect();
+    let mut spare = vec![Slot::default(); slots.len()];
+    let sorted = radix_sort_voxels(&mut slots, &mut spare, bits);
+    Some(
+        sorted
+            .iter()
+            .map(|s| [0, 1, 2].map(|a| (s.sum[a] / s.sum[3]) as f32))
+            .collect(),
+    )
+}
+
+/// The centroids of the occupied voxels in key order (those of
+/// [`super::bucketed_centroids`], to the bit), or `None` where the cloud
+/// is too sparse for this path. Keys are below 2^`bits` < 2³².
+pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> Option<Vec<Point>> {
+    let parts = rayon::current_num_threads();
+    // Cut the key range where the histogram's running count passes each
+    // part's share.
+    let shift = bits.saturating_sub(HISTOGRAM_BITS);
+    let total: usize = keys.histogram.iter().sum();
+    let mut cuts = vec![0u64];
+    let mut running = 0;
+    for (bin, &count) in keys.histogram.iter().enumerate() {
+        running += count;
+        let part = cuts.len();
+        if part < parts && running * parts >= total * part {
+            cuts.push((bin as u64 + 1) << shift);
+        }
+    }
+    // Every finite point's key is below 2^bits and below NOT_FINITE.
+    cuts.push((1u64 << bits).min(u64::from(super::keys::NOT_FINITE)));
+    cuts.dedup();
+    let stop = AtomicBool::new(false);
+    let out: Option<Vec<Vec<Point>>> = cuts
+        .par_windows(2)
+        .map(|w| own_part(points, &keys.keys, (w[0], w[1]), bits, isa, &stop))
+        .collect();
+    Some(out?.concat())
+}
+
+/// The positions in `block` of the keys in `from..from + span` (wrapping
+/// u32 arithmetic: `from + span` ≤ 2³² − 1, so [`NOT_FINITE`] is never
+/// one), written to the front of `own`; returns how many.
+fn owned(isa: Isa, block: &[u32], (from, span): (u32, u32), own: &mut [u32; BLOCK]) -> usize {
+    match isa {
+        // SAFETY: `Isa::best` gives AVX-512 only where the machine has it.
+        #[cfg(target_arch = "x86_64")]
+        Isa::Avx512 => unsafe { avx512::owned(block, from, span, own) },
+        _ => {
+            // Without a branch, which mispredicted where the threads'
+            // voxels interleave.
+            let mut held = 0;
+            for (i, &key) in block.iter().enumerate() {
+                own[held] = i as u32;
+                held += usize::from(key.wrapping_sub(from) < span);
+            }
+            held
+        }
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx512 {
+    use std::arch::x86_64::*;
+
+    use super::BLOCK;
+
+    /// [`super::owned`], 16 keys a step, the positions packed by a
+    /// compress instruction.
+    ///
+    /// # Safety
+    /// AVX-512F; `block` at most [`BLOCK`] keys.
+    #[target_feature(enable = "avx512f,popcnt")]
+    pub(super) unsafe fn owned(
+        block: &[u32],
+        from: u32,
+        span: u32,
+        own: &mut [u32; BLOCK],
+    ) -> usize {
+        assert!(block.len() <= BLOCK);
+        let (from, span) = (
+            _mm512_set1_epi32(from as i32),
+            _mm512_set1_epi32(span as i32),
+        );
+        let step = _mm512_set1_epi32(16);
+        let mut at = _mm512_setr_epi32(0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14, 15);
+        let mut held = 0;
+        for chunk in block.chunks(16) {
+            let lanes: __mmask16 = if chunk.len() == 16 {
+                u16::MAX
+            } else {
+                (1 << chunk.len()) - 1
+            };
+            // SAFETY: the masked lanes lie in `chunk`; `own` has room for
+            // every key of the block.
+            unsafe {
+                let key = _mm512_maskz_loadu_epi32(lanes, chunk.as_ptr().cast());
+                let mine = lanes & _mm512_cmplt_epu32_mask(_mm512_sub_epi32(key, from), span);
+                _mm512_mask_compressstoreu_epi32(own.as_mut_ptr().add(held).cast(), mine, at);
+                held += mine.count_ones() as usize;
+            }
+            at = _mm512_add_epi32(at, step);
+        }
+        held
+    }
+}
+
+#[cfg(target_arch = "x86_64")]
+mod avx2 {
+    use std::arch::x86_64::*;
+
+    use super::Table;
+    use crate::Point;
+
+    /// [`Table::add`] without a branch on where a run of points of one
+    /// voxel ends (a misprediction at the end of every run was most of the
+    /// time on a camera's scan, 3.8 points a run): a point's slot is
+    /// found, the running sum (x, y, z, count in one register) is taken
+    /// from that slot unless it is the last point's, the point is added,
+    /// and the sum is stored back to its slot, every point. Where the slot
+    /// is the last point's, the load reads the spare slot instead, so the
+    /// sum's chain of additions never waits on its own store.
+    ///
+    /// # Safety
+    /// AVX2; `own` indexes `block` and `ps`.
+    #[target_feature(enable = "avx2")]
+    pub(super) unsafe fn add(table: &mut Table, block: &[u32], ps: &[Point], own: &[u32]) {
+        // The table's fields in registers (the stores below could alias
+        // them), read again after a voxel is taken.
+        let mut slots = table.slots.as_ptr();
+        let mut mask = table.slots.len() - 1;
+        let mut shift = 32 - table.bits;
+        let mut sums = table.sums.as_mut_ptr();
+        let count = _mm256_setr_pd(0.0, 0.0, 0.0, 1.0);
+        let mut last = Table::SPARE;
+        let mut sum = _mm256_setzero_pd();
+        for &i in own {
+            // SAFETY: `own` indexes `block` and `ps`; slots are read
+            // within the table (masked), sums at places it gave.
+            unsafe {
+                let key = *block.get_unchecked(i as usize);
+                let p = ps.get_unchecked(i as usize).as_ptr();
+                let mut at = (key.wrapping_mul(0x9E37_79B9) >> shift) as usize;
+                let place = loop {
+                    let (held, place) = *slots.add(at);
+                    if held == key {
+                        break place as usize;
+                    }
+                    if held == super::EMPTY {
+                        let place = table.take(at, key);
+                        slots = table.slots.as_ptr();
+                        mask = table.slots.len() - 1;
+                        shift = 32 - table.bits;
+                        sums = table.sums.as_mut_ptr();
+                        break place;
+                    }
+                    at = (at + 1) & mask;
+                };
+                let same = place == last;
+                let from = if same { Table::SPARE } else { place };
+                let stored = _mm256_loadu_pd(sums.add(from).cast());
+                let keep = _mm256_castsi256_pd(_mm256_set1_epi64x(-(same as i64)));
+                sum = _mm256_blendv_pd(stored, sum, keep);
+                // x, y, z (the fourth lane masked off: the last point may
+                // end the cloud), and 1 for the count.
+                let xyz = _mm_maskload_ps(p, _mm_setr_epi32(-1, -1, -1, 0));
+                let point = _mm256_blend_pd::<0b1000>(_mm256_cvtps_pd(xyz), count);
+                sum = _mm256_add_pd(sum, point);
+                _mm256_storeu_pd(sums.add(place).cast(), sum);
+                last = place;
+            }
+        }
+    }
+}
