@@ -718,20 +718,28 @@ mod tests {
     }
 
     #[test]
-    fn a_sparse_cloud_is_sorted_and_a_dense_one_tabled() {
-        // 100 k points at random in a cube: a few points a voxel at 2 cm
-        // (the tables give way to sorting), one voxel for ten thousand
-        // at 50 cm (the tables keep it).
+    fn the_tables_are_taken_for_runs_of_dense_voxels_only() {
+        // 100 k points at random in a cube: few points a voxel at 2 cm,
+        // ten thousand at 50 cm, but hardly two in a row in one voxel
+        // (the keys' sample says so: sorted); a scan in rows, with runs
+        // of three points a voxel and nine points a voxel at 6 mm (tried,
+        // then given up) and fifty at 2 cm (tabled).
         let mut next = super::super::common::below(5);
-        let cloud: Vec<Point> = (0..100_000)
+        let random: Vec<Point> = (0..100_000)
             .map(|_| [0, 1, 2].map(|_| next(1 << 20) as f32 / (1 << 20) as f32 * 2.0 - 1.0))
             .collect();
-        for (leaf, want) in [(0.02, Way::Buckets), (0.5, Way::Table)] {
+        let rows = scan(400, 400, 6);
+        for (cloud, leaf, want) in [
+            (&random, 0.02, Way::Buckets),
+            (&random, 0.5, Way::Buckets),
+            (&rows, 0.006, Way::Buckets),
+            (&rows, 0.02, Way::Table),
+        ] {
             let (got, way) =
-                centroids(&cloud, &VoxelGridParams::cube(leaf), Isa::best(), true).unwrap();
+                centroids(cloud, &VoxelGridParams::cube(leaf), Isa::best(), true).unwrap();
             assert_eq!(way, want, "leaf {leaf}");
             assert!(
-                bits(&got) == bits(&map_of_voxels(&cloud, leaf)),
+                bits(&got) == bits(&map_of_voxels(cloud, leaf)),
                 "leaf {leaf}"
             );
         }

@@ -58,6 +58,10 @@ pub(super) struct Keys {
     /// from a sample of the keys: a point, and [`VISIT`] more where its
     /// voxel is not the last point's.
     pub histogram: Vec<usize>,
+    /// Finite points in the histogram's sample, and how many of them
+    /// visit another voxel than the point before.
+    pub sampled: usize,
+    pub visits: usize,
 }
 
 impl Grid {
@@ -91,7 +95,8 @@ impl Grid {
         let mut keys: Vec<u32> = crate::room::with_room(points.len());
         let room = &mut keys.spare_capacity_mut()[..points.len()];
         let bins = 1 << HISTOGRAM_BITS;
-        let histogram = room
+        let none = || (vec![0usize; bins], 0, 0);
+        let (histogram, sampled, visits) = room
             .par_chunks_mut(CHUNK)
             .zip(points.par_chunks(CHUNK))
             .map(|(room, ps)| {
@@ -99,26 +104,31 @@ impl Grid {
                 // is written below before it is read.
                 let out = unsafe { &mut *(room as *mut [_] as *mut [u32]) };
                 self.keys_into(isa, ps, out);
-                let mut histogram = vec![0usize; bins];
+                let (mut histogram, mut sampled, mut visits) = none();
                 for run in out.chunks(SAMPLE).step_by(SAMPLE_EVERY) {
                     let mut last = NOT_FINITE;
                     for &k in run.iter().filter(|&&k| k != NOT_FINITE) {
-                        histogram[(k >> shift) as usize] += 1 + VISIT * usize::from(k != last);
+                        let visit = usize::from(k != last);
+                        histogram[(k >> shift) as usize] += 1 + VISIT * visit;
+                        sampled += 1;
+                        visits += visit;
                         last = k;
                     }
                 }
-                histogram
+                (histogram, sampled, visits)
             })
-            .reduce(
-                || vec![0; bins],
-                |mut a, b| {
-                    a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
-                    a
-                },
-            );
+            .reduce(none, |(mut a, sa, va), (b, sb, vb)| {
+                a.iter_mut().zip(b).for_each(|(a, b)| *a += b);
+                (a, sa + sb, va + vb)
+            });
         // SAFETY: every key was written above.
         unsafe { keys.set_len(points.len()) };
-        Keys { keys, histogram }
+        Keys {
+            keys,
+            histogram,
+            sampled,
+            visits,
+        }
     }
 }
 
