@@ -35,7 +35,11 @@ use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 mod keys;
+mod radix;
 mod table;
+
+use keys::floor_i64;
+use radix::{radix_sort_voxels, Voxel};
 
 use super::common::{bad, empty_input, is_finite};
 use super::within::Isa;
@@ -95,16 +99,6 @@ impl VoxelGridParams {
 
 /// Voxel coordinates are kept below this magnitude, far inside i64.
 const MAX_CELL: f32 = 4.0e18;
-
-/// ⌊v⌋ of a finite `v` with |v| < 4e18, as `v.floor() as i64` gives it.
-/// Why by hand: without SSE4.1 (the x86-64 baseline) `f32::floor` is a
-/// call into libm, a tenth of the voxel grid's time; truncation and one
-/// comparison are exact for every f32 in range.
-#[inline(always)]
-fn floor_i64(v: f32) -> i64 {
-    let t = v as i64;
-    t - i64::from((t as f32) > v)
-}
 
 /// The centroids of the occupied voxels, in PCL's order (x fastest, then y,
 /// then z). Non-finite points are skipped.
@@ -349,11 +343,6 @@ struct Entry {
     point: Point,
 }
 
-/// What [`radix_sort_voxels`] sorts by: a voxel's linear index.
-trait Voxel: Copy {
-    fn voxel(&self) -> u32;
-}
-
 impl Voxel for Entry {
     #[inline(always)]
     fn voxel(&self) -> u32 {
@@ -361,9 +350,9 @@ impl Voxel for Entry {
     }
 }
 
-/// The centroids of the occupied voxels in linear-index order, for a box
-/// of at most 2³² `voxels`; `linear` gives a finite point's voxel index.
-/// Why not one sort of all keys: the cloud is cut into chunks (a few a
+/// The centroids of the occupied voxels in linear-index order, from each
+/// point's key (`keys.rs`: its voxel's index, below 2^`voxel_bits` ≤ 2³²,
+/// or `NOT_FINITE`). Why not one sort of all keys: the cloud is cut into chunks (a few a
 /// thread, at most [`MAX_CHUNK`] points), and each chunk is counting-sorted
 /// on its own (in cache, in parallel) into super-buckets by the voxel
 /// index's top bits (about [`BUCKET_POINTS`] points each, over all
@@ -383,7 +372,7 @@ fn bucketed_centroids(points: &[Point], keys: &[u32], voxel_bits: u32) -> Vec<Po
     let super_bits = (usize::BITS - (n / BUCKET_POINTS).max(1).leading_zeros())
         .min(voxel_bits)
         .min(MAX_SUPER_BITS);
-    // At most 31: `voxels` ≤ 2³² and at least one super-bucket bit.
+    // At most 31: `voxel_bits` ≤ 32 and at least one super-bucket bit.
     let shift = voxel_bits - super_bits;
     let low = (1u32 << shift) - 1;
     let supers = 1usize << super_bits;
@@ -508,55 +497,6 @@ fn sort_and_sum(buf: &mut Buffers, bits: u32, out: &mut Vec<Point>) {
 /// comparison sort is quicker).
 const RADIX_FROM: usize = 32;
 
-/// Bits of a digit of [`radix_sort_voxels`]: its counts (8 KiB) stay in
-/// the first-level cache, and 22 bits take two passes.
-const DIGIT_BITS: u32 = 11;
-
-/// Sorts `entries` by the low `bits` bits of their voxel index: a stable
-/// least-significant-digit radix sort on digits of [`DIGIT_BITS`], every
-/// digit counted in one pass first (a digit all entries share is passed
-/// over), so each voxel's points keep their order. `spare` (as long as
-/// `entries`) is scratch; returns whichever of the two holds the sorted
-/// entries.
-#[inline]
-fn radix_sort_voxels<'a, T: Voxel>(
-    mut entries: &'a mut [T],
-    mut spare: &'a mut [T],
-    bits: u32,
-) -> &'a [T] {
-    const DIGITS: usize = 1 << DIGIT_BITS;
-    const MAX_PASSES: usize = 32_usize.div_ceil(DIGIT_BITS as usize);
-    let passes = bits.div_ceil(DIGIT_BITS) as usize;
-    let mut count = [[0u32; DIGITS]; MAX_PASSES];
-    let digit = |e: &T, pass: usize| {
-        ((e.voxel() >> (pass as u32 * DIGIT_BITS)) & (DIGITS as u32 - 1)) as usize
-    };
-    for e in entries.iter() {
-        for (pass, c) in count.iter_mut().enumerate().take(passes) {
-            c[digit(e, pass)] += 1;
-        }
-    }
-    for (pass, c) in count.iter_mut().enumerate().take(passes) {
-        if c.iter().any(|&k| k as usize == entries.len()) {
-            continue;
-        }
-        // Counts to starts.
-        let mut at = 0;
-        for k in c.iter_mut() {
-            let n = *k;
-            *k = at;
-            at += n;
-        }
-        for e in entries.iter() {
-            let slot = &mut c[digit(e, pass)];
-            spare[*slot as usize] = *e;
-            *slot += 1;
-        }
-        std::mem::swap(&mut entries, &mut spare);
-    }
-    entries
-}
-
 /// The centroid of each run of equal voxel keys in the sorted `keys`, in
 /// key order. Within a voxel, points are summed in ascending index, so the
 /// result depends neither on the sort nor on the number of threads.
@@ -622,7 +562,7 @@ where
 
 #[cfg(test)]
 mod tests {
-    use super::{centroids, floor_i64, radix_sort_voxels, Entry, VoxelGridParams, Way};
+    use super::{centroids, VoxelGridParams, Way};
     use crate::filter::within::Isa;
     use crate::Point;
 
@@ -746,53 +686,23 @@ mod tests {
     }
 
     #[test]
-    fn radix_sort_orders_voxels_and_keeps_each_voxels_points_in_order() {
-        let mut next = super::super::common::below(9);
-        for trial in 0..2_000 {
-            let bits = 1 + (trial % 31) as u32;
-            let n = next(300) as usize;
-            // Voxels at random below 2^bits (from few distinct to all
-            // different), each point marked with its place in the input.
-            let spread = 1 + next(1 << bits);
-            let mut entries: Vec<Entry> = (0..n)
-                .map(|i| Entry {
-                    voxel: next(spread) as u32,
-                    point: [i as f32, 0.0, 0.0],
-                })
-                .collect();
-            let mut want = entries.clone();
-            want.sort_by_key(|e| e.voxel);
-            let mut spare = vec![Entry::default(); n];
-            let sorted = radix_sort_voxels(&mut entries, &mut spare, bits);
-            assert!(sorted == want, "bits {bits}, {n} entries");
-        }
-    }
-
-    #[test]
-    fn floor_by_hand_is_floor() {
-        let mut v = vec![
-            0.0, -0.0, 0.5, -0.5, 1.0, -1.0, 2.5, -2.5, 1e-30, -1e-30, 3.9e18, -3.9e18,
-        ];
-        v.extend([
-            8388607.5f32,
-            -8388607.5,
-            16777217.0,
-            -16777217.0,
-            0.99999994,
-            -0.99999994,
-        ]);
-        let mut s = 1u64;
-        for _ in 0..100_000 {
-            s = s
-                .wrapping_mul(6364136223846793005)
-                .wrapping_add(1442695040888963407);
-            let x = f32::from_bits((s >> 32) as u32);
-            if x.is_finite() && x.abs() < 4.0e18 {
-                v.push(x);
-            }
-        }
-        for x in v {
-            assert_eq!(floor_i64(x), x.floor() as i64, "{x}");
+    fn the_tables_take_cells_beyond_32_bits_on_every_path() {
+        // A line 3 km from the origin at a 1 µm leaf: cells near 3e9,
+        // past i32 (the vector keys give way to the portable ones), in a
+        // box of 5 M voxels; each point repeated 20 times in a row, so
+        // the tables take it.
+        let points: Vec<Point> = (0..20_000)
+            .flat_map(|i| {
+                let x = 3000.0 + i as f32 * 2.5e-4;
+                std::iter::repeat_n([x, 0.5, -0.25], 20)
+            })
+            .collect();
+        let leaf = 1e-6;
+        let expected = bits(&map_of_voxels(&points, leaf));
+        for isa in Isa::available() {
+            let (got, way) = centroids(&points, &VoxelGridParams::cube(leaf), isa, true).unwrap();
+            assert_eq!(way, Way::Table, "{isa:?}");
+            assert!(bits(&got) == expected, "{isa:?}");
         }
     }
 }

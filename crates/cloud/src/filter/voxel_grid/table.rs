@@ -25,7 +25,7 @@ use std::sync::atomic::{AtomicBool, Ordering};
 use rayon::prelude::*;
 
 use super::keys::{Keys, HISTOGRAM_BITS};
-use super::{radix_sort_voxels, Voxel};
+use super::radix::{radix_sort_voxels, Voxel};
 use crate::filter::within::Isa;
 use crate::Point;
 
