@@ -246,6 +246,11 @@ def main():
         sizes = [s.strip().lower() for s in args.sizes.split(",")]
     for size in sizes:
         ours("clouds", size)
+    # The clouds just written (0.24 GB at 20 M points) are flushed before
+    # anything is timed, so that no writeback shares the cores with a
+    # timed run. (It was suspected, not shown, in two slow 20 M runs of our
+    # voxel grid: BENCHMARKS.md, 2026-12-05 21:36-00:36.)
+    os.sync()
     binary = None
     if args.process:
         subprocess.run(["cargo", "build", "-q", "--release", "-p", "autoshovel"], cwd=ROOT, check=True)
