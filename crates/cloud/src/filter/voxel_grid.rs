@@ -658,10 +658,11 @@ mod tests {
     }
 
     #[test]
-    fn the_tables_are_taken_for_runs_of_dense_voxels_only() {
+    fn the_tables_are_taken_for_dense_voxels_only() {
         // 100 k points at random in a cube: few points a voxel at 2 cm,
         // ten thousand at 50 cm, but hardly two in a row in one voxel
-        // (the keys' sample says so: sorted); a scan in rows, with runs
+        // (the keys' sample says so) and too few points to estimate its
+        // voxels: sorted; a scan in rows, with runs
         // of three points a voxel and nine points a voxel at 6 mm (tried,
         // then given up) and fifty at 2 cm (tabled).
         let mut next = super::super::common::below(5);
@@ -669,11 +670,18 @@ mod tests {
             .map(|_| [0, 1, 2].map(|_| next(1 << 20) as f32 / (1 << 20) as f32 * 2.0 - 1.0))
             .collect();
         let rows = scan(400, 400, 6);
+        // 1.1 M points at random: estimated first (2 cm: sorted, 50 cm:
+        // tabled, one voxel for seventeen thousand points).
+        let many: Vec<Point> = (0..1_100_000)
+            .map(|_| [0, 1, 2].map(|_| next(1 << 20) as f32 / (1 << 20) as f32 * 2.0 - 1.0))
+            .collect();
         for (cloud, leaf, want) in [
             (&random, 0.02, Way::Buckets),
             (&random, 0.5, Way::Buckets),
             (&rows, 0.006, Way::Buckets),
             (&rows, 0.02, Way::Table),
+            (&many, 0.02, Way::Buckets),
+            (&many, 0.5, Way::Table),
         ] {
             let (got, way) =
                 centroids(cloud, &VoxelGridParams::cube(leaf), Isa::best(), true).unwrap();

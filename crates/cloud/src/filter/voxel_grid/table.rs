@@ -15,10 +15,15 @@
 //! sums its points in f64 in input order.
 //!
 //! Which way runs: this one, where the keys' sample holds at least
-//! [`MIN_POINTS_PER_VISIT`] points a visit to a voxel; a thread whose
-//! table holds more than one voxel for every [`MIN_POINTS_PER_VOXEL`]
-//! points it took stops every thread, and the sorting way runs instead
-//! (with the same keys). The outputs are the same either way.
+//! [`MIN_POINTS_PER_VISIT`] points a visit to a voxel (a scan's rows),
+//! and a thread whose table holds more than one voxel for every
+//! [`MIN_POINTS_PER_VOXEL`] points it took stops every thread; or, for a
+//! cloud of [`ESTIMATE_FROM`] points or more without such runs (points in
+//! random order), where an estimate of its voxels from a sample gives at
+//! least [`MIN_POINTS_PER_VOXEL`] points a voxel, a thread stopping every
+//! thread when its table holds twice the estimate. Where the tables do
+//! not run or stop, the sorting way runs (with the same keys). The
+//! outputs are the same either way.
 
 use std::sync::atomic::{AtomicBool, Ordering};
 
@@ -34,9 +39,10 @@ use crate::Point;
 /// with the tables forced (BENCHMARKS.md): PCL's RGB-D scans (38 points a
 /// voxel, 6.4 a visit) 4.1× quicker than sorting, the 5 M bench pile (32
 /// a voxel, in random order) 1.6× quicker, the 1 M bench pile (9.3)
-/// about as quick, a 1 M rosette scan (3.5) 2.2× slower. A cloud in
-/// random order fills its voxels late, so it is judged sparser than it
-/// is and sorted (the 5 M pile).
+/// about as quick, a 1 M rosette scan (3.5) 2.2× slower, the 20 M bench
+/// pile (65, in random order) 1.7× quicker. A cloud in random order
+/// fills its voxels late, so it is not judged as it goes but on an
+/// estimate of its voxels first ([`estimated_voxels`]).
 const MIN_POINTS_PER_VOXEL: usize = 12;
 
 /// Fewest points a visit to a voxel (a run of points of one voxel in
@@ -48,6 +54,63 @@ const MIN_POINTS_PER_VOXEL: usize = 12;
 /// points (100 k-point frames of a rosette scan: the voxel stage 0.87–0.94
 /// → 1.0–1.1 ms when they did). PCL's RGB-D scans hold 3.0–6.4.
 const MIN_POINTS_PER_VISIT: usize = 2;
+
+/// Points from which a cloud without runs of points a voxel has its
+/// voxels estimated ([`estimated_voxels`]) and may take the tables:
+/// below, the estimate's sort is a share of the grid's time (a 100
+/// k-point frame's voxel stage is under a millisecond).
+const ESTIMATE_FROM: usize = 1 << 20;
+
+/// Keys the estimate of the voxels samples.
+const ESTIMATE_SAMPLE: usize = 1 << 14;
+
+/// How a thread judges its table as it goes.
+#[derive(Debug, Clone, Copy)]
+enum Judge {
+    /// Too sparse where it holds more than one voxel for every
+    /// [`MIN_POINTS_PER_VOXEL`] points taken (points in runs, which fill
+    /// their voxels as they come).
+    AsItGoes,
+    /// Wrong where it holds more voxels than this: twice the estimate of
+    /// the whole cloud's.
+    AtMost(usize),
+}
+
+/// The finite points of a cloud and its voxels, estimated from
+/// [`ESTIMATE_SAMPLE`] keys evenly spaced through it, by Chao's estimator
+/// (the distinct keys seen, and the singletons' count squared over twice
+/// the doubletons'): on the 5 M and 20 M bench piles (points in random
+/// order, 156 k and 308 k voxels) within a few per cent. `None` where the
+/// sample holds no finite point.
+fn estimated_voxels(keys: &[u32]) -> Option<(f64, f64)> {
+    let step = (keys.len() / ESTIMATE_SAMPLE).max(1);
+    let mut sample: Vec<u32> = keys
+        .iter()
+        .step_by(step)
+        .copied()
+        .filter(|&k| k != super::keys::NOT_FINITE)
+        .collect();
+    if sample.is_empty() {
+        return None;
+    }
+    let finite = keys.len() as f64 * sample.len() as f64 / keys.len().div_ceil(step) as f64;
+    sample.sort_unstable();
+    let (mut distinct, mut once, mut twice) = (0.0, 0.0, 0.0);
+    for run in sample.chunk_by(|a, b| a == b) {
+        distinct += 1.0;
+        match run.len() {
+            1 => once += 1.0,
+            2 => twice += 1.0,
+            _ => {}
+        }
+    }
+    let unseen = if twice > 0.0 {
+        once * once / (2.0 * twice)
+    } else {
+        once * (once - 1.0) / 2.0
+    };
+    Some((finite, distinct + unseen))
+}
 
 /// Points a thread takes before the density is first judged.
 const WINDOW: usize = 1 << 15;
@@ -196,6 +259,7 @@ fn own_part(
     (from, to): (u64, u64),
     bits: u32,
     isa: Isa,
+    judge: Judge,
     stop: &AtomicBool,
 ) -> Option<Vec<Point>> {
     let mut table = Table::new(14);
@@ -214,7 +278,11 @@ fn own_part(
         taken += held;
         if taken >= judged {
             judged = taken + WINDOW;
-            if table.held() * MIN_POINTS_PER_VOXEL > taken {
+            let sparse = match judge {
+                Judge::AsItGoes => table.held() * MIN_POINTS_PER_VOXEL > taken,
+                Judge::AtMost(voxels) => table.held() > voxels,
+            };
+            if sparse {
                 stop.store(true, Ordering::Relaxed);
                 return None;
             }
@@ -238,9 +306,19 @@ fn own_part(
 /// [`super::bucketed_centroids`], to the bit), or `None` where the cloud
 /// is too sparse for this path. Keys are below 2^`bits` < 2³².
 pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> Option<Vec<Point>> {
-    if keys.visits * MIN_POINTS_PER_VISIT > keys.sampled {
+    let judge = if keys.visits * MIN_POINTS_PER_VISIT <= keys.sampled {
+        Judge::AsItGoes
+    } else if keys.keys.len() >= ESTIMATE_FROM {
+        // Points in no order (a cloud shuffled, merged or gridded): their
+        // voxels fill late, so the density is estimated first.
+        let (finite, voxels) = estimated_voxels(&keys.keys)?;
+        if finite < MIN_POINTS_PER_VOXEL as f64 * voxels {
+            return None;
+        }
+        Judge::AtMost((2.0 * voxels) as usize + WINDOW)
+    } else {
         return None;
-    }
+    };
     let parts = rayon::current_num_threads();
     // Cut the key range where the histogram's running count passes each
     // part's share.
@@ -261,7 +339,7 @@ pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> O
     let stop = AtomicBool::new(false);
     let out: Option<Vec<Vec<Point>>> = cuts
         .par_windows(2)
-        .map(|w| own_part(points, &keys.keys, (w[0], w[1]), bits, isa, &stop))
+        .map(|w| own_part(points, &keys.keys, (w[0], w[1]), bits, isa, judge, &stop))
         .collect();
     Some(out?.concat())
 }
@@ -284,6 +362,37 @@ fn owned(isa: Isa, block: &[u32], (from, span): (u32, u32), own: &mut [u32; BLOC
             }
             held
         }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::estimated_voxels;
+    use crate::filter::voxel_grid::keys::NOT_FINITE;
+
+    #[test]
+    fn the_voxels_are_estimated_within_a_fifth() {
+        // 2 M keys drawn at random from v voxels (a tenth of them not
+        // finite): where the tables could pay (v up to a twelfth of the
+        // points and beyond), the estimate is near v, and the finite
+        // points near their count.
+        let mut next = crate::filter::common::below(8);
+        for v in [1_000u64, 20_000, 150_000, 500_000] {
+            let keys: Vec<u32> = (0..2_000_000)
+                .map(|_| {
+                    if next(10) == 0 {
+                        NOT_FINITE
+                    } else {
+                        (next(v) * 7) as u32
+                    }
+                })
+                .collect();
+            let finite = keys.iter().filter(|&&k| k != NOT_FINITE).count() as f64;
+            let (f, got) = estimated_voxels(&keys).unwrap();
+            assert!((got / v as f64 - 1.0).abs() < 0.2, "{v} voxels, {got}");
+            assert!((f / finite - 1.0).abs() < 0.02, "{f} finite of {finite}");
+        }
+        assert_eq!(estimated_voxels(&[NOT_FINITE; 100]), None);
     }
 }
 
