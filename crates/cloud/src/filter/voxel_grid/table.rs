@@ -9,7 +9,8 @@
 //! The sorting way ([`super::bucketed_centroids`]) writes, gathers and
 //! sorts a 16-byte entry a point; with 38 points a voxel (1.2 M points of
 //! PCL's RGB-D scans) that was most of its time, where a table of 16 k
-//! voxels a thread is little to sort (15.4 → 4.6 ms there, BENCHMARKS.md).
+//! voxels a thread is little to sort (17–21 → 4.6–4.9 ms there,
+//! BENCHMARKS.md).
 //!
 //! The bits are the sorting way's: a voxel belongs to one thread, which
 //! sums its points in f64 in input order.
@@ -79,9 +80,13 @@ enum Judge {
 /// The finite points of a cloud and its voxels, estimated from
 /// [`ESTIMATE_SAMPLE`] keys evenly spaced through it, by Chao's estimator
 /// (the distinct keys seen, and the singletons' count squared over twice
-/// the doubletons'): on the 5 M and 20 M bench piles (points in random
-/// order, 156 k and 308 k voxels) within a few per cent. `None` where the
-/// sample holds no finite point.
+/// the doubletons'); `None` where the sample holds no finite point. It is
+/// near for voxels about evenly filled, and a lower bound where they are
+/// not: 79 k and 81 k voxels on the 5 M and 20 M bench piles, which have
+/// 156 k and 308 k. A cloud it underrates is judged denser than it is;
+/// the tables then run where sorting might have been as quick (the 1 M
+/// pile, nine points a voxel: about as quick either way), and stop at
+/// twice the estimate ([`Judge::AtMost`]), where sorting takes over.
 fn estimated_voxels(keys: &[u32]) -> Option<(f64, f64)> {
     let step = (keys.len() / ESTIMATE_SAMPLE).max(1);
     let mut sample: Vec<u32> = keys
