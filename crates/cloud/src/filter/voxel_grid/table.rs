@@ -22,7 +22,9 @@
 //! cloud of [`ESTIMATE_FROM`] points or more without such runs (points in
 //! random order), where an estimate of its voxels from a sample gives at
 //! least [`MIN_POINTS_PER_VOXEL`] points a voxel, a thread stopping every
-//! thread when its table holds twice the estimate. Where the tables do
+//! thread when its table holds more than one voxel for every
+//! [`MIN_POINTS_PER_VOXEL`] of the points its part is estimated to hold
+//! (by the histogram). Where the tables do
 //! not run or stop, the sorting way runs (with the same keys). The
 //! outputs are the same either way.
 
@@ -72,8 +74,9 @@ enum Judge {
     /// [`MIN_POINTS_PER_VOXEL`] points taken (points in runs, which fill
     /// their voxels as they come).
     AsItGoes,
-    /// Wrong where it holds more voxels than this: twice the estimate of
-    /// the whole cloud's.
+    /// Too sparse where it holds more voxels than this: one for every
+    /// [`MIN_POINTS_PER_VOXEL`] of the points its part is estimated to
+    /// hold (points in no order, whose voxels fill late).
     AtMost(usize),
 }
 
@@ -85,8 +88,9 @@ enum Judge {
 /// not: 79 k and 81 k voxels on the 5 M and 20 M bench piles, which have
 /// 156 k and 308 k. A cloud it underrates is judged denser than it is;
 /// the tables then run where sorting might have been as quick (the 1 M
-/// pile, nine points a voxel: about as quick either way), and stop at
-/// twice the estimate ([`Judge::AtMost`]), where sorting takes over.
+/// pile, nine points a voxel: about as quick either way), and stop once
+/// a thread holds a voxel for every twelve of its part's points
+/// ([`Judge::AtMost`]), where sorting takes over.
 fn estimated_voxels(keys: &[u32]) -> Option<(f64, f64)> {
     let step = (keys.len() / ESTIMATE_SAMPLE).max(1);
     let mut sample: Vec<u32> = keys
@@ -311,8 +315,10 @@ fn own_part(
 /// [`super::bucketed_centroids`], to the bit), or `None` where the cloud
 /// is too sparse for this path. Keys are below 2^`bits` < 2³².
 pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> Option<Vec<Point>> {
-    let judge = if keys.visits * MIN_POINTS_PER_VISIT <= keys.sampled {
-        Judge::AsItGoes
+    // `Some(finite points)` where they are judged against the whole
+    // count, `None` as they come.
+    let finite = if keys.visits * MIN_POINTS_PER_VISIT <= keys.sampled {
+        None
     } else if keys.keys.len() >= ESTIMATE_FROM {
         // Points in no order (a cloud shuffled, merged or gridded): their
         // voxels fill late, so the density is estimated first.
@@ -320,7 +326,7 @@ pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> O
         if finite < MIN_POINTS_PER_VOXEL as f64 * voxels {
             return None;
         }
-        Judge::AtMost((2.0 * voxels) as usize + WINDOW)
+        Some(finite)
     } else {
         return None;
     };
@@ -341,10 +347,24 @@ pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> O
     // Every finite point's key is below 2^bits and below NOT_FINITE.
     cuts.push((1u64 << bits).min(u64::from(super::keys::NOT_FINITE)));
     cuts.dedup();
+    let judge = |from: u64, to: u64| match finite {
+        None => Judge::AsItGoes,
+        Some(finite) => {
+            // The part's share of the points, by the histogram's (a cloud
+            // in no order visits a voxel at about every point, so its
+            // bins weigh points alike).
+            let bins = (from >> shift) as usize..((to + (1 << shift) - 1) >> shift) as usize;
+            let share = keys.histogram[bins].iter().sum::<usize>() as f64 / total.max(1) as f64;
+            Judge::AtMost((finite * share) as usize / MIN_POINTS_PER_VOXEL + WINDOW)
+        }
+    };
     let stop = AtomicBool::new(false);
     let out: Option<Vec<Vec<Point>>> = cuts
         .par_windows(2)
-        .map(|w| own_part(points, &keys.keys, (w[0], w[1]), bits, isa, judge, &stop))
+        .map(|w| {
+            let judge = judge(w[0], w[1]);
+            own_part(points, &keys.keys, (w[0], w[1]), bits, isa, judge, &stop)
+        })
         .collect();
     Some(out?.concat())
 }
