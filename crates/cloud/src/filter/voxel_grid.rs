@@ -694,6 +694,37 @@ mod tests {
     }
 
     #[test]
+    fn the_tables_cut_a_box_of_nearly_2_32_voxels_among_threads() {
+        // A box of 65 535 × 256 × 256 voxels (2³² less 2¹⁶: 32-bit keys)
+        // between two dense runs of points at its corners, a third of
+        // them at the near one: the far one's keys all fall in the
+        // histogram's last bin, where every thread's range must still end
+        // within the keys.
+        let mut points: Vec<Point> = Vec::new();
+        for i in 0..10_000 {
+            let x = 0.5 + i as f32 * 0.0267;
+            points.extend(std::iter::repeat_n([x, 0.5, 0.5], 3));
+        }
+        for i in 0..20_000 {
+            let x = 65_000.0 + i as f32 * 0.0267;
+            points.extend(std::iter::repeat_n([x, 255.5, 255.5], 3));
+        }
+        let leaf = 1.0;
+        let expected = bits(&map_of_voxels(&points, leaf));
+        for threads in [1, 2, 3, 4] {
+            let pool = rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap();
+            let (got, way) = pool
+                .install(|| centroids(&points, &VoxelGridParams::cube(leaf), Isa::best(), true))
+                .unwrap();
+            assert_eq!(way, Way::Table, "{threads} threads");
+            assert!(bits(&got) == expected, "{threads} threads");
+        }
+    }
+
+    #[test]
     fn the_tables_take_cells_beyond_32_bits_on_every_path() {
         // A line 3 km from the origin at a 1 µm leaf: cells near 3e9,
         // past i32 (the vector keys give way to the portable ones), in a

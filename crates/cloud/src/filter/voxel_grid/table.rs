@@ -335,17 +335,18 @@ pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> O
     // part's share.
     let shift = bits.saturating_sub(HISTOGRAM_BITS);
     let total: usize = keys.histogram.iter().sum();
+    // Every finite point's key is below 2^bits and below NOT_FINITE.
+    let end = (1u64 << bits).min(u64::from(super::keys::NOT_FINITE));
     let mut cuts = vec![0u64];
     let mut running = 0;
     for (bin, &count) in keys.histogram.iter().enumerate() {
         running += count;
         let part = cuts.len();
         if part < parts && running * parts >= total * part {
-            cuts.push((bin as u64 + 1) << shift);
+            cuts.push(((bin as u64 + 1) << shift).min(end));
         }
     }
-    // Every finite point's key is below 2^bits and below NOT_FINITE.
-    cuts.push((1u64 << bits).min(u64::from(super::keys::NOT_FINITE)));
+    cuts.push(end);
     cuts.dedup();
     let judge = |from: u64, to: u64| match finite {
         None => Judge::AsItGoes,
