@@ -39,6 +39,7 @@ mod radix;
 mod table;
 
 use keys::floor_i64;
+pub use keys::VoxelCells;
 use radix::{radix_sort_voxels, Voxel};
 
 use super::common::{bad, empty_input, is_finite};
@@ -219,24 +220,19 @@ fn centroids(
         .saturating_mul(extent[2]);
     // The linear index, PCL's order: x fastest, z slowest (the cell is
     // valid: the bounds pass checked every finite point).
-    let (ex, exy) = (extent[0] as u64, (extent[0] * extent[1]) as u64);
-    let linear = |p: &Point| {
-        let v = scaled(p);
-        let c = [0, 1, 2].map(|a| (floor_i64(v[a]) - lo[a]) as u64);
-        c[0] + c[1] * ex + c[2] * exy
+    let cells = VoxelCells::with_inverse(inv);
+    let grid = keys::Grid {
+        cells,
+        lo,
+        ex: extent[0] as u64,
+        exy: (extent[0] * extent[1]) as u64,
+        bits: bits_of(voxels.min(u128::from(u64::MAX)) as u64),
+        cells_fit_i32: (0..3).all(|a| vlo[a] >= -2_147_483_648.0 && vhi[a] < 2_147_483_648.0),
     };
     let centroids = if voxels < 1 << 32 {
         // Usual case: every point's key once; then a dense cloud summed
         // into a table a thread, or else the keys bucketed by their top
         // bits, each bucket sorted by the rest.
-        let grid = keys::Grid {
-            inv,
-            lo,
-            ex,
-            exy,
-            bits: bits_of(voxels as u64),
-            cells_fit_i32: (0..3).all(|a| vlo[a] >= -2_147_483_648.0 && vhi[a] < 2_147_483_648.0),
-        };
         let keys = grid.keys(points, isa);
         match tables
             .then(|| table::centroids(points, &keys, grid.bits, isa))
@@ -253,7 +249,7 @@ fn centroids(
             .par_iter()
             .enumerate()
             .filter(|(_, p)| is_finite(p))
-            .map(|(i, p)| (linear(p), i))
+            .map(|(i, p)| (grid.linear(p), i))
             .collect();
         keys.par_sort_unstable();
         (
@@ -267,7 +263,7 @@ fn centroids(
             .enumerate()
             .filter(|(_, p)| is_finite(p))
             .map(|(i, p)| {
-                let c = scaled(p).map(floor_i64);
+                let c = cells.of(p);
                 ([c[2], c[1], c[0]], i)
             })
             .collect();
@@ -280,27 +276,10 @@ fn centroids(
     Ok(centroids)
 }
 
-/// The voxel of a point as [`voxel_grid`] computes it (PCL's
-/// `floor(p · (1 / leaf))` in f32), for a caller that must know which
-/// points share a voxel before calling it (a tile deciding which voxels
-/// are its own).
-#[derive(Debug, Clone, Copy, PartialEq)]
-pub struct VoxelCells {
-    inv: [f32; 3],
-}
-
 impl VoxelCells {
     /// The cells of `params`' leaf (an error for a leaf [`voxel_grid`] refuses).
     pub fn new(params: &VoxelGridParams) -> Result<Self> {
-        Ok(Self {
-            inv: params.inverse_leaf()?,
-        })
-    }
-
-    /// The voxel (x, y, z indices) of the finite point `p`.
-    #[inline]
-    pub fn of(&self, p: &Point) -> [i64; 3] {
-        [0, 1, 2].map(|a| floor_i64(p[a] * self.inv[a]))
+        Ok(Self::with_inverse(params.inverse_leaf()?))
     }
 }
 

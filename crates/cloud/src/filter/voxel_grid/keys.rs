@@ -1,9 +1,9 @@
 //! The voxel of every point as one 32-bit key (its linear index in the
 //! occupied box, x fastest), computed once for both of the voxel grid's
-//! paths, 16 points a step on AVX-512. Why a pass of its own: computed
-//! point by point inside the sorting path's filing, the index (PCL's f32
+//! ways, 16 points a step on AVX-512. Why a pass of its own: computed
+//! point by point inside the sorting way's filing, the index (PCL's f32
 //! product, a floor and three i64 conversions, each checked) was a sixth
-//! of the grid's time, and the dense path's owners read it once each.
+//! of the grid's time, and the tables' owners read it once each.
 
 use rayon::prelude::*;
 
@@ -21,6 +21,28 @@ pub(super) fn floor_i64(v: f32) -> i64 {
     t - i64::from((t as f32) > v)
 }
 
+/// The voxel of a point as [`voxel_grid`](crate::filter::voxel_grid)
+/// computes it (PCL's `floor(p · (1 / leaf))` in f32), for a caller that
+/// must know which points share a voxel before calling it (a tile deciding
+/// which voxels are its own); the voxel grid's keys are made from it.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct VoxelCells {
+    inv: [f32; 3],
+}
+
+impl VoxelCells {
+    /// The cells of an inverse leaf, PCL's f32 (checked by the caller).
+    pub(super) fn with_inverse(inv: [f32; 3]) -> Self {
+        Self { inv }
+    }
+
+    /// The voxel (x, y, z indices) of the finite point `p`.
+    #[inline]
+    pub fn of(&self, p: &Point) -> [i64; 3] {
+        [0, 1, 2].map(|a| floor_i64(p[a] * self.inv[a]))
+    }
+}
+
 /// The key of a point with a non-finite coordinate (no voxel's: a box of
 /// fewer than 2³² voxels).
 pub(super) const NOT_FINITE: u32 = u32::MAX;
@@ -36,7 +58,7 @@ const SAMPLE: usize = 256;
 const SAMPLE_EVERY: usize = 4;
 
 /// What a visit to a voxel (a point of another voxel than the last
-/// point's) costs the dense path, in points: a new voxel's sums are
+/// point's) costs the tables, in points: a new voxel's sums are
 /// fetched (most of the cost in a part of many small voxels; measured on
 /// PCL's RGB-D scans, 14.5 ns a visit against 1.9 ns a point).
 const VISIT: usize = 8;
@@ -44,26 +66,27 @@ const VISIT: usize = 8;
 /// The grid of one call of [`super::voxel_grid`].
 #[derive(Debug, Clone, Copy)]
 pub(super) struct Grid {
-    /// The inverse leaf per axis, PCL's f32.
-    pub inv: [f32; 3],
+    /// A point's cell (PCL's f32 product with the inverse leaf, floored).
+    pub cells: VoxelCells,
     /// The least occupied cell per axis.
     pub lo: [i64; 3],
-    /// Cells along x, and in an xy layer (the box holds fewer than 2³²).
+    /// Cells along x, and in an xy layer.
     pub ex: u64,
     pub exy: u64,
-    /// Bits of the largest key.
+    /// Bits of the largest key (the keys are 32 bits for a box of fewer
+    /// than 2³² voxels, which [`Grid::keys`] is for).
     pub bits: u32,
     /// Every finite point's cells lie within i32 (−2³¹ ≤ ⌊v⌋ < 2³¹), so
     /// the vector path may compute them in 32 bits.
     pub cells_fit_i32: bool,
 }
 
-/// Every point's key, and what the dense path decides by.
+/// Every point's key, and what the tables decide by.
 pub(super) struct Keys {
     /// A key a point, in input order ([`NOT_FINITE`] for a point with a
     /// non-finite coordinate).
     pub keys: Vec<u32>,
-    /// The dense path's cost by the key's top [`HISTOGRAM_BITS`] bits,
+    /// The tables' cost by the key's top [`HISTOGRAM_BITS`] bits,
     /// from a sample of the keys: a point, and [`VISIT`] more where its
     /// voxel is not the last point's.
     pub histogram: Vec<usize>,
@@ -85,12 +108,19 @@ impl Grid {
         }
     }
 
+    /// The linear index of the voxel of a finite point of the box (x
+    /// fastest, z slowest), for a box of at most 2⁶⁴ voxels.
+    #[inline]
+    pub(super) fn linear(&self, p: &Point) -> u64 {
+        let cell = self.cells.of(p);
+        let c: [u64; 3] = std::array::from_fn(|a| (cell[a] - self.lo[a]) as u64);
+        c[0] + c[1] * self.ex + c[2] * self.exy
+    }
+
     fn keys_portable(&self, ps: &[Point], out: &mut [u32]) {
         for (p, key) in ps.iter().zip(out) {
             *key = if is_finite(p) {
-                let c: [u64; 3] =
-                    std::array::from_fn(|a| (floor_i64(p[a] * self.inv[a]) - self.lo[a]) as u64);
-                (c[0] + c[1] * self.ex + c[2] * self.exy) as u32
+                self.linear(p) as u32
             } else {
                 NOT_FINITE
             };
@@ -191,9 +221,9 @@ mod avx512 {
         let whole = ps.len() / 16 * 16;
         let flat = ps.as_flattened();
         let inv = [
-            _mm512_set1_ps(grid.inv[0]),
-            _mm512_set1_ps(grid.inv[1]),
-            _mm512_set1_ps(grid.inv[2]),
+            _mm512_set1_ps(grid.cells.inv[0]),
+            _mm512_set1_ps(grid.cells.inv[1]),
+            _mm512_set1_ps(grid.cells.inv[2]),
         ];
         let lo = [
             _mm512_set1_epi32(grid.lo[0] as i32),
