@@ -20,10 +20,11 @@
 //! what to change. Non-finite points are dropped by every filter, as PCL's
 //! tools do. Neighbour searches build one index per call and query it in
 //! parallel with rayon: a grid of height-sorted columns for a dense scan
-//! (`grid/`: statistical and radius removal, smoothing), a k-d tree for
-//! normals and for clouds too sparse for a grid (`kdtree.rs`, which says why
-//! it is not `kiddo`); both find the same neighbours, and results never
-//! depend on the number of threads.
+//! (`grid/`: statistical and radius removal, smoothing), an octree for the
+//! statistical filter where the density varies widely across the cloud
+//! (`octree.rs`), a k-d tree for normals and for clouds too sparse for a
+//! grid (`kdtree.rs`, which says why it is not `kiddo`); all find the same
+//! neighbours, and results never depend on the number of threads.
 
 mod bilateral;
 mod common;
@@ -31,6 +32,7 @@ mod exp;
 mod grid;
 mod kdtree;
 mod normals;
+mod octree;
 mod pass_through;
 mod radius_outlier;
 mod statistical_outlier;

@@ -50,6 +50,7 @@
 use super::common::{bad, emptied, empty_input, gather, on_finite_points};
 use super::grid::Grid;
 use super::kdtree::KdTree;
+use super::octree::Octree;
 use super::within::Isa;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
@@ -166,16 +167,72 @@ pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f
 }
 
 /// `f` of every point's k nearest squared distances (the point itself
-/// counted; in any order, the k-th last), in input order: on the grid of columns when the
-/// cloud suits one (`grid/`), else on the k-d tree; the same bits either way.
+/// counted; in any order, the k-th last), in input order: on the octree
+/// (`octree.rs`) when the density varies widely ([`uneven`], probed on
+/// the octree), else on the grid of columns when the cloud suits one
+/// (`grid/`), else on the k-d tree; the same bits every way.
 fn k_nearest_distances<T, F>(points: &[Point], k: usize, f: F) -> Vec<T>
 where
     T: Send + Sync + Clone + Default,
     F: Fn(&[f32]) -> T + Sync + Send,
 {
+    let search = Search::chosen();
+    if search != Search::Grid {
+        if let Some(tree) = Octree::new(points) {
+            if search == Search::Octree || uneven(&tree.probe_k_nearest(k, PROBES)) {
+                return tree.map_k_nearest_distances(k, f);
+            }
+        }
+    }
     match Grid::for_k_nearest(points, k) {
         Some(grid) => grid.map_k_nearest_distances(k, f),
         None => KdTree::new(points).map_k_nearest_distances(k, f),
+    }
+}
+
+/// Points whose k-th distance [`uneven`] reads.
+const PROBES: usize = 256;
+
+/// A cloud is searched on the octree when the upper quartile of its
+/// probed k-th distances is more than this times the lower quartile.
+///
+/// Measured (BENCHMARKS.md, 2026-12-06; the spread, then grid against
+/// octree): PCL's five RGB-D scans side by side (`kinect5`) 4.7, the
+/// octree about 0.7 of the grid's time; each of those scans alone
+/// 1.6–2.4 and the bench pile 1.1, the rosette scan 1.6 and a 100 k frame
+/// 1.7, where the grid is as fast or up to twice as fast (the octree's
+/// gathers read a box round a group of points, which costs most where
+/// the scan is a layer as thick as the k-th distance: the pile, the
+/// rosette).
+const UNEVEN: f64 = 2.5;
+
+/// Whether the k-th distances `kth` (ascending) spread past [`UNEVEN`].
+fn uneven(kth: &[f64]) -> bool {
+    if kth.len() < 4 {
+        return false;
+    }
+    let quartile = |f: f64| kth[((kth.len() - 1) as f64 * f).round() as usize];
+    quartile(0.75) > UNEVEN * quartile(0.25)
+}
+
+/// Which search the k nearest take ([`k_nearest_distances`]): chosen by
+/// the cloud, or held to one by the environment variable
+/// `AUTOSHOVEL_SEARCH` (`grid`, `octree`), as benchmarks compare them.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+enum Search {
+    Chosen,
+    Grid,
+    Octree,
+}
+
+impl Search {
+    fn chosen() -> Self {
+        static CHOSEN: std::sync::OnceLock<Search> = std::sync::OnceLock::new();
+        *CHOSEN.get_or_init(|| match std::env::var("AUTOSHOVEL_SEARCH").as_deref() {
+            Ok("grid") => Search::Grid,
+            Ok("octree") => Search::Octree,
+            _ => Search::Chosen,
+        })
     }
 }
 
