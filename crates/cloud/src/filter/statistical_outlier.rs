@@ -176,12 +176,14 @@ where
     T: Send + Sync + Clone + Default,
     F: Fn(&[f32]) -> T + Sync + Send,
 {
-    let search = Search::chosen();
-    if search != Search::Grid {
+    let octree = match Search::chosen() {
+        Search::Grid => false,
+        Search::Octree => true,
+        Search::Chosen => uneven(&probe_k_nearest(points, k)),
+    };
+    if octree {
         if let Some(tree) = Octree::new(points) {
-            if search == Search::Octree || uneven(&tree.probe_k_nearest(k, PROBES)) {
-                return tree.map_k_nearest_distances(k, f);
-            }
+            return tree.map_k_nearest_distances(k, f);
         }
     }
     match Grid::for_k_nearest(points, k) {
@@ -194,17 +196,34 @@ where
 const PROBES: usize = 256;
 
 /// A cloud is searched on the octree when the upper quartile of its
-/// probed k-th distances is more than this times the lower quartile.
+/// probed k-th distances ([`probe_k_nearest`]) is more than this times
+/// the lower quartile.
 ///
-/// Measured (BENCHMARKS.md, 2026-12-06; the spread, then grid against
-/// octree): PCL's five RGB-D scans side by side (`kinect5`) 4.7, the
-/// octree about 0.7 of the grid's time; each of those scans alone
-/// 1.6–2.4 and the bench pile 1.1, the rosette scan 1.6 and a 100 k frame
-/// 1.7, where the grid is as fast or up to twice as fast (the octree's
-/// gathers read a box round a group of points, which costs most where
-/// the scan is a layer as thick as the k-th distance: the pile, the
-/// rosette).
+/// Measured (BENCHMARKS.md, 2026-12-06; the spread on the sample, then
+/// grid against octree): PCL's five RGB-D scans side by side (`kinect5`)
+/// 4.3, the octree about 0.6–0.7 of the grid's time; each of those scans
+/// alone 1.6–2.3, the bench pile 1.3, the rosette scan 1.6 and a 100 k
+/// frame 1.8, where the grid is as fast or up to twice as fast (the
+/// octree's gathers read a box round a group of points, which costs most
+/// where the scan is a layer as thick as the k-th distance: the pile, the
+/// rosette). Probing costs the bench pile 2–5 % of the filter's time.
 const UNEVEN: f64 = 2.5;
+
+/// Points of the sample that [`probe_k_nearest`] probes a neighbour a
+/// point of the cloud would have.
+const SAMPLE_K: usize = 8;
+
+/// The k-th distances of [`PROBES`] points, ascending, estimated on a
+/// sample of every m-th point (m = k / [`SAMPLE_K`], at least 1) as their
+/// (k / m)-th distances among the sample: the same distance where the
+/// density is even over m points, found on an octree of a sixth of the
+/// cloud (k = 51; 4 ms for `kinect5` where the whole cloud's took about 25).
+fn probe_k_nearest(points: &[Point], k: usize) -> Vec<f64> {
+    let m = (k / SAMPLE_K).max(1);
+    let sample: Vec<Point> = points.iter().step_by(m).copied().collect();
+    let kth = (k / m).clamp(1, sample.len());
+    Octree::new(&sample).map_or_else(Vec::new, |t| t.probe_k_nearest(kth, PROBES))
+}
 
 /// Whether the k-th distances `kth` (ascending) spread past [`UNEVEN`].
 fn uneven(kth: &[f64]) -> bool {
