@@ -381,14 +381,20 @@ impl Octree {
                 fewest = fewest.min(found);
             }
             let wider = reach * grow(k, fewest);
-            self.gather(group, lo, hi, wider, &mut scratch.lone);
+            self.gather(group, lo, hi, wider, &mut scratch.wider);
             for &(p, found) in &failed {
                 let q = [self.x[p], self.y[p], self.z[p]];
                 let mut r = (reach * grow(k, found)).min(wider);
                 loop {
                     scratch.bits.clear();
                     let cap = (r * r) as f32;
-                    within::keep_distances(self.isa, q, scratch.lone.run(), cap, &mut scratch.bits);
+                    within::keep_distances(
+                        self.isa,
+                        q,
+                        scratch.wider.run(),
+                        cap,
+                        &mut scratch.bits,
+                    );
                     if scratch.bits.len() >= k {
                         within::smallest(self.isa, &mut scratch.bits, k);
                         break;
@@ -521,7 +527,10 @@ impl Cand {
 /// Buffers and the running guesses of one task.
 #[derive(Default)]
 struct Scratch {
+    /// The gathers of a group, of its points left for after it, and of a
+    /// point searched alone.
     cand: Cand,
+    wider: Cand,
     lone: Cand,
     bits: Vec<u32>,
     nearest: Vec<f32>,
@@ -780,6 +789,103 @@ mod tests {
             })
             .collect();
         agree(&far, 51);
+    }
+
+    /// Clusters of every size (many with fewer points than k) and spread,
+    /// in a box of 20 m: many groups with points whose k nearest lie past
+    /// the group's reach, some searched alone.
+    fn clusters(seed: u64) -> Vec<Point> {
+        let mut u = super::super::common::uniform(seed);
+        let mut points = Vec::new();
+        for _ in 0..60 {
+            let centre = [u() * 20.0, u() * 20.0, u() * 2.0];
+            let n = 5 + (u() * u() * 3000.0) as usize;
+            let spread = 0.01 + u() * u();
+            points.extend((0..n).map(|_| {
+                std::array::from_fn(|a| {
+                    centre[a] + (u() - 0.5) * spread * if a == 2 { 0.3 } else { 1.0 }
+                })
+            }));
+        }
+        points
+    }
+
+    /// A plane in tiles of 1 m alternately dense (1 cm) and sparse (6 cm),
+    /// jittered: groups at the tiles' edges hold points of both.
+    fn checkerboard(seed: u64) -> Vec<Point> {
+        let mut u = super::super::common::uniform(seed);
+        let mut points = Vec::new();
+        for tx in 0..6 {
+            for ty in 0..6 {
+                let step = if (tx + ty) % 2 == 0 { 0.01 } else { 0.06 };
+                let n = (1.0 / step) as usize;
+                for i in 0..n {
+                    for j in 0..n {
+                        points.push([
+                            tx as f32 + (i as f32 + u()) * step,
+                            ty as f32 + (j as f32 + u()) * step,
+                            0.002 * u(),
+                        ]);
+                    }
+                }
+            }
+        }
+        points
+    }
+
+    #[test]
+    fn clusters_of_every_size_and_tiles_of_two_densities_agree_too() {
+        for seed in 1..=6 {
+            let points = clusters(seed);
+            agree(&points, 51);
+            agree(&points, 8);
+        }
+        for seed in 1..=2 {
+            agree(&checkerboard(seed), 51);
+        }
+    }
+
+    #[test]
+    fn a_group_searched_from_any_reach_agrees() {
+        // Every seventh group of the tiles, each from reaches far too
+        // small to far too large: its points found at once, on the wider
+        // gather of those left, or alone, one after another.
+        let mut points = checkerboard(3);
+        points.extend(clusters(4).iter().map(|p| [p[0] - 25.0, p[1], p[2]]));
+        let tree = Octree::new(&points).unwrap();
+        let k = 51;
+        let want = KdTree::new(&points).map_k_nearest_distances(k, bits);
+        let (mut wrong, mut checked) = (0, 0);
+        for &group in tree.groups.iter().step_by(7) {
+            for reach in [0.002, 0.008, 0.02, 0.05, 0.2, 0.6] {
+                let mut scratch = Scratch {
+                    reach,
+                    ..Default::default()
+                };
+                let mut out = Vec::new();
+                tree.group_k_nearest(group as usize, k, &mut scratch, &bits, &mut out);
+                for (i, got) in out {
+                    checked += 1;
+                    wrong += usize::from(got != want[i as usize]);
+                }
+            }
+        }
+        assert!(checked > 10_000);
+        assert_eq!(wrong, 0, "{wrong} of {checked} differ");
+    }
+
+    #[test]
+    fn a_few_strays_far_above_a_scan_agree_too() {
+        // Fewer strays than k, spread over a few metres far above a scan:
+        // a group of them finds its k nearest on no gather of its own, and
+        // they are searched one after another, each alone.
+        let mut u = super::super::common::uniform(11);
+        let mut points: Vec<Point> = (0..20_000)
+            .map(|_| [u() * 20.0, u() * 20.0, 0.01 * u()])
+            .collect();
+        points.extend((0..40).map(|_| [8.0 + u() * 4.0, 8.0 + u() * 4.0, 60.0 + u() * 3.0]));
+        agree(&points, 51);
+        agree(&points, 21);
     }
 
     #[test]
