@@ -39,7 +39,18 @@
 //!
 //! The gather climbs from the group to the first ancestor whose Morton cell
 //! holds the widened box (no point outside that subtree can lie in it) and
-//! walks that subtree only.
+//! walks that subtree only. Each of the three (a group, its points left
+//! over, a point alone) gathers into a buffer of its own: when a point
+//! searched alone wrote over its group's wider gather, the next point
+//! left over read the wrong candidates (13 points of `kinect5`, caught by
+//! the peer script's comparison with PCL).
+//!
+//! Measured (BENCHMARKS.md, 2026-12-06): on `kinect5` a query reads
+//! 430–500 candidates (on the grid about 950) and the filter takes 0.6–0.7
+//! of the grid's time. Where a scan is a layer as thick as its k-th
+//! distance (the bench pile, the rosette scan), a group's gather reads a
+//! box round the group, 713–1311 candidates a query against about 340, and
+//! the grid is up to twice as fast: `statistical_outlier.rs` chooses.
 //!
 //! Arithmetic as in `grid/` and `kdtree.rs`: squared distances in f32 in
 //! FLANN's order (`within.rs`), so the distances are PCL's bit for bit;
@@ -53,7 +64,7 @@ use rayon::prelude::*;
 use super::within::{self, Isa, Run};
 use crate::Point;
 
-/// Most points a leaf holds (but where more share one finest cell).
+/// Most points a leaf holds.
 const LEAF: usize = 32;
 
 /// Most points a group (the points searched on one gather) holds.
@@ -648,7 +659,8 @@ type Keyed = (u64, u32);
 /// their bits from `shift` up) by code, then index: by comparison when
 /// short, else by a least-significant-digit radix sort (stable, so equal
 /// codes keep their indices ascending) on the digits below `shift` that
-/// vary. (One camera scan's close-up put 40 k points in one bucket.)
+/// vary. (On `kinect5`, whose top 16 bits leave cells about a metre
+/// wide, sorting the buckets by comparison took 6 % of the filter.)
 fn sort_bucket(bucket: &mut [Keyed], shift: u32, spare: &mut Vec<Keyed>) {
     const DIGIT: u32 = 11;
     const MASK: u64 = (1 << DIGIT) - 1;
