@@ -102,6 +102,26 @@ pub(crate) fn gather(cloud: &[Point], indices: &[usize]) -> PointCloud {
     PointCloud::new(indices.iter().map(|&i| cloud[i]).collect())
 }
 
+/// Relative widening of a search box beyond its radius (`grid/`,
+/// `octree.rs`): far above the f32 rounding of a squared distance (below
+/// 4e-7), so no point whose f32 squared distance is within a cap lies
+/// outside a box of the cap's root widened by it.
+pub(crate) const SLACK: f64 = 1e-4;
+
+/// The values within `wide` of `v`, rounded outwards to f32 (so that no
+/// f32 value within them falls outside).
+pub(crate) fn within_f32(v: f32, wide: f64) -> (f32, f32) {
+    let (lo, hi) = (f64::from(v) - wide, f64::from(v) + wide);
+    let (mut lo32, mut hi32) = (lo as f32, hi as f32);
+    if f64::from(lo32) > lo {
+        lo32 = lo32.next_down();
+    }
+    if f64::from(hi32) < hi {
+        hi32 = hi32.next_up();
+    }
+    (lo32, hi32)
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

@@ -61,6 +61,7 @@
 
 use rayon::prelude::*;
 
+use super::common::{within_f32, SLACK};
 use super::within::{self, Isa, Run};
 use crate::Point;
 
@@ -85,9 +86,6 @@ const REACH: f64 = 1.1;
 /// The k nearest are split at this times the point before's k-th squared
 /// distance (a little below it, so that the few above are sorted).
 const PIVOT: f32 = 0.95;
-
-/// Relative widening of a box (as `grid/`'s `SLACK`).
-const SLACK: f64 = 1e-4;
 
 /// Groups a parallel task takes at a time.
 const GROUPS_A_TASK: usize = 512;
@@ -127,6 +125,8 @@ pub(crate) struct Octree {
     scale: f64,
     /// A millionth of the cloud's size: the least reach searched.
     hair: f64,
+    /// The diagonal of the cloud's box: past twice it, every point is within.
+    diagonal: f64,
     isa: Isa,
 }
 
@@ -164,6 +164,10 @@ impl Octree {
             corner,
             scale,
             hair: (extent * 1e-6).max(f64::MIN_POSITIVE),
+            diagonal: (0..3)
+                .map(|a| (f64::from(hi[a]) - f64::from(lo[a])).powi(2))
+                .sum::<f64>()
+                .sqrt(),
             isa: Isa::best(),
         };
         tree.build(&codes, 0, n, 3 * BITS as i32 - 1, false);
@@ -429,11 +433,7 @@ impl Octree {
     /// `from` within which `scratch.bits` holds fewer than k (or from a
     /// hair of the cloud's size when `from` is 0).
     fn lone_k_nearest(&self, q: [f32; 3], k: usize, from: f64, scratch: &mut Scratch) {
-        let root = self.nodes[0];
-        let diagonal = (0..3)
-            .map(|a| (f64::from(root.hi[a]) - f64::from(root.lo[a])).powi(2))
-            .sum::<f64>()
-            .sqrt();
+        let diagonal = self.diagonal;
         let mut reach = (from * grow(k, scratch.bits.len()))
             .max(diagonal * 1e-4)
             .max(self.hair);
@@ -564,18 +564,10 @@ fn grow(k: usize, found: usize) -> f64 {
 /// The box `lo..hi` widened by `reach` (and [`SLACK`]), rounded outwards to f32.
 fn widened(lo: [f32; 3], hi: [f32; 3], reach: f64) -> ([f32; 3], [f32; 3]) {
     let wide = reach * (1.0 + SLACK);
-    let out = |v: f32, d: f64| {
-        let t = f64::from(v) + d;
-        let r = t as f32;
-        if d > 0.0 && f64::from(r) < t {
-            r.next_up()
-        } else if d < 0.0 && f64::from(r) > t {
-            r.next_down()
-        } else {
-            r
-        }
-    };
-    (lo.map(|v| out(v, -wide)), hi.map(|v| out(v, wide)))
+    (
+        lo.map(|v| within_f32(v, wide).0),
+        hi.map(|v| within_f32(v, wide).1),
+    )
 }
 
 /// `(code, index)` of every point, sorted: dealt by the code's top [`TOP`]

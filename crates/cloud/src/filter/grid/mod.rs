@@ -51,6 +51,7 @@ use rayon::prelude::*;
 mod far;
 mod near;
 
+use super::common::{within_f32 as heights_within, SLACK};
 use super::within::{self, Isa, Run};
 use near::Near;
 
@@ -58,9 +59,6 @@ use crate::Point;
 
 /// Columns allowed per point before the grid is declined.
 const COLUMNS_PER_POINT: usize = 8;
-
-/// Relative widening of the box (see the module docs).
-const SLACK: f64 = 1e-4;
 
 /// A column's span widened by this share of its side (see `Grid::off_columns`).
 const MARGIN: f64 = 1e-6;
@@ -1184,20 +1182,6 @@ struct Scratch {
     waiting: std::collections::BinaryHeap<std::cmp::Reverse<(u64, usize)>>,
     /// The columns of the block `far_k_nearest` is opening.
     columns: Vec<(u64, usize)>,
-}
-
-/// The heights within `wide` of `z`, rounded outwards to f32 (so that
-/// no f32 height within them falls outside).
-fn heights_within(z: f32, wide: f64) -> (f32, f32) {
-    let (z_lo, z_hi) = (f64::from(z) - wide, f64::from(z) + wide);
-    let (mut lo32, mut hi32) = (z_lo as f32, z_hi as f32);
-    if f64::from(lo32) > z_lo {
-        lo32 = lo32.next_down();
-    }
-    if f64::from(hi32) < z_hi {
-        hi32 = hi32.next_up();
-    }
-    (lo32, hi32)
 }
 
 /// The cloud's bounding box, in f64.
