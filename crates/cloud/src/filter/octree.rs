@@ -27,8 +27,10 @@
 //! group's box widened by a reach R (the largest k-th distance of the
 //! group before, times [`REACH`]) are gathered and their points copied
 //! into one buffer; every point within R of any point of the group is in
-//! it. Each point of the group then takes one vector pass over the buffer
-//! (`within.rs`) keeping the distances within r (the k-th distance of the
+//! it. Each [`PART`] points of the group (a patch next in Morton order)
+//! cut that buffer to their own box widened by R (one vector pass,
+//! `within::keep_inside`), and each point then takes one vector pass over
+//! its part's cut (`within.rs`) keeping the distances within r (the k-th distance of the
 //! point before, times [`GUESS`], at most R), and when k are within r they
 //! hold its k nearest. The k are picked by splitting the distances at a
 //! little below the point before's k-th (`within::smallest_near`). A point
@@ -46,8 +48,10 @@
 //! the peer script's comparison with PCL).
 //!
 //! Measured (BENCHMARKS.md, 2026-12-06): on `kinect5` a query reads
-//! 430–500 candidates (on the grid about 950) and the filter takes 0.6–0.7
-//! of the grid's time. Where a scan is a layer as thick as its k-th
+//! 430–500 candidates of its group's gather (on the grid about 950) and
+//! the filter takes 0.6–0.7 of the grid's time; cutting the gather to
+//! parts of 16 took the filter from 191–199 to 181–185 ms (parts of 8 or
+//! 32, groups of 128 or 256, leaves of 16: slower). Where a scan is a layer as thick as its k-th
 //! distance (the bench pile, the rosette scan), a group's gather reads a
 //! box round the group, 713–1311 candidates a query against about 340, and
 //! the grid is up to twice as fast: `statistical_outlier.rs` chooses.
@@ -70,6 +74,10 @@ const LEAF: usize = 32;
 
 /// Most points a group (the points searched on one gather) holds.
 const GROUP: usize = 64;
+
+/// Points of a group that take their candidates from its gather cut to
+/// their own box.
+const PART: usize = 16;
 
 /// Bits of a coordinate in a Morton code.
 const BITS: u32 = 21;
@@ -361,12 +369,20 @@ impl Octree {
             kth
         };
         for p in node.start as usize..node.end as usize {
+            if (p - node.start as usize).is_multiple_of(PART) {
+                // The gather cut to the box of this part of the group.
+                let part = p..(p + PART).min(node.end as usize);
+                let (lo, hi) = self.bounds(part);
+                let (lo, hi) = widened(lo, hi, reach);
+                scratch.part.clear();
+                scratch.part.inside(self.isa, &scratch.cand, lo, hi);
+            }
             let q = [self.x[p], self.y[p], self.z[p]];
             let mut r = scratch.guess.min(reach);
             loop {
                 scratch.bits.clear();
                 let cap = (r * r) as f32;
-                within::keep_distances(self.isa, q, scratch.cand.run(), cap, &mut scratch.bits);
+                within::keep_distances(self.isa, q, scratch.part.run(), cap, &mut scratch.bits);
                 let found = scratch.bits.len();
                 if found >= k {
                     within::smallest_near(self.isa, &mut scratch.bits, k, scratch.pivot);
@@ -386,15 +402,8 @@ impl Octree {
             // Those whose k nearest reach past the group's: together, on
             // one gather wide enough for the fewest found.
             let failed = std::mem::take(&mut scratch.failed);
-            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            let mut fewest = usize::MAX;
-            for &(p, found) in &failed {
-                for (a, v) in [self.x[p], self.y[p], self.z[p]].into_iter().enumerate() {
-                    lo[a] = lo[a].min(v);
-                    hi[a] = hi[a].max(v);
-                }
-                fewest = fewest.min(found);
-            }
+            let (lo, hi) = self.bounds(failed.iter().map(|&(p, _)| p));
+            let fewest = failed.iter().map(|&(_, found)| found).min().unwrap_or(0);
             let wider = reach * grow(k, fewest);
             self.gather(group, lo, hi, wider, &mut scratch.wider);
             for &(p, found) in &failed {
@@ -426,6 +435,18 @@ impl Octree {
             scratch.failed.clear();
         }
         scratch.reach = widest * REACH;
+    }
+
+    /// The bounding box of the points at sorted positions `at`.
+    fn bounds(&self, at: impl Iterator<Item = usize>) -> ([f32; 3], [f32; 3]) {
+        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+        for p in at {
+            for (a, v) in [self.x[p], self.y[p], self.z[p]].into_iter().enumerate() {
+                lo[a] = lo[a].min(v);
+                hi[a] = hi[a].max(v);
+            }
+        }
+        (lo, hi)
     }
 
     /// The k nearest squared distances of `q` (any point, in any order but
@@ -526,6 +547,17 @@ impl Cand {
         copy(s, e);
     }
 
+    /// Copies the points of `from` inside the box `lo..hi`.
+    fn inside(&mut self, isa: Isa, from: &Cand, lo: [f32; 3], hi: [f32; 3]) {
+        within::keep_inside(
+            isa,
+            from.run(),
+            lo,
+            hi,
+            [&mut self.x, &mut self.y, &mut self.z],
+        );
+    }
+
     fn run(&self) -> Run<'_> {
         Run {
             x: &self.x,
@@ -541,6 +573,8 @@ struct Scratch {
     /// The gathers of a group, of its points left for after it, and of a
     /// point searched alone.
     cand: Cand,
+    /// The group's gather cut to the box of a part of it.
+    part: Cand,
     wider: Cand,
     lone: Cand,
     bits: Vec<u32>,
