@@ -176,13 +176,19 @@ where
     T: Send + Sync + Clone + Default,
     F: Fn(&[f32]) -> T + Sync + Send,
 {
+    // The octree's finest cell (0: as fine as codes go), or none.
     let octree = match Search::chosen() {
-        Search::Grid => false,
-        Search::Octree => true,
-        Search::Chosen => uneven(&probe_k_nearest(points, k)),
+        Search::Grid => None,
+        Search::Octree => Some(0.0),
+        Search::Chosen => {
+            let kth = probe_k_nearest(points, k);
+            // A quarter of the least k-th distance probed: at the densest
+            // place probed, a cell holds a point or so.
+            uneven(&kth).then(|| kth[0] / FINEST)
+        }
     };
-    if octree {
-        if let Some(tree) = Octree::new(points) {
+    if let Some(finest) = octree {
+        if let Some(tree) = Octree::with_finest(points, finest) {
             return tree.map_k_nearest_distances(k, f);
         }
     }
@@ -191,6 +197,10 @@ where
         None => KdTree::new(points).map_k_nearest_distances(k, f),
     }
 }
+
+/// The octree's cells are no finer than the least probed k-th distance
+/// over this (`Octree::with_finest`).
+const FINEST: f64 = 4.0;
 
 /// Points whose k-th distance [`uneven`] reads.
 const PROBES: usize = 256;
