@@ -3,7 +3,7 @@
 PCL keeps the very points we keep, and print a table. Run by hand (not by CI):
 
     apt-get install -y pcl-tools && pip install open3d-cpu   # or open3d
-    python3 crates/cloud/peer/bench_peers.py [--runs 3] [--dir /tmp/filter_bench]
+    python3 crates/cloud/peer/bench_peers.py [--runs 3] [--rounds 1] [--dir /tmp/filter_bench]
         [--sizes 100k,1m,5m,20m | --input SCAN] [--process] [--markdown FILE]
         [--peer-timeout SECONDS]
 
@@ -20,6 +20,11 @@ loading and saving are not counted, but each run is a fresh process) and
 Open3D's legacy (o3d.geometry) and tensor (o3d.t.geometry, float32, CPU)
 calls (timed around the call alone, the cloud already in memory, repeated as
 ours); and it compares PCL's kept points with ours bit for bit. With
+--rounds N all of that is done N times over, ours and the peers in turn,
+and a row gives the medians of the rounds and the median of the rounds'
+ratios with their range: on a shared VM whose speed drifts by a fifth
+within minutes, one round's ratio moved between 10.6 and 16.1 (statistical
+removal on kinect5, three runs within ten minutes, 2026-12-06). With
 --process it also times `autoshovel filter` and the PCL tool as whole
 processes (read, filter, write).
 
@@ -199,6 +204,9 @@ def main():
         return
     ap = argparse.ArgumentParser()
     ap.add_argument("--runs", type=int, default=3)
+    ap.add_argument("--rounds", type=int, default=1,
+                    help="times each row's measurements are repeated, ours and the peers' alternating; "
+                         "medians of the rounds, and the ratio as the median of the rounds' ratios with its range")
     ap.add_argument("--big-runs", type=int, default=1,
                     help="PCL and Open3D runs at 5 M points and more (Open3D without a warm-up); ours keeps --runs")
     ap.add_argument("--dir", default="/tmp/filter_bench")
@@ -295,12 +303,39 @@ def main():
             if name not in wanted:
                 continue
             out = os.path.join(args.dir, f"pcl_{name}_{size}.pcd")
-            our_ms, our_n = ours(f"{name}:{size}", size)
-            pcl_runs = []
-            for _ in range(pcl_runs_n):
-                ms, kept = pcl_time(tool, inp, out, targs)
-                pcl_runs.append(ms)
-            pcl_ms = statistics.median(pcl_runs)
+            # Each round times ours, then PCL, then Open3D's two APIs, back
+            # to back; with --rounds > 1 the rounds alternate the peers
+            # over the machine's drift, and the ratio is the median of the
+            # rounds' ratios.
+            rounds = []
+            for _ in range(args.rounds):
+                our_ms, our_n = ours(f"{name}:{size}", size)
+                pcl_runs = []
+                for _ in range(pcl_runs_n):
+                    ms, kept = pcl_time(tool, inp, out, targs)
+                    pcl_runs.append(ms)
+                o3d_ms = o3t_ms = None
+                o3d_n = o3t_n = "n/a"
+                if cloud is not None:
+                    # At 5 M points and more, --big-runs runs and no warm-up, as PCL.
+                    big = n_points >= 5_000_000
+                    if big and args.peer_timeout:
+                        o3d_ms, o3d_n = open3d_in_child(inp, name, False, pcl_runs_n, False, args.peer_timeout)
+                        o3t_ms, o3t_n = open3d_in_child(inp, name, True, pcl_runs_n, False, args.peer_timeout)
+                    else:
+                        o3d_ms, o3d_n = repeat(lambda: open3d_time(o3d, cloud, name, False), pcl_runs_n, not big)
+                        o3t_ms, o3t_n = repeat(lambda: open3d_time(o3d, cloud_t, name, True), pcl_runs_n, not big)
+                rounds.append((our_ms, statistics.median(pcl_runs), o3d_ms, o3t_ms))
+
+            def middle(j):
+                got = [r[j] for r in rounds if r[j] is not None]
+                return statistics.median(got) if got else None
+
+            our_ms, pcl_ms, o3d_ms, o3t_ms = (middle(j) for j in range(4))
+            ratios = [min(m for m in r[1:] if m is not None) / r[0] for r in rounds]
+            ratio = f"{statistics.median(ratios):.1f}"
+            if len(ratios) > 1:
+                ratio += f" ({min(ratios):.1f}–{max(ratios):.1f} over {len(ratios)} rounds)"
             mine = pcd.read_pcd(os.path.join(args.dir, f"ours_{name}_{size}.pcd"))
             if name == "voxel_grid":
                 # PCL sums a voxel's points in f32, we in f64: both are held
@@ -317,23 +352,13 @@ def main():
                     same = f"NO (voxel counts differ: exact {len(exact)})"
             else:
                 same = "yes (bit for bit, in order)" if np.array_equal(mine.view(np.uint32), kept.view(np.uint32)) else "NO"
-            peers = [pcl_ms]
             if cloud is not None:
-                # At 5 M points and more, --big-runs runs and no warm-up, as PCL.
-                big = n_points >= 5_000_000
-                if big and args.peer_timeout:
-                    o3d_ms, o3d_n = open3d_in_child(inp, name, False, pcl_runs_n, False, args.peer_timeout)
-                    o3t_ms, o3t_n = open3d_in_child(inp, name, True, pcl_runs_n, False, args.peer_timeout)
-                else:
-                    o3d_ms, o3d_n = repeat(lambda: open3d_time(o3d, cloud, name, False), pcl_runs_n, not big)
-                    o3t_ms, o3t_n = repeat(lambda: open3d_time(o3d, cloud_t, name, True), pcl_runs_n, not big)
-                peers += [m for m in (o3d_ms, o3t_ms) if m is not None]
                 o3d_cells = tuple(f"{m:.1f}" if m is not None else n for m, n in ((o3d_ms, o3d_n), (o3t_ms, o3t_n))) \
                     + (str(o3d_n) if o3d_ms is not None else "–", str(o3t_n) if o3t_ms is not None else "–")
             else:
                 o3d_cells = ("n/a", "n/a", "n/a", "n/a")
             row = (f"| {name} | {'bench pile' if not args.input else args.input} | {size} | {our_ms:.1f} | {pcl_ms:.1f} "
-                   f"| {o3d_cells[0]} | {o3d_cells[1]} | {min(peers) / our_ms:.1f} "
+                   f"| {o3d_cells[0]} | {o3d_cells[1]} | {ratio} "
                    f"| {our_n} / {len(kept)} / {o3d_cells[2]} / {o3d_cells[3]} | {same} |")
             if args.process:
                 mine_out = os.path.join(args.dir, f"process_{name}_{size}.pcd")
