@@ -13,12 +13,14 @@
 //! shrink where the points crowd, so a leaf holds a few dozen points at any
 //! density.
 //!
-//! The tree: every point's Morton code (21 bits an axis over the cloud's
-//! bounding cube), the points sorted by code (dealt by the top 16 bits in
-//! parallel, each bucket then sorted by a radix sort), and a binary tree
-//! over the sorted codes split at the highest bit in which a node's codes
-//! differ, down to leaves of at most [`LEAF`] points (an octree with its
-//! levels cut in three; equal codes are cut by count). Each node keeps the
+//! The tree: every point's Morton code (up to 21 bits an axis over the
+//! cloud's bounding cube, fewer where the points lie far apart:
+//! [`Octree::with_finest`]), the points sorted by code (dealt by the top 16
+//! bits in parallel, each bucket then sorted by a radix sort), and a binary
+//! tree over the sorted codes split at the highest bit in which a node's
+//! codes differ, down to leaves of at most [`LEAF`] points (an octree with
+//! its levels cut in three; equal codes are cut by count), its top built
+//! alone and its subtrees in parallel ([`Builder`]). Each node keeps the
 //! bounding box of its points; nodes are stored depth first, each with the
 //! index past its subtree, so a search is a loop over an array.
 //!
@@ -30,9 +32,9 @@
 //! it. Each [`PART`] points of the group (a patch next in Morton order)
 //! cut that buffer to their own box widened by R (one vector pass,
 //! `within::keep_inside`), and each point then takes one vector pass over
-//! its part's cut (`within.rs`) keeping the distances within r (the k-th distance of the
-//! point before, times [`GUESS`], at most R), and when k are within r they
-//! hold its k nearest. The k are picked by splitting the distances at a
+//! its part's cut (`within.rs`) keeping the distances within r (the k-th
+//! distance of the point before, times [`GUESS`], at most R), and when k
+//! are within r they hold its k nearest. The k are picked by splitting the distances at a
 //! little below the point before's k-th (`within::smallest_near`). A point
 //! whose k nearest lie beyond R (the edge of a scan, a stray) waits for the
 //! end of its group, and those of a group are answered together on one
@@ -47,13 +49,14 @@
 //! left over read the wrong candidates (13 points of `kinect5`, caught by
 //! the peer script's comparison with PCL).
 //!
-//! Measured (BENCHMARKS.md, 2026-12-06): on `kinect5` a query reads
-//! 430–500 candidates of its group's gather (on the grid about 950) and
-//! the filter takes 0.6–0.7 of the grid's time; cutting the gather to
-//! parts of 16 took the filter from 191–199 to 181–185 ms (parts of 8 or
-//! 32, groups of 128 or 256, leaves of 16: slower). Where a scan is a layer as thick as its k-th
-//! distance (the bench pile, the rosette scan), a group's gather reads a
-//! box round the group, 713–1311 candidates a query against about 340, and
+//! Measured (BENCHMARKS.md, 2026-12-06): on `kinect5` a group's gather
+//! holds about 480 points, a part's cut 270, of which 61 lie within r (on
+//! the grid a query reads about 950); the filter takes 0.6–0.7 of the
+//! grid's time. Cutting the gather to parts of 16 took the filter from
+//! 191–199 to 181–185 ms (parts of 8 or 32, groups of 128 or 256, leaves of
+//! 16: slower; per-query tests of 16-point blocks' boxes, 14 % slower).
+//! Where a scan is a layer as thick as its k-th distance (the bench pile,
+//! the rosette scan), a group's gather reads a box round the group, and
 //! the grid is up to twice as fast: `statistical_outlier.rs` chooses.
 //!
 //! Arithmetic as in `grid/` and `kdtree.rs`: squared distances in f32 in
