@@ -34,8 +34,9 @@
 //! `within::keep_inside`), and each point then takes one vector pass over
 //! its part's cut (`within.rs`) keeping the distances within r (the k-th
 //! distance of the point before, times [`GUESS`], at most R), and when k
-//! are within r they hold its k nearest. The k are picked by splitting the distances at a
-//! little below the point before's k-th (`within::smallest_near`). A point
+//! are within r they hold its k nearest. The k are picked by splitting
+//! the distances at a little below the point before's k-th
+//! (`within::smallest_near`). A point
 //! whose k nearest lie beyond R (the edge of a scan, a stray) waits for the
 //! end of its group, and those of a group are answered together on one
 //! wider gather; what still lacks k (an outlier far from the rest) is
