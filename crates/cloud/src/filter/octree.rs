@@ -405,14 +405,7 @@ impl Octree {
 
     /// The bounding box of the points at sorted positions `at`.
     fn bounds(&self, at: impl Iterator<Item = usize>) -> ([f32; 3], [f32; 3]) {
-        let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-        for p in at {
-            for (a, v) in [self.x[p], self.y[p], self.z[p]].into_iter().enumerate() {
-                lo[a] = lo[a].min(v);
-                hi[a] = hi[a].max(v);
-            }
-        }
-        (lo, hi)
+        bounds_of([&self.x, &self.y, &self.z], at)
     }
 
     /// The k nearest squared distances of `q` (any point, in any order but
@@ -568,13 +561,7 @@ impl<'a> Builder<'a> {
             e - s <= GROUP
         };
         if e - s <= LEAF {
-            let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
-            for p in s..e {
-                for (a, v) in [self.x[p], self.y[p], self.z[p]].into_iter().enumerate() {
-                    lo[a] = lo[a].min(v);
-                    hi[a] = hi[a].max(v);
-                }
-            }
+            let (lo, hi) = bounds_of([self.x, self.y, self.z], s..e);
             self.nodes[me] = Node {
                 lo,
                 hi,
@@ -639,6 +626,18 @@ fn split_at(codes: &[u64], s: usize, e: usize, bit: i32) -> (usize, i32) {
         }
         b -= 1;
     }
+}
+
+/// The bounding box of the points at positions `at` of the axes `xyz`.
+fn bounds_of(xyz: [&[f32]; 3], at: impl Iterator<Item = usize>) -> ([f32; 3], [f32; 3]) {
+    let (mut lo, mut hi) = ([f32::INFINITY; 3], [f32::NEG_INFINITY; 3]);
+    for p in at {
+        for a in 0..3 {
+            lo[a] = lo[a].min(xyz[a][p]);
+            hi[a] = hi[a].max(xyz[a][p]);
+        }
+    }
+    (lo, hi)
 }
 
 /// A node's level from the bit its codes share those above.
