@@ -22,9 +22,10 @@ calls (timed around the call alone, the cloud already in memory, repeated as
 ours); and it compares PCL's kept points with ours bit for bit. With
 --rounds N all of that is done N times over, ours and the peers in turn,
 and a row gives the medians of the rounds and the median of the rounds'
-ratios with their range: on a shared VM whose speed drifts by a fifth
-within minutes, one round's ratio moved between 10.6 and 16.1 (statistical
-removal on kinect5, three runs within ten minutes, 2026-12-06). With
+ratios with their range: on a shared VM whose speed drifted by half
+within twenty minutes, one round's ratio moved between 10.6 and 16.1
+(statistical removal on kinect5, three runs within three minutes,
+2026-12-06). With
 --process it also times `autoshovel filter` and the PCL tool as whole
 processes (read, filter, write).
 

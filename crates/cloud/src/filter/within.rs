@@ -121,8 +121,10 @@ pub(super) fn keep_payload(
 /// (bounds included), in run order.
 ///
 /// Why: a group's gather holds every point near any of its few dozen
-/// points; a quarter of the group, cut to its own box, reads a third as
-/// many a query.
+/// points; a quarter of the group, cut to its own box, reads about half
+/// as many a query (272 of 478 on `kinect5`). AVX-512 packs the points
+/// kept with a compress a vector; the other paths take the portable,
+/// branch-free loop.
 pub(super) fn keep_inside(isa: Isa, run: Run, lo: [f32; 3], hi: [f32; 3], out: [&mut Vec<f32>; 3]) {
     check(run);
     let [ox, oy, oz] = out;
