@@ -13,7 +13,7 @@
 
 use std::sync::Once;
 
-use autoshovel_cloud::io::{read_from_bytes, Format};
+use autoshovel_point_cloud::io::{read_from_bytes, Format};
 use libfuzzer_sys::fuzz_target;
 
 static HOOK: Once = Once::new();

@@ -3,7 +3,7 @@
 //! huge allocation (run with -malloc_limit_mb, see fuzz/README.md).
 #![no_main]
 
-use autoshovel_cloud::io::{read_from_bytes, Format};
+use autoshovel_point_cloud::io::{read_from_bytes, Format};
 use libfuzzer_sys::fuzz_target;
 
 fuzz_target!(|data: &[u8]| {

@@ -1,0 +1,384 @@
+//! `autoshovel replay`: the tracking metrics of Figs. 13–14 (centroid
+//! deviation, heading error) recomputed from a record of a run — a `drive`
+//! MCAP log (its path and every decision, on the simulator's truth when
+//! the PLC was `plc-sim`), or a plain CSV of a real machine's RTK track
+//! against its planned path.
+
+use std::path::Path;
+
+use autoshovel_core::Pose2;
+use autoshovel_walk_tracker::sim::{measure, Evaluator, Event, Run, Sample, Setup};
+use autoshovel_walk_tracker::workstation::Decision;
+use autoshovel_walk_tracker::{deviations, RefLeg, RtkFix, TrackCommand};
+use serde::Serialize;
+
+use crate::error::LinkError;
+use crate::log::{topic, EventMsg, PathMsg, PoseMsg, TickMsg};
+
+/// The part of the end message replay needs.
+#[derive(serde::Deserialize)]
+struct EndIn {
+    t_s: f64,
+    end: PoseMsg,
+    travelled_m: f64,
+    completed: bool,
+}
+
+/// A replayed run.
+#[derive(Debug, Clone)]
+pub struct Replay {
+    /// Samples, events and metrics, as `track` computes them.
+    pub run: Run,
+    /// The path.
+    pub legs: Vec<RefLeg>,
+    /// What the deviations are measured on: `simulator truth`, `rtk fixes`.
+    pub measured_on: &'static str,
+    /// Where the record came from.
+    pub source: String,
+}
+
+fn err(path: &Path, why: impl Into<String>) -> LinkError {
+    LinkError::Log {
+        path: path.to_path_buf(),
+        why: why.into(),
+    }
+}
+
+/// The legs of a path message.
+pub fn legs_of(msg: &PathMsg, path: &Path) -> Result<Vec<RefLeg>, LinkError> {
+    msg.legs
+        .iter()
+        .enumerate()
+        .map(|(i, l)| {
+            RefLeg::new(
+                l.direction,
+                l.points
+                    .iter()
+                    .map(|p| autoshovel_core::Vec2::new(p[0], p[1]))
+                    .collect(),
+                Some(l.end_heading_rad),
+            )
+            .map_err(|e| err(path, format!("{} leg {i}: {e:?}", topic::PATH)))
+        })
+        .collect()
+}
+
+fn setup_with(legs: Vec<RefLeg>, start: Pose2) -> Setup {
+    Setup {
+        legs,
+        start,
+        crawler: Default::default(),
+        slip: Default::default(),
+        rtk: Default::default(),
+        sim: Default::default(),
+    }
+}
+
+/// Replays a `drive` MCAP log.
+pub fn replay_mcap(path: &Path) -> Result<Replay, LinkError> {
+    let bytes = std::fs::read(path).map_err(|e| err(path, e.to_string()))?;
+    let stream = mcap::MessageStream::new(&bytes)
+        .map_err(|e| err(path, format!("not an MCAP file: {e}")))?;
+    let mut path_msg: Option<PathMsg> = None;
+    let mut ticks: Vec<TickMsg> = Vec::new();
+    let mut events: Vec<Event> = Vec::new();
+    let mut end_msg: Option<(f64, PoseMsg, f64, bool)> = None;
+    for m in stream {
+        let m = m.map_err(|e| err(path, format!("damaged MCAP: {e}")))?;
+        let topic_name = m.channel.topic.as_str();
+        let bad = |e: serde_json::Error| {
+            err(path, format!("message {} on {topic_name}: {e}", m.sequence))
+        };
+        match topic_name {
+            topic::PATH => path_msg = Some(serde_json::from_slice(&m.data).map_err(bad)?),
+            topic::TICK => ticks.push(serde_json::from_slice(&m.data).map_err(bad)?),
+            topic::EVENT => {
+                let e: EventMsg = serde_json::from_slice(&m.data).map_err(bad)?;
+                if e.source == "workstation" {
+                    events.push(Event {
+                        t_s: e.t_s,
+                        kind: intern(&e.kind),
+                        message: e.message,
+                    });
+                }
+            }
+            topic::SUMMARY => {
+                let v: EndIn = serde_json::from_slice(&m.data).map_err(bad)?;
+                end_msg = Some((v.t_s, v.end, v.travelled_m, v.completed));
+            }
+            _ => {}
+        }
+    }
+    let path_msg = path_msg
+        .ok_or_else(|| err(path, format!("no {} message: not a drive log", topic::PATH)))?;
+    let legs = legs_of(&path_msg, path)?;
+    if ticks.is_empty() {
+        return Err(err(path, format!("no {} messages", topic::TICK)));
+    }
+    let truth_all = ticks.iter().all(|t| t.truth.is_some());
+    let mut eval = Evaluator::new();
+    let mut samples: Vec<Sample> = Vec::with_capacity(ticks.len());
+    for t in &ticks {
+        if t.leg >= legs.len() {
+            return Err(err(
+                path,
+                format!("tick at {} s names leg {} of {}", t.t_s, t.leg, legs.len()),
+            ));
+        }
+        let d = decision(&legs, t);
+        let truth: Pose2 = t.truth.unwrap_or(t.measured).into();
+        samples.push(eval.sample(&legs, &d, t.t_s, truth, t.travelled_m));
+    }
+    // The end as the drive recorded it; a log cut short ends at its last tick.
+    let last = ticks.last().expect("not empty");
+    let (t_end, end, travelled, completed) = end_msg.unwrap_or_else(|| {
+        (
+            last.t_s,
+            last.truth.unwrap_or(last.measured),
+            last.travelled_m,
+            events.iter().filter(|e| e.kind == Event::LEG_END).count() == legs.len(),
+        )
+    });
+    let setup = setup_with(legs.clone(), samples[0].truth);
+    let metrics = measure(&samples, &setup, end.into(), travelled, t_end, completed);
+    Ok(Replay {
+        run: Run {
+            samples,
+            events,
+            metrics,
+        },
+        legs,
+        measured_on: if truth_all {
+            "simulator truth"
+        } else {
+            "rtk fixes"
+        },
+        source: path.display().to_string(),
+    })
+}
+
+fn decision(legs: &[RefLeg], t: &TickMsg) -> Decision {
+    let measured: Pose2 = t.measured.into();
+    let mut dev = deviations(&legs[t.leg], measured, 0.0, None);
+    dev.d_m = t.d_m;
+    dev.d0_m = t.d0_m;
+    Decision {
+        leg: t.leg,
+        measured,
+        dev,
+        speed_ref_mps: t.speed_ref_mps,
+        steer_rpm: t.steer_rpm,
+        command: TrackCommand {
+            left_rpm: t.left_rpm,
+            right_rpm: t.right_rpm,
+        },
+    }
+}
+
+/// Event kinds as the workstation names them (the summary's `kind` is a
+/// `&'static str`).
+fn intern(kind: &str) -> &'static str {
+    const KINDS: &[&str] = &[
+        "leg-end",
+        "stale-pose",
+        "pose-jump",
+        "pose-recovered",
+        "timeout",
+        "link-lost",
+        "link-restored",
+        "plc-fault",
+        "acknowledged",
+    ];
+    KINDS
+        .iter()
+        .find(|k| **k == kind)
+        .copied()
+        .unwrap_or("other")
+}
+
+/// One row of a real machine's RTK track.
+#[derive(Debug, Clone, Copy, PartialEq, Serialize)]
+pub struct TrackRow {
+    /// Time [s].
+    pub t_s: f64,
+    /// The fix.
+    pub fix: RtkFix,
+}
+
+/// Reads a CSV of RTK fixes: a header naming `t_s` (or `time_s`),
+/// `east_m`, `north_m` and `heading_deg` (north, clockwise, the
+/// receiver's), in any order; other columns are ignored.
+pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, LinkError> {
+    let text = std::fs::read_to_string(path).map_err(|e| err(path, e.to_string()))?;
+    let mut lines = text
+        .lines()
+        .enumerate()
+        .filter(|(_, l)| !l.trim().is_empty());
+    let (_, header) = lines.next().ok_or_else(|| {
+        err(
+            path,
+            "empty file: expected a header t_s,east_m,north_m,heading_deg",
+        )
+    })?;
+    let names: Vec<String> = header
+        .split(',')
+        .map(|s| s.trim().to_ascii_lowercase())
+        .collect();
+    let col = |want: &[&str]| {
+        names
+            .iter()
+            .position(|n| want.contains(&n.as_str()))
+            .ok_or_else(|| {
+                err(
+                    path,
+                    format!(
+                        "line 1: no column {} in the header {header:?}",
+                        want.join(" or ")
+                    ),
+                )
+            })
+    };
+    let (ct, ce, cn, ch) = (
+        col(&["t_s", "time_s"])?,
+        col(&["east_m", "east"])?,
+        col(&["north_m", "north"])?,
+        col(&["heading_deg", "heading"])?,
+    );
+    let mut rows = Vec::new();
+    for (i, line) in lines {
+        let cells: Vec<&str> = line.split(',').map(str::trim).collect();
+        let num = |c: usize, name: &str| -> Result<f64, LinkError> {
+            cells
+                .get(c)
+                .and_then(|s| s.parse::<f64>().ok())
+                .filter(|v| v.is_finite())
+                .ok_or_else(|| {
+                    err(
+                        path,
+                        format!(
+                            "line {}: {name} {:?} is not a finite number",
+                            i + 1,
+                            cells.get(c).copied().unwrap_or("")
+                        ),
+                    )
+                })
+        };
+        let t = num(ct, "t_s")?;
+        if let Some(prev) = rows.last().map(|r: &TrackRow| r.t_s) {
+            if t <= prev {
+                return Err(err(
+                    path,
+                    format!(
+                        "line {}: time {t} does not increase (previous {prev})",
+                        i + 1
+                    ),
+                ));
+            }
+        }
+        rows.push(TrackRow {
+            t_s: t,
+            fix: RtkFix {
+                time_s: t,
+                east_m: num(ce, "east_m")?,
+                north_m: num(cn, "north_m")?,
+                heading_north_cw_rad: num(ch, "heading_deg")?.to_radians(),
+            },
+        });
+    }
+    if rows.len() < 2 {
+        return Err(err(path, "fewer than two fixes"));
+    }
+    Ok(rows)
+}
+
+/// A run is complete when its last fix is within this of the path's end [m].
+pub const COMPLETE_WITHIN_M: f64 = 0.5;
+
+/// Replays a real machine's RTK track (`read_rtk_csv`) against `legs`: each
+/// fix is measured against the leg the machine is on (the next leg takes
+/// over once the fix is nearer to it and the current one is run to its end).
+pub fn replay_rtk(rows: &[TrackRow], legs: Vec<RefLeg>, source: &str) -> Replay {
+    let mut eval = Evaluator::new();
+    let mut samples = Vec::with_capacity(rows.len());
+    let mut leg = 0usize;
+    let mut travelled = 0.0;
+    let mut prev: Option<Pose2> = None;
+    for r in rows {
+        let pose = r.fix.to_pose();
+        if let Some(p) = prev {
+            travelled += (pose.position() - p.position()).norm();
+        }
+        prev = Some(pose);
+        while leg + 1 < legs.len() {
+            let here = deviations(&legs[leg], pose, 0.0, None);
+            let next = deviations(&legs[leg + 1], pose, 0.0, None);
+            let at_end = legs[leg].length_m() - here.s_a_m < 0.5;
+            if at_end && next.d0_m.abs() <= here.d0_m.abs() + 0.05 {
+                leg += 1;
+            } else {
+                break;
+            }
+        }
+        let dev = deviations(&legs[leg], pose, 0.0, None);
+        let d = Decision {
+            leg,
+            measured: pose,
+            dev,
+            speed_ref_mps: f64::NAN,
+            steer_rpm: f64::NAN,
+            command: TrackCommand::STOP,
+        };
+        samples.push(eval.sample(&legs, &d, r.t_s, pose, travelled));
+    }
+    let end = prev.expect("at least two rows");
+    let goal = *legs
+        .last()
+        .and_then(|l| l.points.last())
+        .expect("legs have points");
+    let completed = (end.position() - goal).norm() <= COMPLETE_WITHIN_M;
+    let setup = setup_with(legs.clone(), samples[0].truth);
+    let t_end = rows.last().map(|r| r.t_s).unwrap_or(0.0) - rows[0].t_s;
+    let metrics = measure(&samples, &setup, end, travelled, t_end, completed);
+    Replay {
+        run: Run {
+            samples,
+            events: Vec::new(),
+            metrics,
+        },
+        legs,
+        measured_on: "rtk fixes",
+        source: source.to_string(),
+    }
+}
+
+/// The `replay` job's summary.
+#[derive(Debug, Clone, Serialize)]
+pub struct ReplaySummary {
+    /// `"replay"`.
+    pub job: &'static str,
+    /// The record replayed.
+    pub source: String,
+    /// What the deviations are measured on.
+    pub measured_on: &'static str,
+    /// The metrics (as `track` and `drive` report them).
+    #[serde(flatten)]
+    pub metrics: autoshovel_walk_tracker::Metrics,
+    /// Workstation events found in the record.
+    pub events: Vec<Event>,
+    /// Whether the run completed.
+    pub success: bool,
+}
+
+impl Replay {
+    /// The job's summary.
+    pub fn summary(&self) -> ReplaySummary {
+        ReplaySummary {
+            job: "replay",
+            source: self.source.clone(),
+            measured_on: self.measured_on,
+            metrics: self.run.metrics,
+            events: self.run.events.clone(),
+            success: self.run.metrics.completed,
+        }
+    }
+}

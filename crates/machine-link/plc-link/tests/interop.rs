@@ -1,0 +1,289 @@
+//! Interoperability with an OPC UA stack nobody here wrote: Python's
+//! `asyncua` (PyPI) as a client of `plc-sim`, and as a PLC that `drive`
+//! runs a scenario against, both over Basic256Sha256 SignAndEncrypt with
+//! the operator's identity; and the workstation's refusals of a PLC whose
+//! model or values are wrong.
+//!
+//! `.ci/run` installs asyncua in a venv and sets `AUTOSHOVEL_PYTHON`; with
+//! it set, a missing asyncua fails the test. Without it, `python3` is tried
+//! and the tests are skipped, saying so, when it has no asyncua.
+
+use std::io::{BufRead, BufReader};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::sync::OnceLock;
+use std::time::Duration;
+
+use autoshovel_plc_link::{
+    drive, pki, Clock, DriveOptions, Link, LinkError, LinkParams, PlcParams, PlcServer,
+    ServeParams, HEARTBEAT_TIMEOUT,
+};
+use autoshovel_walk_tracker::scenario::resolve;
+use autoshovel_walk_tracker::{ControllerKind, Noise};
+
+fn python() -> Option<String> {
+    let set = std::env::var("AUTOSHOVEL_PYTHON").ok();
+    let py = set.clone().unwrap_or_else(|| "python3".into());
+    let ok = Command::new(&py)
+        .args(["-c", "import asyncua"])
+        .stderr(Stdio::null())
+        .status()
+        .map(|s| s.success())
+        .unwrap_or(false);
+    match (ok, set) {
+        (true, _) => Some(py),
+        (false, Some(p)) => panic!("AUTOSHOVEL_PYTHON={p} cannot import asyncua"),
+        (false, None) => {
+            eprintln!(
+                "SKIPPED: python3 has no asyncua (pip install asyncua, or run .ci/run, which sets AUTOSHOVEL_PYTHON)"
+            );
+            None
+        }
+    }
+}
+
+fn script(name: &str) -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("tests/interop")
+        .join(name)
+}
+
+fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
+    static PKI: OnceLock<(tempfile::TempDir, PathBuf, String)> = OnceLock::new();
+    PKI.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("pki");
+        pki::init(&root, &[]).unwrap();
+        let pw = pki::read_password(&root.join(pki::PASSWORD_FILE)).unwrap();
+        (dir, root, pw)
+    })
+}
+
+fn rt() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+#[test]
+fn python_asyncua_client_browses_reads_and_writes_securely() {
+    let Some(py) = python() else { return };
+    let (_, root, pw) = pki_root();
+    let sc = resolve("curve", Some(Noise::Rtk), 1).unwrap();
+    rt().block_on(async {
+        let server = PlcServer::start(
+            PlcParams {
+                setup: sc.setup.clone(),
+                clock: Clock::Scaled(1.0),
+                heartbeat_timeout: HEARTBEAT_TIMEOUT,
+                auto: true,
+                schedule: Vec::new(),
+            },
+            ServeParams {
+                host: "127.0.0.1".into(),
+                port: 0,
+                pki: root.clone(),
+                insecure: false,
+                users: vec![(pki::OPERATOR.into(), pw.clone())],
+            },
+        )
+        .await
+        .unwrap();
+        let (py, endpoint, root, pw) = (py.clone(), server.endpoint(), root.clone(), pw.clone());
+        let out = tokio::task::spawn_blocking(move || {
+            Command::new(py)
+                .arg(script("ua_client.py"))
+                .arg(endpoint)
+                .arg(root)
+                .arg(pw)
+                .output()
+                .unwrap()
+        })
+        .await
+        .unwrap();
+        assert!(
+            out.status.success(),
+            "ua_client.py: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        let v: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let names = |k: &str| -> Vec<String> {
+            v[k].as_array()
+                .unwrap()
+                .iter()
+                .map(|s| s.as_str().unwrap().to_string())
+                .collect()
+        };
+        for f in [
+            "Crawler",
+            "Rtk",
+            "Fault",
+            "Limits",
+            "Workstation",
+            "Mode",
+            "Clock",
+        ] {
+            assert!(names("shovel_children").contains(&f.to_string()), "{v}");
+        }
+        for f in ["East", "North", "Heading", "FixQuality", "Timestamp"] {
+            assert!(names("rtk_children").contains(&f.to_string()), "{v}");
+        }
+        assert_eq!(v["setpoint_type"], "Double");
+        assert_eq!(v["max_rpm"], 3000.0);
+        {
+            let plc = server.plc.lock().unwrap();
+            // The pose it read is the receiver's (at rest: the start fix).
+            let fix = plc.fix().unwrap();
+            assert_eq!(v["east_m"].as_f64().unwrap(), fix.east_m);
+            assert_eq!(v["quality"], 4);
+            // The operator's write was taken; the out-of-range one was refused
+            // and latched a fault, which zeroed the setpoints.
+            assert_eq!(v["write_in_range"], "Good");
+            assert_eq!(plc.setpoints().left_rpm, 0.0, "cleared by the fault");
+            assert_eq!(v["write_out_of_range"], "BadOutOfRange");
+            assert_eq!(v["fault_after"], true);
+            assert!(plc.events.iter().any(|e| e.kind == "setpoint-rejected"));
+            // Anonymous may read, not write.
+            assert!(v["anonymous_read_east"].is_number());
+            assert_ne!(v["anonymous_write"], "Good", "{v}");
+        }
+        server.stop().await;
+    });
+}
+
+/// A python asyncua PLC on a free port, started at `pose`, with `extra` args.
+struct PyPlc {
+    child: Child,
+    endpoint: String,
+}
+
+impl PyPlc {
+    fn start(py: &str, pose: (f64, f64, f64), extra: &[&str]) -> PyPlc {
+        let (_, root, pw) = pki_root();
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port();
+        let mut child = Command::new(py)
+            .arg(script("ua_plc.py"))
+            .arg(port.to_string())
+            .arg(root)
+            .arg(pw)
+            .args([pose.0.to_string(), pose.1.to_string(), pose.2.to_string()])
+            .args(extra)
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        let mut line = String::new();
+        BufReader::new(child.stdout.take().unwrap())
+            .read_line(&mut line)
+            .unwrap();
+        assert_eq!(line.trim(), "ready", "ua_plc.py did not start");
+        PyPlc {
+            child,
+            endpoint: format!("opc.tcp://127.0.0.1:{port}/"),
+        }
+    }
+}
+
+impl Drop for PyPlc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+fn params(endpoint: &str) -> LinkParams {
+    let (_, root, pw) = pki_root();
+    let mut p = LinkParams::new(
+        endpoint,
+        root.clone(),
+        Some((pki::OPERATOR.into(), pw.clone())),
+    );
+    p.connect_timeout = Duration::from_secs(20);
+    p
+}
+
+#[test]
+fn drive_runs_a_scenario_against_a_python_asyncua_plc() {
+    let Some(py) = python() else { return };
+    let sc = resolve("fig9a", Some(Noise::Off), 1).unwrap();
+    let s = sc.setup.start;
+    let plc = PyPlc::start(&py, (s.x, s.y, s.theta), &[]);
+    let p = params(&plc.endpoint);
+    let run = rt().block_on(async {
+        let link = Link::open(&p).await.unwrap();
+        assert!(!link.simulator, "a PLC, not plc-sim");
+        let mut ctl = ControllerKind::Fuzzy.build(&sc.controllers);
+        let opts = DriveOptions::new(&sc.setup, &p);
+        let r = drive(&link, &sc.setup, ctl.as_mut(), &opts, None).await;
+        link.close().await;
+        r.unwrap()
+    });
+    let m = &run.run.metrics;
+    assert!(!run.truth, "measured on the fixes");
+    assert!(m.completed, "{m:?} {:?}", run.run.events);
+    // An ideal crawler at 10 ms steps: the same tracker keeps it within
+    // a few centimetres once on the path (fig9a in process: 4.4 cm).
+    assert!(m.max_centroid_dev_m < 0.10, "{m:?}");
+    assert!(m.final_position_error_m < 0.10, "{m:?}");
+}
+
+#[test]
+fn a_plc_with_a_wrong_type_a_nan_or_other_limits_is_refused_by_node() {
+    let Some(py) = python() else { return };
+    let sc = resolve("fig9a", Some(Noise::Off), 1).unwrap();
+    let s = sc.setup.start;
+    let pose = (s.x, s.y, s.theta);
+    {
+        let plc = PyPlc::start(&py, pose, &["--wrong-type", "Shovel.Rtk.East"]);
+        let p = params(&plc.endpoint);
+        let e = rt().block_on(Link::open(&p)).err().expect("refused");
+        match &e {
+            LinkError::Model { node, why, .. } => {
+                assert!(node.ends_with("Shovel.Rtk.East"), "{e}");
+                assert!(why.contains("Double"), "{e}");
+            }
+            other => panic!("{other}"),
+        }
+    }
+    {
+        let plc = PyPlc::start(&py, pose, &["--nan", "Shovel.Crawler.Left.Speed"]);
+        let p = params(&plc.endpoint);
+        rt().block_on(async {
+            let link = Link::open(&p).await.unwrap();
+            let mut ctl = ControllerKind::Fuzzy.build(&sc.controllers);
+            let opts = DriveOptions::new(&sc.setup, &p);
+            let e = drive(&link, &sc.setup, ctl.as_mut(), &opts, None)
+                .await
+                .expect_err("refused");
+            assert!(
+                matches!(&e, LinkError::BadValue { node, .. } if node.ends_with("Shovel.Crawler.Left.Speed")),
+                "{e}"
+            );
+            assert!(e.to_string().contains("NaN"), "{e}");
+            link.close().await;
+        });
+    }
+    {
+        // The scenario's machine is not this PLC's.
+        let plc = PyPlc::start(&py, pose, &[]);
+        let p = params(&plc.endpoint);
+        let mut setup = sc.setup.clone();
+        setup.crawler.motor_max_rpm = 1500.0;
+        rt().block_on(async {
+            let link = Link::open(&p).await.unwrap();
+            let mut ctl = ControllerKind::Fuzzy.build(&sc.controllers);
+            let opts = DriveOptions::new(&setup, &p);
+            let e = drive(&link, &setup, ctl.as_mut(), &opts, None)
+                .await
+                .expect_err("refused");
+            assert!(matches!(e, LinkError::Mismatch { .. }), "{e}");
+            assert!(e.to_string().contains("MotorMaxSpeed"), "{e}");
+            link.close().await;
+        });
+    }
+}

@@ -1,0 +1,441 @@
+//! Filter chains for any cloud, as PCL's command-line tools and PDAL
+//! pipelines run them: one or more stages in the order given, each with
+//! PCL's semantics ([`autoshovel_point_cloud::filter`]), counted and timed. Unlike
+//! [`crate::perceive::perceive`], nothing here assumes a muck pile: no
+//! floor to find, no surface to fit.
+//!
+//! A stage is written as on the command line of `autoshovel filter`
+//! (`--voxel 0.05`, `--statistical 50,1.0`, `--radius 0.05,3`,
+//! `--pass z:-10.5:-3`, `--level 3,-2`):
+//!
+//! ```
+//! use autoshovel_terrain::chain::{run_chain, Stage, StageKind};
+//! use autoshovel_terrain::{generate_pile, PileParams};
+//!
+//! let scan = generate_pile(&PileParams { points: 20_000, ..PileParams::default() }).unwrap();
+//! let stages = [
+//!     Stage::parse(StageKind::Level, "3,-2").unwrap(),
+//!     Stage::parse(StageKind::Pass, "z:-11.9:inf").unwrap(),
+//!     Stage::parse(StageKind::Voxel, "0.2").unwrap(),
+//! ];
+//! let (out, report) = run_chain(&scan, &stages).unwrap();
+//! assert_eq!(report.len(), 3);
+//! assert_eq!(report[2].points_out, out.len());
+//! assert!(out.len() < report[1].points_out);
+//! ```
+
+use std::time::Instant;
+
+use autoshovel_point_cloud::filter::{
+    pass_through, radius_outlier_removal, statistical_outlier_removal, voxel_grid, Axis,
+    OutlierSides, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
+    VoxelGridParams,
+};
+use autoshovel_point_cloud::PointCloud;
+use serde::Serialize;
+
+use crate::calibrate::level;
+use crate::error::{Result, SurfaceError};
+
+/// The kinds of stage, by their command-line flag.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub enum StageKind {
+    /// `--voxel LEAF` or `--voxel LX,LY,LZ` [m]: PCL's VoxelGrid ([RS eq. 17]–[RS eq. 18]).
+    Voxel,
+    /// `--statistical K,ALPHA[,both]`: PCL's StatisticalOutlierRemoval
+    /// ([RS eq. 14]–[RS eq. 16]); `both` for the two-sided rule as printed.
+    Statistical,
+    /// `--radius R,MIN`: PCL's RadiusOutlierRemoval ([RS eq. 13]).
+    Radius,
+    /// `--pass AXIS:MIN:MAX[:outside]` [m]: PCL's PassThrough, keeping
+    /// MIN ≤ v ≤ MAX (or the rest with `outside`); `-inf`/`inf` for no limit.
+    Pass,
+    /// `--level ROLL,PITCH` [deg]: rotate the sensor frame level
+    /// ([RS eq. 11]–[RS eq. 12]).
+    Level,
+}
+
+impl StageKind {
+    /// The flag's name, without dashes.
+    pub fn flag(self) -> &'static str {
+        match self {
+            StageKind::Voxel => "voxel",
+            StageKind::Statistical => "statistical",
+            StageKind::Radius => "radius",
+            StageKind::Pass => "pass",
+            StageKind::Level => "level",
+        }
+    }
+
+    /// What a value of this flag looks like.
+    pub fn syntax(self) -> &'static str {
+        match self {
+            StageKind::Voxel => "LEAF or LX,LY,LZ in metres, e.g. 0.05",
+            StageKind::Statistical => "K,ALPHA or K,ALPHA,both, e.g. 50,1.0",
+            StageKind::Radius => "RADIUS,MIN_NEIGHBOURS, e.g. 0.05,3",
+            StageKind::Pass => "AXIS:MIN:MAX or AXIS:MIN:MAX:outside, e.g. z:-10.5:-3",
+            StageKind::Level => "ROLL,PITCH in degrees, e.g. 3,-2",
+        }
+    }
+}
+
+/// One stage of a chain.
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub enum Stage {
+    /// Voxel-grid down-sampling to centroids.
+    Voxel(VoxelGridParams),
+    /// Statistical outlier removal.
+    Statistical(StatisticalOutlierParams),
+    /// Radius outlier removal.
+    Radius(RadiusOutlierParams),
+    /// Pass-through on one axis.
+    Pass(PassThroughParams),
+    /// Levelling by roll and pitch, in degrees as given.
+    Level {
+        /// Sensor roll α [deg].
+        roll_deg: f64,
+        /// Sensor pitch β [deg].
+        pitch_deg: f64,
+    },
+}
+
+/// What one stage did.
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct StageReport {
+    /// The flag (`voxel`, `statistical`, `radius`, `pass`, `level`).
+    pub stage: &'static str,
+    /// Its value as given.
+    pub spec: String,
+    /// Points in.
+    pub points_in: usize,
+    /// Points out (kept).
+    pub points_out: usize,
+    /// Wall time [ms].
+    pub ms: f64,
+}
+
+impl Stage {
+    /// Parse the value `spec` of the flag `kind` (see [`StageKind::syntax`]);
+    /// a bad value is [`SurfaceError::BadStage`] naming the flag and the part
+    /// at fault. Ranges are checked by the filter when it runs.
+    pub fn parse(kind: StageKind, spec: &str) -> Result<Self> {
+        let bad = |problem: String| SurfaceError::BadStage {
+            flag: kind.flag(),
+            spec: spec.to_string(),
+            problem,
+            syntax: kind.syntax(),
+        };
+        let number = |part: &str, what: &str| -> Result<f64> {
+            let t = part.trim();
+            match t {
+                "inf" | "+inf" => Ok(f64::INFINITY),
+                "-inf" => Ok(f64::NEG_INFINITY),
+                _ => t
+                    .parse::<f64>()
+                    .ok()
+                    .filter(|v| v.is_finite())
+                    .ok_or_else(|| bad(format!("{what} '{t}' is not a number"))),
+            }
+        };
+        let finite = |part: &str, what: &str| -> Result<f64> {
+            let v = number(part, what)?;
+            if v.is_finite() {
+                Ok(v)
+            } else {
+                Err(bad(format!("{what} must be finite")))
+            }
+        };
+        let count = |part: &str, what: &str| -> Result<usize> {
+            let t = part.trim();
+            t.parse::<usize>()
+                .map_err(|_| bad(format!("{what} '{t}' is not a whole number")))
+        };
+        let parts: Vec<&str> = match kind {
+            StageKind::Pass => spec.split(':').collect(),
+            _ => spec.split(',').collect(),
+        };
+        let arity = |allowed: &[usize]| -> Result<()> {
+            if allowed.contains(&parts.len()) {
+                Ok(())
+            } else {
+                Err(bad(format!("{} parts", parts.len())))
+            }
+        };
+        Ok(match kind {
+            StageKind::Voxel => {
+                arity(&[1, 3])?;
+                let leaf = if parts.len() == 1 {
+                    [finite(parts[0], "leaf")?; 3]
+                } else {
+                    [
+                        finite(parts[0], "leaf x")?,
+                        finite(parts[1], "leaf y")?,
+                        finite(parts[2], "leaf z")?,
+                    ]
+                };
+                Stage::Voxel(VoxelGridParams { leaf_m: leaf })
+            }
+            StageKind::Statistical => {
+                arity(&[2, 3])?;
+                let sides = match parts.get(2).map(|s| s.trim()) {
+                    None | Some("above") => OutlierSides::Above,
+                    Some("both") => OutlierSides::Both,
+                    Some(other) => {
+                        return Err(bad(format!("'{other}' is neither 'above' nor 'both'")))
+                    }
+                };
+                Stage::Statistical(StatisticalOutlierParams {
+                    mean_k: count(parts[0], "K")?,
+                    std_mul: finite(parts[1], "ALPHA")?,
+                    sides,
+                })
+            }
+            StageKind::Radius => {
+                arity(&[2])?;
+                Stage::Radius(RadiusOutlierParams {
+                    radius_m: finite(parts[0], "radius")?,
+                    min_neighbors: count(parts[1], "MIN_NEIGHBOURS")?,
+                })
+            }
+            StageKind::Pass => {
+                arity(&[3, 4])?;
+                let axis = match parts[0].trim() {
+                    "x" | "X" => Axis::X,
+                    "y" | "Y" => Axis::Y,
+                    "z" | "Z" => Axis::Z,
+                    other => return Err(bad(format!("axis '{other}' is not x, y or z"))),
+                };
+                let keep_inside = match parts.get(3).map(|s| s.trim()) {
+                    None | Some("inside") => true,
+                    Some("outside") => false,
+                    Some(other) => {
+                        return Err(bad(format!("'{other}' is neither 'inside' nor 'outside'")))
+                    }
+                };
+                Stage::Pass(PassThroughParams {
+                    axis,
+                    min_m: number(parts[1], "MIN")?,
+                    max_m: number(parts[2], "MAX")?,
+                    keep_inside,
+                })
+            }
+            StageKind::Level => {
+                arity(&[2])?;
+                Stage::Level {
+                    roll_deg: finite(parts[0], "roll")?,
+                    pitch_deg: finite(parts[1], "pitch")?,
+                }
+            }
+        })
+    }
+
+    /// The kind of this stage.
+    pub fn kind(&self) -> StageKind {
+        match self {
+            Stage::Voxel(_) => StageKind::Voxel,
+            Stage::Statistical(_) => StageKind::Statistical,
+            Stage::Radius(_) => StageKind::Radius,
+            Stage::Pass(_) => StageKind::Pass,
+            Stage::Level { .. } => StageKind::Level,
+        }
+    }
+
+    /// Run the stage on `cloud`; a filter's refusal is
+    /// [`SurfaceError::Filter`] naming the stage.
+    pub fn apply(&self, cloud: &PointCloud) -> Result<PointCloud> {
+        let stage = self.kind().flag();
+        let filter = |source| SurfaceError::Filter { stage, source };
+        match self {
+            Stage::Voxel(p) => voxel_grid(cloud, p).map_err(filter),
+            Stage::Statistical(p) => statistical_outlier_removal(cloud, p).map_err(filter),
+            Stage::Radius(p) => radius_outlier_removal(cloud, p).map_err(filter),
+            Stage::Pass(p) => pass_through(cloud, p).map_err(filter),
+            Stage::Level {
+                roll_deg,
+                pitch_deg,
+            } => Ok(level(cloud, roll_deg.to_radians(), pitch_deg.to_radians())),
+        }
+    }
+}
+
+/// Run `stages` on `cloud` in order: the result and what each stage did
+/// (its spec written back from the parsed values).
+pub fn run_chain(cloud: &PointCloud, stages: &[Stage]) -> Result<(PointCloud, Vec<StageReport>)> {
+    let mut current = cloud.clone();
+    let mut report = Vec::with_capacity(stages.len());
+    for stage in stages {
+        let t0 = Instant::now();
+        let next = stage.apply(&current)?;
+        report.push(StageReport {
+            stage: stage.kind().flag(),
+            spec: stage.spec(),
+            points_in: current.len(),
+            points_out: next.len(),
+            ms: t0.elapsed().as_secs_f64() * 1e3,
+        });
+        current = next;
+    }
+    Ok((current, report))
+}
+
+impl Stage {
+    /// The stage written as its flag's value (parses back to the same stage).
+    pub fn spec(&self) -> String {
+        match self {
+            Stage::Voxel(p) if p.leaf_m[0] == p.leaf_m[1] && p.leaf_m[1] == p.leaf_m[2] => {
+                format!("{}", p.leaf_m[0])
+            }
+            Stage::Voxel(p) => format!("{},{},{}", p.leaf_m[0], p.leaf_m[1], p.leaf_m[2]),
+            Stage::Statistical(p) => match p.sides {
+                OutlierSides::Above => format!("{},{}", p.mean_k, p.std_mul),
+                OutlierSides::Both => format!("{},{},both", p.mean_k, p.std_mul),
+            },
+            Stage::Radius(p) => format!("{},{}", p.radius_m, p.min_neighbors),
+            Stage::Pass(p) => {
+                let axis = match p.axis {
+                    Axis::X => "x",
+                    Axis::Y => "y",
+                    Axis::Z => "z",
+                };
+                let side = if p.keep_inside { "" } else { ":outside" };
+                format!("{axis}:{}:{}{side}", p.min_m, p.max_m)
+            }
+            Stage::Level {
+                roll_deg,
+                pitch_deg,
+            } => format!("{roll_deg},{pitch_deg}"),
+        }
+    }
+}
+
+/// The summary of `autoshovel filter` (SPEC §6: `job`, `success`, then the
+/// chain's own fields).
+#[derive(Debug, Clone, PartialEq, Serialize)]
+pub struct FilterSummary {
+    /// Always "filter".
+    pub job: &'static str,
+    /// Always true (a failed chain is an error, not a summary).
+    pub success: bool,
+    /// The cloud read.
+    pub input: String,
+    /// Its format, as the reader names it.
+    pub input_format: &'static str,
+    /// The cloud written.
+    pub output: String,
+    /// Its encoding.
+    pub output_encoding: &'static str,
+    /// Finite points read.
+    pub points_in: usize,
+    /// Points dropped on reading for a non-finite coordinate.
+    pub non_finite_dropped: usize,
+    /// Points written.
+    pub points_out: usize,
+    /// Each stage, in the order run.
+    pub stages: Vec<StageReport>,
+    /// Reading [ms].
+    pub read_ms: f64,
+    /// The stages together [ms].
+    pub filter_ms: f64,
+    /// Writing [ms].
+    pub write_ms: f64,
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use autoshovel_point_cloud::filter::{
+        pass_through_indices, radius_outlier_removal_indices, statistical_outlier_removal_indices,
+    };
+
+    fn cloud() -> PointCloud {
+        // A jittered 40 × 40 grid with a few far points.
+        let mut pts: Vec<[f32; 3]> = (0..1600)
+            .map(|i| {
+                let (x, y) = ((i % 40) as f32 * 0.1, (i / 40) as f32 * 0.1);
+                [x, y, 0.01 * ((i * 7919) % 13) as f32]
+            })
+            .collect();
+        pts.extend([[10.0, 10.0, 5.0], [-8.0, 3.0, 2.0], [2.0, -9.0, -4.0]]);
+        PointCloud::new(pts)
+    }
+
+    #[test]
+    fn every_spec_parses_back_to_its_stage() {
+        for (kind, spec) in [
+            (StageKind::Voxel, "0.05"),
+            (StageKind::Voxel, "0.1,0.2,0.3"),
+            (StageKind::Statistical, "50,1"),
+            (StageKind::Statistical, "8,0.5,both"),
+            (StageKind::Radius, "0.05,3"),
+            (StageKind::Pass, "z:-10.5:-3"),
+            (StageKind::Pass, "x:-inf:2:outside"),
+            (StageKind::Level, "3,-2"),
+        ] {
+            let s = Stage::parse(kind, spec).unwrap();
+            assert_eq!(Stage::parse(kind, &s.spec()).unwrap(), s, "{spec}");
+        }
+    }
+
+    #[test]
+    fn bad_values_name_the_flag_and_the_part() {
+        for (kind, spec, needle) in [
+            (StageKind::Voxel, "abc", "leaf 'abc'"),
+            (StageKind::Voxel, "0.1,0.2", "2 parts"),
+            (StageKind::Statistical, "50", "1 parts"),
+            (StageKind::Statistical, "x,1", "K 'x'"),
+            (StageKind::Statistical, "50,1,left", "'left'"),
+            (StageKind::Radius, "0.05,-3", "MIN_NEIGHBOURS '-3'"),
+            (StageKind::Pass, "w:0:1", "axis 'w'"),
+            (StageKind::Pass, "z:0:NaN", "MAX 'NaN'"),
+            (StageKind::Level, "3", "1 parts"),
+            (StageKind::Level, "inf,0", "roll must be finite"),
+        ] {
+            let e = Stage::parse(kind, spec).unwrap_err().to_string();
+            assert!(
+                e.contains(&format!("--{}", kind.flag())) && e.contains(needle),
+                "{spec}: {e}"
+            );
+        }
+        // Ranges are the filter's: a zero leaf is refused when it runs.
+        let s = Stage::parse(StageKind::Voxel, "0").unwrap();
+        let e = run_chain(&cloud(), &[s]).unwrap_err().to_string();
+        assert!(e.contains("voxel"), "{e}");
+    }
+
+    #[test]
+    fn a_chain_is_its_filters_applied_in_order() {
+        let c = cloud();
+        let stages = [
+            Stage::parse(StageKind::Pass, "z:-1:1").unwrap(),
+            Stage::parse(StageKind::Radius, "0.15,3").unwrap(),
+            Stage::parse(StageKind::Statistical, "8,1").unwrap(),
+        ];
+        let (out, report) = run_chain(&c, &stages).unwrap();
+        // The same by hand, through the filters' own index functions.
+        let Stage::Pass(p) = stages[0] else {
+            unreachable!()
+        };
+        let Stage::Radius(r) = stages[1] else {
+            unreachable!()
+        };
+        let Stage::Statistical(st) = stages[2] else {
+            unreachable!()
+        };
+        let pick = |c: &PointCloud, idx: Vec<usize>| {
+            PointCloud::new(idx.into_iter().map(|i| c.points[i]).collect())
+        };
+        let a = pick(&c, pass_through_indices(&c, &p).unwrap());
+        let b = pick(&a, radius_outlier_removal_indices(&a, &r).unwrap());
+        let d = pick(&b, statistical_outlier_removal_indices(&b, &st).unwrap());
+        assert_eq!(out.points, d.points);
+        assert_eq!(
+            report
+                .iter()
+                .map(|r| (r.points_in, r.points_out))
+                .collect::<Vec<_>>(),
+            vec![(c.len(), a.len()), (a.len(), b.len()), (b.len(), d.len())]
+        );
+        // The three far points, all beyond z ±1, went at the first stage.
+        assert_eq!(a.len(), c.len() - 3);
+    }
+}
