@@ -2,7 +2,7 @@
 
 use std::f64::consts::PI;
 
-/// Wraps an angle [rad] to (−π, π].
+/// Wraps an angle (rad) to (−π, π].
 pub fn wrap_angle(a_rad: f64) -> f64 {
     let mut a = a_rad % (2.0 * PI);
     if a <= -PI {
@@ -13,7 +13,7 @@ pub fn wrap_angle(a_rad: f64) -> f64 {
     a
 }
 
-/// Signed smallest difference `a − b` [rad], wrapped to (−π, π].
+/// Signed smallest difference `a − b` (rad), wrapped to (−π, π].
 pub fn angle_diff(a_rad: f64, b_rad: f64) -> f64 {
     wrap_angle(a_rad - b_rad)
 }

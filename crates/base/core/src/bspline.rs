@@ -112,7 +112,7 @@ impl CubicBSpline {
     }
 
     /// Samples the curve at (about) every `ds_m` metres of arc length.
-    /// Each sample is (point, unit tangent, signed curvature [1/m]). The last
+    /// Each sample is (point, unit tangent, signed curvature (1/m)). The last
     /// sample is the curve's end point.
     pub fn sample_by_arc_length(&self, ds_m: f64) -> Vec<CurveSample> {
         let d1 = self.derivative();
@@ -178,13 +178,13 @@ impl CubicBSpline {
 /// One sample of a curve.
 #[derive(Debug, Clone, Copy)]
 pub struct CurveSample {
-    /// Position [m].
+    /// Position (m).
     pub point: Vec2,
     /// Unit tangent (zero where the curve stalls).
     pub tangent: Vec2,
-    /// Signed curvature, positive turning left [1/m].
+    /// Signed curvature, positive turning left (1/m).
     pub curvature: f64,
-    /// Arc length from the curve's start [m].
+    /// Arc length from the curve's start (m).
     pub s: f64,
 }
 

@@ -297,7 +297,7 @@ pub fn bytes(bytes: f64) -> String {
     format!("{v:.digits$} {}", units[u])
 }
 
-/// A finite length in (0, 1 km] [m], for [`check_each`]: no machine or
+/// A finite length in (0, 1 km] (m), for [`check_each`]: no machine or
 /// site part is longer, and geometry beyond it overflows the f32 clouds
 /// and the planners' grids.
 pub const LENGTH: (fn(f64) -> bool, &str) = (

@@ -4,7 +4,7 @@
 use nalgebra::Vector2;
 use serde::{Deserialize, Serialize};
 
-/// A point or vector in the ground plane [m].
+/// A point or vector in the ground plane (m).
 pub type Vec2 = Vector2<f64>;
 
 /// Unit vector of heading `theta_rad` (from +x, counter-clockwise).
@@ -17,19 +17,19 @@ pub fn perp(v: Vec2) -> Vec2 {
     Vec2::new(-v.y, v.x)
 }
 
-/// Planar pose of a machine: position [m] and heading [rad].
+/// Planar pose of a machine: position (m) and heading (rad).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Pose2 {
-    /// East [m].
+    /// East (m).
     pub x: f64,
-    /// North [m].
+    /// North (m).
     pub y: f64,
-    /// Heading from +x, counter-clockwise [rad].
+    /// Heading from +x, counter-clockwise (rad).
     pub theta: f64,
 }
 
 impl Pose2 {
-    /// A pose from position [m] and heading [rad].
+    /// A pose from position (m) and heading (rad).
     pub fn new(x: f64, y: f64, theta: f64) -> Self {
         Self { x, y, theta }
     }

@@ -18,7 +18,7 @@
 //!     e^{[ξ]θ} = [ I  v θ ; 0  1 ]                                 (ω = 0)
 //! ```
 //!
-//! with Rodrigues' formula e^{[ω]θ} = I + sin θ [ω] + (1 − cos θ)[ω]².
+//! with Rodrigues' formula e^{\[ω\]θ} = I + sin θ \[ω\] + (1 − cos θ)\[ω\]².
 //! Written here rather than taken from a robotics crate because the two
 //! closed forms are a dozen lines on nalgebra, and the kinematics crates on
 //! crates.io (k, urdf-rs) model URDF chains, not bare twists.
@@ -52,7 +52,7 @@ impl Twist {
         }
     }
 
-    /// The matrix exponential e^{[ξ]θ} of [RS eq. 2] (θ in rad for a revolute
+    /// The matrix exponential e^{\[ξ\]θ} of [RS eq. 2] (θ in rad for a revolute
     /// joint, m for a prismatic one).
     pub fn exp(&self, theta: f64) -> Matrix4<f64> {
         // [RS eq. 2]: prismatic (ω = 0) then revolute by Rodrigues.
@@ -70,13 +70,13 @@ impl Twist {
     }
 }
 
-/// Rodrigues' formula e^{[ω]θ} for a unit axis ω.
+/// Rodrigues' formula e^{\[ω\]θ} for a unit axis ω.
 pub fn rodrigues(omega: &Vector3<f64>, theta: f64) -> Matrix3<f64> {
     let k = omega.cross_matrix();
     Matrix3::identity() + k * theta.sin() + k * k * (1.0 - theta.cos())
 }
 
-/// Eq. 1: T(q) = Π e^{[ξᵢ]qᵢ} · T(0). `twists` and `q` pair up joint by joint.
+/// Eq. 1: T(q) = Π e^{\[ξᵢ\]qᵢ} · T(0). `twists` and `q` pair up joint by joint.
 ///
 /// ```
 /// use autoshovel_core::poe::{product_of_exponentials, Twist};

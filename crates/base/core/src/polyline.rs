@@ -3,12 +3,12 @@
 
 use crate::Vec2;
 
-/// Total length of a polyline [m].
+/// Total length of a polyline (m).
 pub fn polyline_length(points: &[Vec2]) -> f64 {
     points.windows(2).map(|w| (w[1] - w[0]).norm()).sum()
 }
 
-/// Cumulative arc length at each vertex, starting at 0 [m].
+/// Cumulative arc length at each vertex, starting at 0 (m).
 pub fn arc_lengths(points: &[Vec2]) -> Vec<f64> {
     let mut s = Vec::with_capacity(points.len());
     let mut acc = 0.0;
@@ -21,7 +21,7 @@ pub fn arc_lengths(points: &[Vec2]) -> Vec<f64> {
     s
 }
 
-/// Signed curvature [1/m] of the circle through three points (Menger
+/// Signed curvature (1/m) of the circle through three points (Menger
 /// curvature, positive when turning left); 0 for collinear or repeated points.
 pub fn menger_curvature(a: Vec2, b: Vec2, c: Vec2) -> f64 {
     let ab = b - a;

@@ -1,7 +1,7 @@
 //! Builds the crawler trajectory-tracking fuzzy controller of the
 //! electric-shovel paper's §4.3 (Mamdani & Assilian 1975 inference) with
-//! autoshovel-fuzzy: e = lateral deviation [m] ∈ [−0.45, 0.45], ec = its
-//! rate ∈ [−30, 30], u = track motor speed difference [rpm] ∈ [−2700, 2700],
+//! autoshovel-fuzzy: e = lateral deviation (m) ∈ [−0.45, 0.45], ec = its
+//! rate ∈ [−30, 30], u = track motor speed difference (rpm) ∈ [−2700, 2700],
 //! seven triangles NB … PB each and the 7 × 7 Table 1 (rows ec, columns e).
 //! Prints u at a few points and a coarse control surface, and asserts the
 //! odd symmetry and the sign of the response.

@@ -3,7 +3,7 @@
 //! (Mamdani & Assilian 1975, "An experiment in linguistic synthesis with a
 //! fuzzy logic controller"), on which autoshovel's crawler
 //! trajectory-tracking controller is built (electric-shovel paper §4.3:
-//! inputs e [m] and ec, output u [rpm], seven triangular terms each and a
+//! inputs e (m) and ec, output u (rpm), seven triangular terms each and a
 //! 7 × 7 rule table).
 //!
 //! The crate is generic — any number of inputs, any terms, any rules; the
@@ -29,9 +29,6 @@
 //! only checks its arguments, never panics and, on the
 //! [`MamdaniSystem::infer`] / [`MamdaniSystem::infer_with`] paths, never
 //! allocates.
-
-// Units in brackets ("[m]", "[rpm]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
 
 mod error;
 mod mamdani;

@@ -14,7 +14,7 @@ use serde::{Deserialize, Serialize};
 
 /// A membership function of one real variable.
 ///
-/// Parameters are in the variable's own unit (e.g. [m] for e, [rpm] for u).
+/// Parameters are in the variable's own unit (e.g. (m) for e, (rpm) for u).
 /// Validity (ordering, finiteness, positive width) is checked by
 /// [`Membership::check`], which every system constructor calls.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]

@@ -1,8 +1,8 @@
 //! Published rule bases, ready to use.
 //!
 //! [`shovel_table1`]: the crawler trajectory-tracking controller of the
-//! electric-shovel walking paper §4.3 — inputs e [m] ∈ [−0.45, 0.45] (lateral
-//! deviation) and ec ∈ [−30, 30] (its rate), output u [rpm] ∈ [−2700, 2700]
+//! electric-shovel walking paper §4.3 — inputs e (m) ∈ [−0.45, 0.45] (lateral
+//! deviation) and ec ∈ [−30, 30] (its rate), output u (rpm) ∈ [−2700, 2700]
 //! (track motor speed difference), seven evenly spaced triangles NB … PB on
 //! each, and the 7 × 7 rule table of its Table 1 (rows ec, columns e),
 //! Mamdani min / max / centroid (Mamdani & Assilian 1975).
@@ -25,12 +25,12 @@ pub mod shovel_table1 {
         ["ZE", "PS", "PS", "PM", "PM", "PB", "PB"],
     ];
 
-    /// Universe of e, ±this [m]: the fuzzy universe [−σ1, σ1] of [W eq. 24]
+    /// Universe of e, ±this (m): the fuzzy universe [−σ1, σ1] of [W eq. 24]
     /// (the tracker maps e into it with k1).
     pub const E_MAX: f64 = 0.45;
     /// Universe of ec, ±this: [−σ2, σ2] of [W eq. 24].
     pub const EC_MAX: f64 = 30.0;
-    /// Universe of u, ±this [rpm]: [−σ3, σ3] of [W eq. 24].
+    /// Universe of u, ±this (rpm): [−σ3, σ3] of [W eq. 24].
     pub const U_MAX: f64 = 2700.0;
 
     /// The system (inputs [e, ec], output u) at the default output

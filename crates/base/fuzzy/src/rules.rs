@@ -57,7 +57,7 @@ impl RuleBase {
         self
     }
 
-    /// Appends "IF inputs[0] is antecedent[0] AND … THEN output is
+    /// Appends "IF inputs\[0\] is antecedent\[0\] AND … THEN output is
     /// consequent" with weight `weight`, looking the names up.
     ///
     /// Errors: [`FuzzyError::RuleArity`] if `antecedent` does not name one

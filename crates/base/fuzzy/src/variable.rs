@@ -1,7 +1,7 @@
 //! Linguistic variables: a named universe of discourse `[min, max]` and its
 //! named terms, and the fuzzification of a crisp value into one degree per
 //! term (Mamdani & Assilian 1975). The paper's §4.3 uses three of them:
-//! e ∈ [−0.45, 0.45] [m], ec ∈ [−30, 30] and u ∈ [−2700, 2700] [rpm], each
+//! e ∈ [−0.45, 0.45] (m), ec ∈ [−30, 30] and u ∈ [−2700, 2700] (rpm), each
 //! with seven evenly spaced triangles NB … PB.
 //!
 //! Crisp inputs are clamped to the universe before fuzzification, so values

@@ -31,9 +31,6 @@
 //! - [`benchmarks`] holds sphere, Rosenbrock, Rastrigin and Ackley with the
 //!   paper's bounds and published results.
 
-// Units in brackets ("[m]") and intervals ("[0, 1)") are prose, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod benchmarks;
 mod cma_es;
 mod constraints;

@@ -34,7 +34,7 @@ pub struct Args {
     /// PCD/PLY encoding (default binary).
     #[arg(long, value_enum)]
     pub encoding: Option<EncodingArg>,
-    /// Voxel grid to centroids (PCL VoxelGrid): LEAF or LX,LY,LZ [m].
+    /// Voxel grid to centroids (PCL VoxelGrid): LEAF or LX,LY,LZ (m).
     #[arg(long, value_name = "LEAF", allow_hyphen_values = true)]
     pub voxel: Vec<String>,
     /// Statistical outlier removal (PCL StatisticalOutlierRemoval): K,ALPHA, or K,ALPHA,both for the two-sided rule.
@@ -46,7 +46,7 @@ pub struct Args {
     /// Pass-through (PCL PassThrough): AXIS:MIN:MAX keeps MIN ≤ v ≤ MAX; add :outside for the rest; -inf/inf for no limit.
     #[arg(long, value_name = "AXIS:MIN:MAX", allow_hyphen_values = true)]
     pub pass: Vec<String>,
-    /// Level the sensor frame: ROLL,PITCH [deg].
+    /// Level the sensor frame: ROLL,PITCH (deg).
     #[arg(long, value_name = "ROLL,PITCH", allow_hyphen_values = true)]
     pub level: Vec<String>,
     #[command(flatten)]

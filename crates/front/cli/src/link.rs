@@ -134,9 +134,9 @@ pub struct PlcSimArgs {
     /// Start in manual mode (setpoints ignored).
     #[arg(long)]
     pub manual: bool,
-    /// Inject a fault at a machine time: KIND@SECONDS[:VALUE], KIND one of
+    /// Inject a fault at a machine time: KIND@SECONDS or KIND@SECONDS:VALUE, KIND one of
     /// rtk-dropout, rtk-jump, rtk-freeze, link-cut, delay (VALUE: duration
-    /// [s], for rtk-jump the offset [m]; default 1). Repeatable.
+    /// (s), for rtk-jump the offset (m); default 1). Repeatable.
     #[arg(long = "fault")]
     pub faults: Vec<String>,
     /// Stop after this many wall-clock seconds (default: run until Ctrl-C).
@@ -284,10 +284,10 @@ pub struct DriveArgs {
     /// Security and identity.
     #[command(flatten)]
     pub security: SecurityArgs,
-    /// Give up when the link stays down this long [s].
+    /// Give up when the link stays down this long (s).
     #[arg(long, default_value_t = 30.0)]
     pub link_timeout: f64,
-    /// Give up waiting for a fault's acknowledgement after this long [s].
+    /// Give up waiting for a fault's acknowledgement after this long (s).
     #[arg(long, default_value_t = 600.0)]
     pub ack_timeout: f64,
     /// Write summary.json, CSV and plots here.
@@ -483,7 +483,7 @@ pub fn replay(args: &ReplayArgs) -> Result<()> {
         args.output.force,
     )?;
     let job = autoshovel_jobs::replay(&args.log, planned.as_ref(), out.as_ref())?;
-    job.report(args.output.json, |s: &autoshovel_plc_link::replay::ReplaySummary| {
+    job.report(args.output.json, |s: &autoshovel_run_log::ReplaySummary| {
         let m = &s.metrics;
         crate::say!(
             "replay {} (on {}): max dev {:.3} m, mean dev {:.3} m, final pos err {:.3} m, final heading err {:.2} deg, completed {}",

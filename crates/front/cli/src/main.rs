@@ -2,9 +2,6 @@
 //! each writes `summary.json`, CSV data and SVG+PNG plots with `--out DIR`
 //! and prints the summary alone with `--json`.
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 /// `println!` that ignores a closed stdout (`autoshovel ... | head`) instead of panicking.
 macro_rules! say {
     ($($arg:tt)*) => {{

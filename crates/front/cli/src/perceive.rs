@@ -27,7 +27,7 @@ pub struct Args {
     /// CAP_SYS_NICE.
     #[arg(long, num_args = 0..=1, default_missing_value = "10", value_name = "PRIORITY")]
     pub realtime: Option<u8>,
-    /// Frame mode: cell edge of the running height model [m] (default: 4 × the
+    /// Frame mode: cell edge of the running height model (m) (default: 4 × the
     /// point spacing); survey mode: of the survey's height model (default 1 m).
     #[arg(long)]
     pub model_cell: Option<f64>,
@@ -38,12 +38,12 @@ pub struct Args {
     /// 30 bytes a point read, at the most) and are removed at the end.
     #[arg(long)]
     pub tiles: bool,
-    /// Survey mode: tile side [m] (default: from the memory limit and the
+    /// Survey mode: tile side (m) (default: from the memory limit and the
     /// survey's density). Implies --tiles.
     #[arg(long)]
     pub tile_size: Option<f64>,
     /// Survey mode: most working memory of the tiles running at once (a
-    /// tile a core while they fit) [GiB].
+    /// tile a core while they fit) (GiB).
     #[arg(long, default_value_t = 2.0)]
     pub memory_limit: f64,
     /// Pipeline settings (TOML); defaults otherwise (`autoshovel perceive --print-config` shows them).

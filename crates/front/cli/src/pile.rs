@@ -42,10 +42,10 @@ pub struct Args {
     /// Number of points.
     #[arg(long, default_value_t = 100_000)]
     pub points: usize,
-    /// Sensor roll [deg].
+    /// Sensor roll (deg).
     #[arg(long, default_value_t = 3.0, allow_negative_numbers = true)]
     pub roll: f64,
-    /// Sensor pitch [deg].
+    /// Sensor pitch (deg).
     #[arg(long, default_value_t = -2.0, allow_negative_numbers = true)]
     pub pitch: f64,
     /// Scale of the pile: 1 = a 10 m face; 0.0333 = the paper's 1:30 model.
@@ -55,10 +55,10 @@ pub struct Args {
     /// Livox-like non-repetitive pattern cast from the sensor).
     #[arg(long, default_value = "area")]
     pub pattern: ScanPattern,
-    /// Sensor height above the floor [m at scale 1].
+    /// Sensor height above the floor (m at scale 1).
     #[arg(long, default_value_t = 12.0)]
     pub sensor_height: f64,
-    /// Full field of view of the rosette pattern [deg].
+    /// Full field of view of the rosette pattern (deg).
     #[arg(long, default_value_t = 70.4)]
     pub fov: f64,
     /// Seed of the noise and sampling.

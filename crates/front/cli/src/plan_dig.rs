@@ -13,12 +13,12 @@
 use std::path::PathBuf;
 
 use anyhow::{bail, Result};
+use autoshovel_figures::dig as figures;
+use autoshovel_optim::Init;
 use autoshovel_rope_shovel_dig::TomlFile as _;
 use autoshovel_rope_shovel_dig::{
     DigSetup, DigSummary, MachineProfile, Pile, SearchSpace, WarmStart, CONSTRAINT_NAMES,
 };
-use autoshovel_figures::dig as figures;
-use autoshovel_optim::Init;
 use autoshovel_terrain::PileShape;
 
 use autoshovel_terrain::perceive::PerceptionParams;

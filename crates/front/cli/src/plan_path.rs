@@ -21,7 +21,7 @@ pub struct Args {
     pub planner: PlannerArg,
     #[command(flatten)]
     pub output: crate::output::OutputArgs,
-    /// Success needs every leg to end within this of its required heading [deg].
+    /// Success needs every leg to end within this of its required heading (deg).
     #[arg(long, default_value_t = autoshovel_walk_planner::DEFAULT_HEADING_TOLERANCE_DEG)]
     pub heading_tolerance_deg: f64,
 }

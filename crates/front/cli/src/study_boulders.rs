@@ -26,10 +26,10 @@ pub struct Args {
     /// Seed of the boulders and of the sensor noise.
     #[arg(long, default_value_t = 1)]
     pub seed: u64,
-    /// Smallest boulder radius [m].
+    /// Smallest boulder radius (m).
     #[arg(long, default_value_t = 0.15)]
     pub min_radius: f64,
-    /// Largest boulder radius [m].
+    /// Largest boulder radius (m).
     #[arg(long, default_value_t = 0.5)]
     pub max_radius: f64,
     #[command(flatten)]

@@ -13,12 +13,12 @@ use std::path::{Path, PathBuf};
 
 use crate::output::Report as _;
 use anyhow::{bail, Result};
+use autoshovel_figures::validate as figures;
 use autoshovel_rope_shovel_dig::validate::{
     simulate_measurement, AlignParams, MeasuredRecord, MeasurementModel, PlannedRecord,
     ValidateSummary,
 };
 use autoshovel_rope_shovel_dig::DigError;
-use autoshovel_figures::validate as figures;
 
 /// Arguments of `validate-dig`.
 #[derive(Debug, clap::Args)]
@@ -50,13 +50,13 @@ pub struct Args {
     /// Write a measurement simulated from the plan to this CSV, then compare with it.
     #[arg(long)]
     pub simulate: Option<PathBuf>,
-    /// Offsets searched either side of the record's start [s]; default: half the planned dig time.
+    /// Offsets searched either side of the record's start (s); default: half the planned dig time.
     #[arg(long)]
     pub max_lag_s: Option<f64>,
-    /// Largest deviation of the measured dig's pace from the plan's searched [%] (0: as planned).
+    /// Largest deviation of the measured dig's pace from the plan's searched (%) (0: as planned).
     #[arg(long, default_value_t = 10.0)]
     pub max_stretch_pct: f64,
-    /// --simulate: time from the logger's start to the dig's start [s].
+    /// --simulate: time from the logger's start to the dig's start (s).
     #[arg(long, default_value_t = MeasurementModel::testbed().delay_s, allow_negative_numbers = true)]
     pub sim_delay_s: f64,
     /// --simulate: gain of the hoist force sensor.
@@ -65,16 +65,16 @@ pub struct Args {
     /// --simulate: gain of the crowd force sensor.
     #[arg(long, default_value_t = MeasurementModel::testbed().gain_crowd)]
     pub sim_gain_crowd: f64,
-    /// --simulate: standard deviation of the force noise [N].
+    /// --simulate: standard deviation of the force noise (N).
     #[arg(long, default_value_t = MeasurementModel::testbed().noise_n)]
     pub sim_noise_n: f64,
     /// --simulate: measured dig time per planned dig time.
     #[arg(long, default_value_t = MeasurementModel::testbed().time_scale)]
     pub sim_time_scale: f64,
-    /// --simulate: weighed minus planned mass [kg].
+    /// --simulate: weighed minus planned mass (kg).
     #[arg(long, default_value_t = MeasurementModel::testbed().mass_offset_kg, allow_negative_numbers = true)]
     pub sim_mass_offset_kg: f64,
-    /// --simulate: logger sample period [s].
+    /// --simulate: logger sample period (s).
     #[arg(long, default_value_t = MeasurementModel::testbed().sample_period_s)]
     pub sim_period_s: f64,
     /// --simulate: seed of the noise.

@@ -83,7 +83,7 @@ fn pair(v: &Value) -> [f64; 2] {
 }
 
 /// γ as the paper defines it in our mirrored frame (docs/excavate.md):
-/// clockwise from V_c to F_f, atan2(−(V × F), V·F) mod 360° [deg].
+/// clockwise from V_c to F_f, atan2(−(V × F), V·F) mod 360° (deg).
 fn gamma_deg(v: [f64; 2], f: [f64; 2]) -> f64 {
     let cross = v[0] * f[1] - v[1] * f[0];
     let dot = v[0] * f[0] + v[1] * f[1];
@@ -471,7 +471,8 @@ fn printed_scenario_and_profile_round_trip_to_the_same_plan() {
 
 /// The example file of the library.
 fn two_boulders_file() -> PathBuf {
-    Path::new(env!("CARGO_MANIFEST_DIR")).join("../../hydraulic-excavator/excavator-dig/scenarios/two-boulders.toml")
+    Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../hydraulic-excavator/excavator-dig/scenarios/two-boulders.toml")
 }
 
 #[test]

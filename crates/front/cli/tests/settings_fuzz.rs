@@ -21,7 +21,7 @@ use std::sync::Mutex;
 use autoshovel_core::config::TomlFile;
 use proptest::prelude::*;
 
-/// Largest single allocation a settings file may cause [bytes]: above the
+/// Largest single allocation a settings file may cause (bytes): above the
 /// biggest the stated work ceilings allow (the excavator's 10⁶ simulator
 /// samples, about 180 MB in one vector).
 const ALLOCATION_BOUND: usize = 512 << 20;
@@ -30,30 +30,36 @@ struct Bounded;
 
 static LARGEST: AtomicUsize = AtomicUsize::new(0);
 
+// SAFETY: forwards every call unchanged to the system allocator, or
+// refuses one past the bound with a null pointer, as `GlobalAlloc` allows.
 unsafe impl GlobalAlloc for Bounded {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
         note(l.size());
         if l.size() > 2 * ALLOCATION_BOUND {
             return std::ptr::null_mut();
         }
-        System.alloc(l)
+        // SAFETY: same contract as our caller's.
+        unsafe { System.alloc(l) }
     }
     unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
         note(l.size());
         if l.size() > 2 * ALLOCATION_BOUND {
             return std::ptr::null_mut();
         }
-        System.alloc_zeroed(l)
+        // SAFETY: same contract as our caller's.
+        unsafe { System.alloc_zeroed(l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
         note(new);
         if new > 2 * ALLOCATION_BOUND {
             return std::ptr::null_mut();
         }
-        System.realloc(p, l, new)
+        // SAFETY: same contract as our caller's.
+        unsafe { System.realloc(p, l, new) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
-        System.dealloc(p, l)
+        // SAFETY: same contract as our caller's.
+        unsafe { System.dealloc(p, l) }
     }
 }
 
@@ -170,7 +176,9 @@ fn damage(text: &str, (edits, cut): &(Vec<Edit>, Option<usize>)) -> String {
 
 /// A cheap optimiser budget: the property is about the settings, not the
 /// search.
-fn small_dig_setup(profile: autoshovel_rope_shovel_dig::MachineProfile) -> autoshovel_rope_shovel_dig::DigSetup {
+fn small_dig_setup(
+    profile: autoshovel_rope_shovel_dig::MachineProfile,
+) -> autoshovel_rope_shovel_dig::DigSetup {
     let mut s = autoshovel_rope_shovel_dig::DigSetup::new(profile, "fuzzed", 1);
     s.gwo.population = 6;
     s.gwo.iterations = 3;

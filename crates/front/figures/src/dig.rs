@@ -9,13 +9,13 @@
 
 use std::path::Path;
 
-use autoshovel_rope_shovel_dig::{
-    write_pack, AllSurfaces, AllSurfacesSummary, ComparedPile, Decision, DigModel, DigPlan,
-    DigSample, PlannedPile, TableRow, SAMPLE_COLUMNS, TABLE_COLUMNS,
-};
 use autoshovel_report::{
     markdown_table as md_table, rating_line, write_csv, write_csv_cells, write_figure,
     write_job_summary, write_panels, Figure, Layer, Rgb, Stroke, Written,
+};
+use autoshovel_rope_shovel_dig::{
+    write_pack, AllSurfaces, AllSurfacesSummary, ComparedPile, Decision, DigModel, DigPlan,
+    DigSample, PlannedPile, TableRow, SAMPLE_COLUMNS, TABLE_COLUMNS,
 };
 
 use crate::shovel::{pile_layers, shovel_frame_layers, shovel_pose_layers};
@@ -417,7 +417,10 @@ pub fn write_table_csv(path: &Path, all: &AllSurfacesSummary) -> Result<(), Erro
 
 /// One pile of the comparison: our tooth path and the paper's (Table 4's
 /// decision drawn on our pile).
-pub fn comparison_panel(pile: &ComparedPile, s: &autoshovel_rope_shovel_dig::SurfaceComparison) -> Figure {
+pub fn comparison_panel(
+    pile: &ComparedPile,
+    s: &autoshovel_rope_shovel_dig::SurfaceComparison,
+) -> Figure {
     let model = &pile.planned.model;
     let paper = pile.paper;
     let ours = s.plan.plan.as_ref().map(|p| p.decision());

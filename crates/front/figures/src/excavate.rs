@@ -20,7 +20,7 @@ use autoshovel_report::{
     ReportError, Rgb, Stroke, Written,
 };
 
-/// Length of the V_c and F_f direction arrows drawn at a contact [m].
+/// Length of the V_c and F_f direction arrows drawn at a contact (m).
 const ARROW_M: f64 = 0.3;
 
 /// Writes the job's CSV tables and plots of `ex`, planned from `setup`,
@@ -536,7 +536,7 @@ pub fn force_figure(profile: &MachineProfile, ex: &Excavation) -> Figure {
     fig
 }
 
-/// Figs. 5c/6c: joint angles and the attitude angle [deg], and the joint torques.
+/// Figs. 5c/6c: joint angles and the attitude angle (deg), and the joint torques.
 pub fn joint_figures(ex: &Excavation) -> Vec<Figure> {
     let name = &ex.scenario;
     let series = |f: &dyn Fn(&Sample) -> f64| -> Vec<(f64, f64)> {

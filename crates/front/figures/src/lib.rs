@@ -6,9 +6,6 @@
 //! Every `write_*` function takes the output folder and a
 //! [`Written`](autoshovel_report::Written) that records each file written.
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod boulders;
 pub mod dig;
 pub mod excavate;
@@ -36,7 +33,7 @@ pub enum FiguresError {
     Cloud(#[from] autoshovel_point_cloud::CloudError),
     /// A run log (MCAP) could not be written (names the file).
     #[error(transparent)]
-    Link(#[from] autoshovel_plc_link::LinkError),
+    RunLog(#[from] autoshovel_run_log::RunLogError),
     /// A dig file (the warm-start pack) could not be written.
     #[error(transparent)]
     Dig(#[from] autoshovel_rope_shovel_dig::DigError),

@@ -6,10 +6,10 @@
 use std::path::Path;
 
 use autoshovel_core::{heading_vec, Pose2, Vec2};
-use autoshovel_walk_planner::{Direction, Map, Plan, PlanOutcome, Scenario, Shape};
 use autoshovel_report::{
     write_csv, write_figure, write_panels, Figure, Layer, ReportError, Rgb, Stroke, Written,
 };
+use autoshovel_walk_planner::{Direction, Map, Plan, PlanOutcome, Scenario, Shape};
 
 fn xy(v: Vec2) -> (f64, f64) {
     (v.x, v.y)

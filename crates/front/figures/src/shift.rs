@@ -517,9 +517,9 @@ fn base64(bytes: &[u8]) -> String {
 pub fn run_log(
     path: &Path,
     run: &ShiftRun,
-) -> Result<std::path::PathBuf, autoshovel_plc_link::LinkError> {
-    use autoshovel_plc_link::log::{topic, EventMsg, PoseMsg};
-    let mut log = autoshovel_plc_link::RunLog::create(
+) -> Result<std::path::PathBuf, autoshovel_run_log::RunLogError> {
+    use autoshovel_run_log::{topic, EventMsg, PoseMsg};
+    let mut log = autoshovel_run_log::RunLog::create(
         path,
         &[
             ("job", "shift".to_string()),

@@ -1,8 +1,8 @@
 //! Dig-plane drawings of the rope shovel and its pile (our reading of the
 //! rope-shovel paper's Fig. 2, which the text lacks).
 
-use autoshovel_rope_shovel_dig::{DigSurface, Joints, MachineProfile, RopeShovel};
 use autoshovel_report::{Layer, Rgb, Stroke};
+use autoshovel_rope_shovel_dig::{DigSurface, Joints, MachineProfile, RopeShovel};
 
 fn pt(p: [f64; 2]) -> (f64, f64) {
     (p[0], p[1])

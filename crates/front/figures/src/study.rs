@@ -4,10 +4,12 @@
 
 use std::path::Path;
 
-use autoshovel_walk_planner::study::{success_by_obstacles, MapRow, StudyParams, StudySummary, FIELDS};
 use autoshovel_report::{
     finite_cell as cell, write_csv_cells, write_figure, Figure, Layer, ReportError, Rgb, Stroke,
     Written,
+};
+use autoshovel_walk_planner::study::{
+    success_by_obstacles, MapRow, StudyParams, StudySummary, FIELDS,
 };
 
 /// The per-planner columns of `maps.csv`, each prefixed with the planner

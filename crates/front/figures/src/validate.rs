@@ -7,10 +7,10 @@
 
 use std::path::Path;
 
-use autoshovel_rope_shovel_dig::validate::{Paired, ValidateSummary, Validation};
 use autoshovel_report::{
     markdown_table, time_panel, write_csv, write_panels, Figure, Rgb, Written,
 };
+use autoshovel_rope_shovel_dig::validate::{Paired, ValidateSummary, Validation};
 
 /// Errors of the writers here.
 pub type Error = crate::FiguresError;

@@ -5,9 +5,9 @@
 use std::path::{Path, PathBuf};
 use std::sync::atomic::AtomicBool;
 
+use autoshovel_report::{write_index_html, write_summary, Section};
 use autoshovel_walk_planner::study::StudyParams;
 use autoshovel_walk_planner::{FieldKind, Scenario};
-use autoshovel_report::{write_index_html, write_summary, Section};
 use serde_json::{json, Value};
 
 use autoshovel_terrain::perceive::PerceptionParams;
@@ -374,7 +374,11 @@ fn perception(p: &mut Place, r: &mut Report) -> Result<()> {
             &[],
             (&p.ours, p.force),
             |p| {
-                autoshovel_point_cloud::io::write(p, &cloud, autoshovel_point_cloud::io::Encoding::Binary)?;
+                autoshovel_point_cloud::io::write(
+                    p,
+                    &cloud,
+                    autoshovel_point_cloud::io::Encoding::Binary,
+                )?;
                 Ok(())
             },
         )?;
@@ -472,7 +476,9 @@ fn dig(p: &mut Place, r: &mut Report) -> Result<()> {
         section(
             key,
             &description,
-            &autoshovel_report::summary_value(&autoshovel_rope_shovel_dig::table_summary(&job.summary))?,
+            &autoshovel_report::summary_value(&autoshovel_rope_shovel_dig::table_summary(
+                &job.summary,
+            ))?,
             sub,
             // The comparison and each pile's path; the other plots are in the pile folders.
             &job.written

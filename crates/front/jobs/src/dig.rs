@@ -3,12 +3,12 @@
 //! hydraulic excavator's plan round buried boulders ([HE eq. 1]–[HE eq. 10])
 //! and the seeded boulder study.
 
+use autoshovel_excavator_dig::{ExcavateSummary, Setup};
+use autoshovel_figures as figures;
 use autoshovel_rope_shovel_dig::{
     all_surfaces, plan_pile, AllSurfaces, AllSurfacesSummary, DigSetup, DigSummary, Pile,
     PlannedPile, SurfaceComparison,
 };
-use autoshovel_excavator_dig::{ExcavateSummary, Setup};
-use autoshovel_figures as figures;
 use indicatif::ParallelProgressIterator;
 use rayon::prelude::*;
 

@@ -76,6 +76,9 @@ pub enum JobError {
     /// The machine link.
     #[error(transparent)]
     Link(#[from] autoshovel_plc_link::LinkError),
+    /// A run log (written, or read back by `replay`).
+    #[error(transparent)]
+    RunLog(#[from] autoshovel_run_log::RunLogError),
     /// The whole machine's shift.
     #[error(transparent)]
     Shift(#[from] autoshovel_work_shift::ShiftError),

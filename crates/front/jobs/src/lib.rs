@@ -9,9 +9,6 @@
 //! Nothing here decides a result: the checks are of a job's settings, said
 //! in the names the front ends give them.
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod demo;
 mod dig;
 mod error;

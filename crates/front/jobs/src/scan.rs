@@ -3,8 +3,8 @@
 
 use std::path::Path;
 
-use autoshovel_rope_shovel_dig::{MachineProfile, Pile};
 use autoshovel_figures as figures;
+use autoshovel_rope_shovel_dig::{MachineProfile, Pile};
 use autoshovel_terrain::perceive::{
     perceive_file_with, PerceiveSummary, Perceived, PerceptionParams,
 };

@@ -224,8 +224,8 @@ pub fn replay(
     log: &Path,
     planned: Option<&TrackScenario>,
     out: Option<&OutDir>,
-) -> Result<Job<autoshovel_plc_link::replay::ReplaySummary>> {
-    use autoshovel_plc_link::replay::{read_rtk_csv, replay_mcap, replay_rtk};
+) -> Result<Job<autoshovel_run_log::ReplaySummary>> {
+    use autoshovel_run_log::{read_rtk_csv, replay_mcap, replay_rtk};
     use autoshovel_walk_tracker::{ControllerRun, Noise, Tracking};
     let is_csv = log
         .extension()
@@ -259,7 +259,8 @@ pub fn replay(
     let scenario = match planned {
         Some(sc) => sc.clone(),
         None => {
-            let mut sc = autoshovel_walk_tracker::scenario::resolve("straight", Some(Noise::Off), 1)?;
+            let mut sc =
+                autoshovel_walk_tracker::scenario::resolve("straight", Some(Noise::Off), 1)?;
             sc.name = format!("replay of {}", log.display());
             sc.setup.legs = r.legs.clone();
             sc.setup.start = r

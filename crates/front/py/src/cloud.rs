@@ -363,7 +363,7 @@ impl Perception {
         Ok(PyArray1::from_vec(py, z))
     }
 
-    /// The floor height in the levelled frame [m].
+    /// The floor height in the levelled frame (m).
     #[getter]
     fn floor_height_m(&self) -> f64 {
         self.got.floor_height_m
@@ -420,7 +420,7 @@ fn perceive(
     })
 }
 
-/// For `crates/front/py/bench/bench_calls.py`: the wall times [s] of `repeats`
+/// For `crates/front/py/bench/bench_calls.py`: the wall times (s) of `repeats`
 /// calls of one library function made from Rust, on the very array the
 /// script times from Python (the same data, process and machine state).
 /// `kind`: voxel (leaf 0.05 m), statistical (k 50, 1σ), radius (0.05 m, 3),

@@ -5,8 +5,8 @@
 use std::path::{Path, PathBuf};
 
 use autoshovel_core::config::TomlFile as _;
-use autoshovel_rope_shovel_dig::{plan_pile, DigSetup, MachineProfile, Pile, SearchSpace};
 use autoshovel_optim::Init;
+use autoshovel_rope_shovel_dig::{plan_pile, DigSetup, MachineProfile, Pile, SearchSpace};
 use autoshovel_walk_planner::study::{self, MapRow, StudyParams};
 use autoshovel_walk_planner::{FieldKind, PlanOutcome, Scenario};
 use autoshovel_walk_tracker::scenario::Noise;
@@ -206,7 +206,8 @@ fn track<'py>(
 #[pyfunction]
 #[pyo3(signature = (scenario, profile=None))]
 fn plan_excavate(py: Python<'_>, scenario: &str, profile: Option<PathBuf>) -> PyResult<String> {
-    let setup = autoshovel_excavator_dig::Setup::load(scenario, profile.as_deref()).map_err(lib_err)?;
+    let setup =
+        autoshovel_excavator_dig::Setup::load(scenario, profile.as_deref()).map_err(lib_err)?;
     let ex = py.detach(|| setup.run()).map_err(|e| {
         AutoshovelError::new_err(format!(
             "plan-excavate {} ({}): {}",

@@ -10,8 +10,6 @@
 //! place (the filters take `&[Point]`), and handed back by moving the
 //! library's `Vec` into the array, so neither way copies.
 
-use std::fmt::Write as _;
-
 use numpy::ndarray::Array2;
 use numpy::{PyArray2, PyArrayMethods, PyReadonlyArray2, PyUntypedArrayMethods};
 use pyo3::exceptions::{PyTypeError, PyValueError};
@@ -32,16 +30,7 @@ pyo3::create_exception!(
 /// The message of a library error and its causes, as the CLI prints them
 /// (`error: {e:#}`).
 pub(crate) fn message(e: &dyn std::error::Error) -> String {
-    let mut msg = e.to_string();
-    let mut source = e.source();
-    while let Some(s) = source {
-        let text = s.to_string();
-        if !msg.contains(&text) {
-            let _ = write!(msg, ": {text}");
-        }
-        source = s.source();
-    }
-    msg
+    autoshovel_core::error_chain(e)
 }
 
 /// The library's error as Python's `AutoshovelError` with [`message`].

@@ -26,9 +26,6 @@
 //! # }
 //! ```
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 mod clip;
 mod csv;
 mod error;

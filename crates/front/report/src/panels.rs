@@ -22,7 +22,7 @@ pub fn finite_range(values: impl IntoIterator<Item = f64>) -> (f64, f64) {
     }
 }
 
-/// A 1000 px wide figure of `lines` against time [s], `height_px` high,
+/// A 1000 px wide figure of `lines` against time (s), `height_px` high,
 /// with `headroom` of the data's span left free above for the legend and
 /// `marks(lo, hi)` (e.g. vertical lines at events, spanning the y range)
 /// drawn under the lines.

@@ -9,7 +9,7 @@ use autoshovel_excavator_dig::{excavate, AvoidSide, MachineProfile, Scenario, PA
 
 fn main() {
     let profile = MachineProfile::default();
-    // (scenario, side, the paper's volume [m³], the paper's contact times [s])
+    // (scenario, side, the paper's volume (m³), the paper's contact times (s))
     let cases = PAPER_CASES.map(|c| {
         (
             Scenario::builtin(c.scenario).expect("built-in"),

@@ -34,17 +34,16 @@ use nalgebra::{Matrix2x3, Matrix3, Vector3};
 use crate::kinematics::{Backhoe, Joints};
 use crate::profile::MachineProfile;
 
-/// Gravity [m/s²].
-pub const G: f64 = 9.81;
+use autoshovel_core::G;
 
 /// Mass properties of the three links.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct MassModel {
-    /// mᵢ [kg].
+    /// mᵢ (kg).
     pub mass_kg: [f64; 3],
-    /// Centroid distance from the link's own joint along the link [m].
+    /// Centroid distance from the link's own joint along the link (m).
     pub centroid_m: [f64; 3],
-    /// Iᵢ about the centroid [kg·m²].
+    /// Iᵢ about the centroid (kg·m²).
     pub inertia_kg_m2: [f64; 3],
 }
 
@@ -64,7 +63,7 @@ impl MassModel {
     }
 }
 
-/// Kinetic and potential energy at one state [J] (potential zero at y = 0).
+/// Kinetic and potential energy at one state (J) (potential zero at y = 0).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Energy {
     /// ½ q̇ᵀ M q̇.
@@ -188,9 +187,9 @@ impl Dynamics {
         g
     }
 
-    /// Joint torques τ [N·m] that move the front along (q, q̇, q̈) with
+    /// Joint torques τ (N·m) that move the front along (q, q̇, q̈) with
     /// `load_kg` in the bucket against the external tip force `tip_force`
-    /// (the soil's push on the tooth, [N]).
+    /// (the soil's push on the tooth, (N)).
     pub fn inverse_dynamics(
         &self,
         q: &Joints,

@@ -25,11 +25,11 @@ pub enum ExcavateError {
     /// The bucket cannot put its tip at the start of the dig.
     #[error("the dig start ({x_m:.3}, {y_m:.3}) m is out of reach at attitude {:.1}°: {cause}; move the start nearer the machine or change the attitude", attitude_rad.to_degrees())]
     StartOutOfReach {
-        /// Start x [m].
+        /// Start x (m).
         x_m: f64,
-        /// Start y [m].
+        /// Start y (m).
         y_m: f64,
-        /// Attitude angle asked for [rad].
+        /// Attitude angle asked for (rad).
         attitude_rad: f64,
         /// Why.
         cause: IkError,
@@ -43,11 +43,11 @@ pub enum ExcavateError {
     ObstacleEnclosesStart {
         /// Index of the obstacle in the scenario.
         index: usize,
-        /// Its centre [m].
+        /// Its centre (m).
         center_m: [f64; 2],
-        /// Its radius [m].
+        /// Its radius (m).
         radius_m: f64,
-        /// The start [m].
+        /// The start (m).
         start_m: [f64; 2],
     },
     /// The reachable ground cannot hold the volume asked for.
@@ -59,11 +59,11 @@ pub enum ExcavateError {
     TargetVolumeTooLarge {
         /// Which part of the dig (`first half`, `second half`, `re-plan`).
         what: String,
-        /// Volume this part needs [m³].
+        /// Volume this part needs (m³).
         needed_m3: f64,
-        /// The largest volume a feasible candidate held [m³].
+        /// The largest volume a feasible candidate held (m³).
         reachable_m3: f64,
-        /// The last candidate x tried [m].
+        /// The last candidate x tried (m).
         stopped_at_x_m: f64,
         /// Why the search stopped there.
         why: String,
@@ -74,7 +74,7 @@ pub enum ExcavateError {
     NoFeasiblePath {
         /// What was being planned.
         what: String,
-        /// From where [m].
+        /// From where (m).
         from_m: [f64; 2],
         /// Why (the last limit met).
         why: String,
@@ -89,7 +89,7 @@ pub enum ExcavateError {
         index: usize,
         /// The side the preimage rule chose.
         side: AvoidSide,
-        /// Where the tip met it [m].
+        /// Where the tip met it (m).
         contact_m: [f64; 2],
         /// The limit that blocks the way (joint, reach, attitude) and where.
         why: String,
@@ -100,13 +100,13 @@ pub enum ExcavateError {
          than the machine's digging force {max_n:.0} N; dig shallower or in softer soil"
     )]
     SoilTooHard {
-        /// When [s].
+        /// When (s).
         t_s: f64,
-        /// The resistance [N].
+        /// The resistance (N).
         force_n: f64,
-        /// The machine's rating [N].
+        /// The machine's rating (N).
         max_n: f64,
-        /// Tip depth below the ground then [m].
+        /// Tip depth below the ground then (m).
         depth_m: f64,
     },
     /// Defensive: an output path would enter an obstacle envelope. Never returned
@@ -115,7 +115,7 @@ pub enum ExcavateError {
     PathThroughObstacle {
         /// Index of the obstacle.
         index: usize,
-        /// Where [m].
+        /// Where (m).
         at_m: [f64; 2],
     },
     /// More contacts than the planner allows in one pass (each contact costs a

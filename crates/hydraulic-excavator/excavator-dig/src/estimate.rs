@@ -51,7 +51,7 @@ pub const BOULDER_CLASS_SHARE: f64 = 0.3;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct BoulderPrior {
     /// Radius assumed for a boulder touched once; also the least radius a
-    /// refined estimate may take [m].
+    /// refined estimate may take (m).
     pub radius_m: f64,
     /// μ assumed between the tooth and rock, to turn the force into a normal.
     pub rock_friction: f64,
@@ -76,19 +76,19 @@ impl BoulderPrior {
 /// What the machine sensed at a contact: all the planner gets.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Touch {
-    /// Joints at the contact (encoders) [rad].
+    /// Joints at the contact (encoders) (rad).
     pub q: Joints,
-    /// The tooth tip, by forward kinematics [m].
+    /// The tooth tip, by forward kinematics (m).
     pub point: Vec2,
-    /// V_c: the tip velocity (or its planned direction at rest) [m/s].
+    /// V_c: the tip velocity (or its planned direction at rest) (m/s).
     pub velocity: Vec2,
-    /// Measured joint torques at the contact [N·m].
+    /// Measured joint torques at the contact (N·m).
     pub torques_nm: Joints,
-    /// Measured joint torques one step before [N·m].
+    /// Measured joint torques one step before (N·m).
     pub torques_before_nm: Joints,
 }
 
-/// The tip force the torque jump of a touch implies (module docs) [N].
+/// The tip force the torque jump of a touch implies (module docs) (N).
 pub fn force_from_torques(machine: &Backhoe, touch: &Touch) -> Vec2 {
     let j = machine.jacobian(&touch.q); // 2 × 3
     let dtau: Vector3<f64> = touch.torques_nm - touch.torques_before_nm;
@@ -142,7 +142,7 @@ pub fn normal_from_force(force: Vec2, velocity: Vec2, mu: f64) -> Vec2 {
 /// One boulder as the planner believes it.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct BoulderEstimate {
-    /// The envelope planned round [m].
+    /// The envelope planned round (m).
     pub envelope: Envelope,
     /// Every touch on it: (point, estimated normal).
     pub touches: Vec<([f64; 2], [f64; 2])>,

@@ -6,7 +6,7 @@ use serde::{Deserialize, Serialize};
 /// The ground surface in the dig plane.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct Ground {
-    /// Vertices (x, y) [m], x strictly increasing; empty for the level ground y = 0.
+    /// Vertices (x, y) (m), x strictly increasing; empty for the level ground y = 0.
     pub points: Vec<[f64; 2]>,
 }
 
@@ -22,7 +22,7 @@ impl Ground {
         Self { points: Vec::new() }
     }
 
-    /// Height of the ground at x [m].
+    /// Height of the ground at x (m).
     #[inline]
     pub fn height(&self, x: f64) -> f64 {
         let p = &self.points;
@@ -44,7 +44,7 @@ impl Ground {
         }
     }
 
-    /// Depth of a point below the ground (negative above it) [m].
+    /// Depth of a point below the ground (negative above it) (m).
     #[inline]
     pub fn depth(&self, x: f64, y: f64) -> f64 {
         self.height(x) - y

@@ -37,7 +37,7 @@ use serde::Serialize;
 
 use crate::profile::MachineProfile;
 
-/// Joint angles [θ₁ boom, θ₂ stick, θ₃ bucket] [rad].
+/// Joint angles [θ₁ boom, θ₂ stick, θ₃ bucket] (rad).
 pub type Joints = Vector3<f64>;
 
 /// One of the three joints.
@@ -83,11 +83,11 @@ pub enum IkError {
          the boom and stick reach {min_m:.3}..{max_m:.3} m"
     )]
     OutOfReach {
-        /// Distance from the boom foot to the stick pin the pose needs [m].
+        /// Distance from the boom foot to the stick pin the pose needs (m).
         distance_m: f64,
-        /// Least distance boom and stick can make [m].
+        /// Least distance boom and stick can make (m).
         min_m: f64,
-        /// Greatest distance [m].
+        /// Greatest distance (m).
         max_m: f64,
     },
     /// A joint would leave its range.
@@ -98,11 +98,11 @@ pub enum IkError {
     JointOutOfLimit {
         /// The joint.
         joint: Joint,
-        /// The angle the pose needs [rad].
+        /// The angle the pose needs (rad).
         value_rad: f64,
-        /// Lower limit [rad].
+        /// Lower limit (rad).
         min_rad: f64,
-        /// Upper limit [rad].
+        /// Upper limit (rad).
         max_rad: f64,
     },
     /// The digging attitude angle is outside its range.
@@ -111,11 +111,11 @@ pub enum IkError {
         value_rad.to_degrees(), min_rad.to_degrees(), max_rad.to_degrees()
     )]
     AttitudeOutOfRange {
-        /// The attitude angle φ = θ₁ + θ₂ + θ₃ [rad].
+        /// The attitude angle φ = θ₁ + θ₂ + θ₃ (rad).
         value_rad: f64,
-        /// Lower limit [rad].
+        /// Lower limit (rad).
         min_rad: f64,
-        /// Upper limit [rad].
+        /// Upper limit (rad).
         max_rad: f64,
     },
 }
@@ -123,11 +123,11 @@ pub enum IkError {
 /// One row of a D-H table.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct DhLink {
-    /// aᵢ: link length along xᵢ [m].
+    /// aᵢ: link length along xᵢ (m).
     pub a_m: f64,
-    /// αᵢ: link twist about xᵢ [rad].
+    /// αᵢ: link twist about xᵢ (rad).
     pub alpha_rad: f64,
-    /// dᵢ: offset along zᵢ₋₁ [m].
+    /// dᵢ: offset along zᵢ₋₁ (m).
     pub d_m: f64,
 }
 
@@ -160,13 +160,13 @@ impl DhLink {
 /// The tooth tip: position and attitude angle.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipPose {
-    /// Position in the dig plane [m].
+    /// Position in the dig plane (m).
     pub point: Vec2,
-    /// φ = θ₁ + θ₂ + θ₃, unwrapped [rad].
+    /// φ = θ₁ + θ₂ + θ₃, unwrapped (rad).
     pub attitude_rad: f64,
 }
 
-/// Joint and attitude ranges [rad] and speed limits [rad/s].
+/// Joint and attitude ranges (rad) and speed limits (rad/s).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Limits {
     /// Lower joint limits.
@@ -184,7 +184,7 @@ pub struct Limits {
 pub struct Backhoe {
     /// D-H rows for boom, stick, bucket.
     pub dh: [DhLink; 3],
-    /// Boom foot pin in the dig frame [m].
+    /// Boom foot pin in the dig frame (m).
     pub boom_foot: [f64; 2],
     /// Ranges and speed limits.
     pub limits: Limits,
@@ -232,7 +232,7 @@ impl Backhoe {
         }
     }
 
-    /// Link lengths [a₁, a₂, a₃] [m].
+    /// Link lengths [a₁, a₂, a₃] (m).
     pub fn lengths(&self) -> [f64; 3] {
         [self.dh[0].a_m, self.dh[1].a_m, self.dh[2].a_m]
     }
@@ -278,7 +278,7 @@ impl Backhoe {
         }
     }
 
-    /// Stick pin, bucket pin and tooth tip in the dig frame [m].
+    /// Stick pin, bucket pin and tooth tip in the dig frame (m).
     #[inline]
     pub fn joint_points(&self, q: &Joints) -> [Vec2; 3] {
         let [a1, a2, a3] = self.lengths();

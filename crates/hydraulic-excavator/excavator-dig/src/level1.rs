@@ -57,22 +57,22 @@ pub struct StepSearch<'a> {
     pub machine: &'a Backhoe,
     /// The ground line.
     pub ground: &'a Ground,
-    /// h_b [m].
+    /// h_b (m).
     pub bucket_width_m: f64,
-    /// s [m].
+    /// s (m).
     pub step_m: f64,
     /// Trapezoids per candidate path (time samples − 1).
     pub trapezoids: usize,
     /// Fraction of the joint speed limits a segment may use at its peak.
     pub speed_fraction: f64,
-    /// Shortest segment [s].
+    /// Shortest segment (s).
     pub min_segment_time_s: f64,
     /// Boulders known so far (their envelopes must not be entered).
     pub known: &'a [Envelope],
     /// Refine inside the last step (see the module docs); false is the paper's rule.
     pub refine: bool,
     /// How far a path may dip below the dig depth, or below its start where
-    /// that is deeper [m].
+    /// that is deeper (m).
     pub max_overdig_m: f64,
 }
 
@@ -91,15 +91,15 @@ pub enum EndLevel {
 pub struct StepFound {
     /// The segment from the start of the search to the point found.
     pub segment: Segment,
-    /// The point found [m].
+    /// The point found (m).
     pub point: Vec2,
-    /// Its joints [rad].
+    /// Its joints (rad).
     pub joints: Joints,
-    /// Volume of the segment ([HE eq. 2]) [m³].
+    /// Volume of the segment ([HE eq. 2]) (m³).
     pub volume_m3: f64,
     /// n of x′ = x₀ − n·s (when refined: the n of the step refined into).
     pub steps: usize,
-    /// Volume the last step changed (|V(n) − V(n − 1)|, or V(1) at n = 1) [m³].
+    /// Volume the last step changed (|V(n) − V(n − 1)|, or V(1) at n = 1) (m³).
     pub step_volume_m3: f64,
     /// True when the end was refined inside the last step.
     pub refined: bool,
@@ -359,26 +359,26 @@ fn at(p: Vec2, e: IkError) -> String {
 /// Level-1 inputs: the dig the operator asks for.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Level1Request {
-    /// x_begin [m] (the start is on the ground there).
+    /// x_begin (m) (the start is on the ground there).
     pub start_x_m: f64,
-    /// h [m].
+    /// h (m).
     pub depth_m: f64,
-    /// V [m³].
+    /// V (m³).
     pub target_volume_m3: f64,
-    /// Attitude at the start, the midpoint and the end [rad].
+    /// Attitude at the start, the midpoint and the end (rad).
     pub attitude_rad: [f64; 3],
 }
 
 /// A level-1 plan.
 #[derive(Debug, Clone)]
 pub struct Level1Plan {
-    /// (x_begin, ground) [m].
+    /// (x_begin, ground) (m).
     pub start: Vec2,
-    /// (x_mid, −h) [m].
+    /// (x_mid, −h) (m).
     pub mid: Vec2,
-    /// (x_end, ground) [m].
+    /// (x_end, ground) (m).
     pub end: Vec2,
-    /// Joints at the start [rad].
+    /// Joints at the start (rad).
     pub start_joints: Joints,
     /// The first half (descent): volume and search.
     pub first: StepFound,
@@ -387,7 +387,7 @@ pub struct Level1Plan {
 }
 
 impl Level1Plan {
-    /// V_first + V_second [m³].
+    /// V_first + V_second (m³).
     pub fn volume_m3(&self) -> f64 {
         self.first.volume_m3 + self.second.volume_m3
     }

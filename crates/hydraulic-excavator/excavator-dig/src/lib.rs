@@ -11,8 +11,8 @@
 //!   resistance and the simulator that meets boulders the planner does not know.
 //! - [`preimage`], [`search`], [`smooth`]: level 2 — the side from the angle γ,
 //!   the forward search over the free set P and collision set Q, smoothing (§2.2).
-//! - [`plan`]: both levels run against the simulator, with re-planning of the
-//!   remaining volume after each boulder; [`plan::Excavation`] holds everything
+//! - [`excavation`]: both levels run against the simulator, with re-planning of the
+//!   remaining volume after each boulder; [`excavation::Excavation`] holds everything
 //!   to plot and summarise.
 //! - [`profile`], [`scenario`]: the machine and the dig as TOML; [`setup`]
 //!   loads both (built-ins by name) and runs the plan; [`summary`] is the
@@ -30,18 +30,15 @@
 //! # Ok::<(), autoshovel_excavator_dig::ExcavateError>(())
 //! ```
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod dynamics;
 mod error;
 pub mod estimate;
+pub mod excavation;
 pub mod ground;
 pub mod kinematics;
 pub mod level1;
 pub mod obstacle;
 pub mod paper;
-pub mod plan;
 mod planner;
 pub mod preimage;
 pub mod profile;
@@ -59,9 +56,9 @@ pub mod volume;
 
 pub use autoshovel_core::config::TomlFile;
 pub use error::{ExcavateError, Result};
+pub use excavation::{excavate, ContactReport, Excavation, Sample, Summary};
 pub use kinematics::{Backhoe, IkError, Joint, Joints};
 pub use paper::{paper_case, PaperCase, PAPER_CASES};
-pub use plan::{excavate, ContactReport, Excavation, Sample, Summary};
 pub use preimage::AvoidSide;
 pub use profile::MachineProfile;
 pub use scenario::Scenario;

@@ -9,9 +9,9 @@ use serde::{Deserialize, Serialize};
 /// An envelope circle S(p₀, r₀) in the dig plane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct Envelope {
-    /// Centre p₀ = (x₀, y₀) [m].
+    /// Centre p₀ = (x₀, y₀) (m).
     pub center_m: [f64; 2],
-    /// r₀ [m].
+    /// r₀ (m).
     pub radius_m: f64,
 }
 
@@ -31,7 +31,7 @@ impl Envelope {
     }
 
     /// Signed distance of a point from the circle (negative inside, i.e. in
-    /// S of [HE eq. 10]) [m].
+    /// S of [HE eq. 10]) (m).
     #[inline]
     pub fn signed_distance(&self, p: Vec2) -> f64 {
         (p - self.center()).norm() - self.radius_m // [HE eq. 10], as a distance
@@ -55,7 +55,7 @@ impl Envelope {
         }
     }
 
-    /// Area of the circle [m²].
+    /// Area of the circle (m²).
     pub fn area_m2(&self) -> f64 {
         std::f64::consts::PI * self.radius_m * self.radius_m
     }

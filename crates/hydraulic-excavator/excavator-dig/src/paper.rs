@@ -13,9 +13,9 @@ pub struct PaperCase {
     pub figure: &'static str,
     /// The side the bucket passes the boulder.
     pub side: AvoidSide,
-    /// The volume the paper's dig achieved [m³].
+    /// The volume the paper's dig achieved (m³).
     pub volume_m3: f64,
-    /// The contact times the paper reports [s].
+    /// The contact times the paper reports (s).
     pub contacts_s: &'static [f64],
 }
 

@@ -6,7 +6,7 @@
 //! learns of boulders only through [`Touch`]es: what the machine measured at a
 //! contact ([`crate::estimate`]). It holds no [`crate::Scenario`] and no
 //! simulator, so nothing here can read where a boulder really is, how large
-//! it is, or the force the simulator applied; [`crate::plan`] runs it against
+//! it is, or the force the simulator applied; [`crate::excavation`] runs it against
 //! the simulator and measures the result on the truth.
 
 use autoshovel_core::Vec2;
@@ -55,11 +55,11 @@ impl PlannedSegment {
 /// What the planner made of one touch.
 #[derive(Debug, Clone, Serialize)]
 pub struct TouchReading {
-    /// F̂, the force estimated from the torque jump [N].
+    /// F̂, the force estimated from the torque jump (N).
     pub force_n: [f64; 2],
-    /// n̂, the rock's normal estimated from F̂ [m].
+    /// n̂, the rock's normal estimated from F̂ (m).
     pub normal: [f64; 2],
-    /// γ from V_c to F̂ (see [`crate::preimage`]) [rad].
+    /// γ from V_c to F̂ (see [`crate::preimage`]) (rad).
     pub gamma_rad: f64,
     /// The preimage rule's choice.
     pub side: AvoidSide,
@@ -75,7 +75,7 @@ pub(crate) struct DetourPlan {
     pub goal_x_m: f64,
     pub search: SearchPath,
     pub smoothed_m: Vec<[f64; 2]>,
-    /// Least distance of the detour from the estimated envelope, past its first tenth [m].
+    /// Least distance of the detour from the estimated envelope, past its first tenth (m).
     pub planned_clearance_m: f64,
     pub volume_before_replan_m3: f64,
     pub replanned_m: Vec<[f64; 2]>,
@@ -127,7 +127,7 @@ impl<'a> Planner<'a> {
         self.brief.step_search(&self.machine, self.width_m, known)
     }
 
-    /// The tip path of `segments` sampled every dt [m].
+    /// The tip path of `segments` sampled every dt (m).
     pub fn sample_path(&self, segments: &[Segment]) -> Vec<[f64; 2]> {
         let dt = self.brief.planner.dt_s;
         let mut out = Vec::new();
@@ -155,7 +155,7 @@ impl<'a> Planner<'a> {
         self.first_half_done = true;
     }
 
-    /// (soil, boulders) volume [m³] the planner counts for a path with
+    /// (soil, boulders) volume (m³) the planner counts for a path with
     /// [HE eq. 2] area `area`, with its estimated boulders.
     pub fn counted(&self, path: &[Vec2], area: f64) -> (f64, f64) {
         let envelopes = self.estimates.envelopes();
@@ -304,7 +304,7 @@ impl<'a> Planner<'a> {
     }
 
     /// Level 1 from a detour's end to the remaining volume (module docs of
-    /// [`crate::plan`]).
+    /// [`crate::excavation`]).
     fn plan_rest(
         &mut self,
         from: Vec2,

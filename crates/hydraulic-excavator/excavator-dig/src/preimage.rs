@@ -65,7 +65,7 @@ pub enum GammaReading {
 }
 
 impl GammaReading {
-    /// γ [rad] in [0, 2π) from the tip velocity to the contact force.
+    /// γ (rad) in [0, 2π) from the tip velocity to the contact force.
     pub fn gamma_rad(self, velocity: Vec2, force: Vec2) -> f64 {
         let g = gamma_rad(velocity, force);
         match self {
@@ -75,7 +75,7 @@ impl GammaReading {
     }
 }
 
-/// γ [rad] in [0, 2π): clockwise angle from the tip velocity to the contact force (module docs).
+/// γ (rad) in [0, 2π): clockwise angle from the tip velocity to the contact force (module docs).
 pub fn gamma_rad(velocity: Vec2, force: Vec2) -> f64 {
     let cross = velocity.x * force.y - velocity.y * force.x;
     let dot = velocity.dot(&force);

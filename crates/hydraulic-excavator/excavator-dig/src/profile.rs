@@ -24,15 +24,15 @@ pub const EXCAVATOR_15T_TOML: &str = include_str!("../profiles/excavator-15t.tom
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GeometrySpec {
-    /// a₁: boom foot pin to stick pin [m].
+    /// a₁: boom foot pin to stick pin (m).
     pub boom_length_m: f64,
-    /// a₂: stick pin to bucket pin [m].
+    /// a₂: stick pin to bucket pin (m).
     pub stick_length_m: f64,
-    /// a₃: bucket pin to tooth tip [m].
+    /// a₃: bucket pin to tooth tip (m).
     pub bucket_tip_radius_m: f64,
-    /// Horizontal distance of the boom foot pin ahead of the slew axis [m].
+    /// Horizontal distance of the boom foot pin ahead of the slew axis (m).
     pub boom_foot_x_m: f64,
-    /// Height of the boom foot pin above the ground [m].
+    /// Height of the boom foot pin above the ground (m).
     pub boom_foot_height_m: f64,
 }
 
@@ -40,43 +40,43 @@ pub struct GeometrySpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct BucketSpec {
-    /// Heaped capacity [m³].
+    /// Heaped capacity (m³).
     pub capacity_m3: f64,
-    /// h_b: opening width across the dig plane ([HE eq. 2]) [m].
+    /// h_b: opening width across the dig plane ([HE eq. 2]) (m).
     pub width_m: f64,
 }
 
-/// Joint ranges of the D-H joint angles [deg] (see [`crate::kinematics`]).
+/// Joint ranges of the D-H joint angles (deg) (see [`crate::kinematics`]).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct JointLimitsSpec {
-    /// θ₁ (boom from the horizontal), lower [deg].
+    /// θ₁ (boom from the horizontal), lower (deg).
     pub boom_min_deg: f64,
-    /// θ₁ upper [deg].
+    /// θ₁ upper (deg).
     pub boom_max_deg: f64,
-    /// θ₂ (stick relative to the boom), lower [deg].
+    /// θ₂ (stick relative to the boom), lower (deg).
     pub stick_min_deg: f64,
-    /// θ₂ upper [deg].
+    /// θ₂ upper (deg).
     pub stick_max_deg: f64,
-    /// θ₃ (bucket link relative to the stick), lower [deg].
+    /// θ₃ (bucket link relative to the stick), lower (deg).
     pub bucket_min_deg: f64,
-    /// θ₃ upper [deg].
+    /// θ₃ upper (deg).
     pub bucket_max_deg: f64,
-    /// Digging attitude angle φ = θ₁ + θ₂ + θ₃, lower [deg].
+    /// Digging attitude angle φ = θ₁ + θ₂ + θ₃, lower (deg).
     pub attitude_min_deg: f64,
-    /// φ upper [deg].
+    /// φ upper (deg).
     pub attitude_max_deg: f64,
 }
 
-/// Joint speed limits [deg/s].
+/// Joint speed limits (deg/s).
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SpeedLimitsSpec {
-    /// |θ̇₁| [deg/s].
+    /// |θ̇₁| (deg/s).
     pub boom_deg_s: f64,
-    /// |θ̇₂| [deg/s].
+    /// |θ̇₂| (deg/s).
     pub stick_deg_s: f64,
-    /// |θ̇₃| [deg/s].
+    /// |θ̇₃| (deg/s).
     pub bucket_deg_s: f64,
 }
 
@@ -84,23 +84,23 @@ pub struct SpeedLimitsSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MassesSpec {
-    /// Boom mass [kg].
+    /// Boom mass (kg).
     pub boom_kg: f64,
-    /// Boom centroid, from the boom foot along the link [m].
+    /// Boom centroid, from the boom foot along the link (m).
     pub boom_centroid_m: f64,
-    /// Boom moment of inertia about its centroid [kg·m²].
+    /// Boom moment of inertia about its centroid (kg·m²).
     pub boom_inertia_kg_m2: f64,
-    /// Stick mass [kg].
+    /// Stick mass (kg).
     pub stick_kg: f64,
-    /// Stick centroid, from the stick pin along the link [m].
+    /// Stick centroid, from the stick pin along the link (m).
     pub stick_centroid_m: f64,
-    /// Stick moment of inertia about its centroid [kg·m²].
+    /// Stick moment of inertia about its centroid (kg·m²).
     pub stick_inertia_kg_m2: f64,
-    /// Empty bucket mass [kg].
+    /// Empty bucket mass (kg).
     pub bucket_kg: f64,
-    /// Bucket (and load) centroid, from the bucket pin along the link [m].
+    /// Bucket (and load) centroid, from the bucket pin along the link (m).
     pub bucket_centroid_m: f64,
-    /// Empty bucket moment of inertia about its centroid [kg·m²].
+    /// Empty bucket moment of inertia about its centroid (kg·m²).
     pub bucket_inertia_kg_m2: f64,
 }
 
@@ -108,7 +108,7 @@ pub struct MassesSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ForceSpec {
-    /// Greatest digging force at the tooth tip [N]. Soil resisting more is an
+    /// Greatest digging force at the tooth tip (N). Soil resisting more is an
     /// error (SPEC §5, out of scope); a boulder stalls the bucket at this force.
     pub max_digging_force_n: f64,
 }

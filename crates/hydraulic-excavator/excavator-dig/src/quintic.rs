@@ -20,7 +20,7 @@ pub const PEAK_RATE: f64 = 15.0 / 8.0;
 pub struct Quintic {
     /// a₀ … a₅.
     pub coeffs: [f64; 6],
-    /// T [s].
+    /// T (s).
     pub duration_s: f64,
 }
 
@@ -69,11 +69,11 @@ pub fn blend(tau: f64) -> [f64; 3] {
 /// A quintic in joint space from `q0` to `q1` over `duration_s`, at rest at both ends.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct JointQuintic {
-    /// Start joints [rad].
+    /// Start joints (rad).
     pub q0: Joints,
-    /// End joints [rad].
+    /// End joints (rad).
     pub q1: Joints,
-    /// T [s].
+    /// T (s).
     pub duration_s: f64,
 }
 

@@ -104,19 +104,19 @@ pub const SIM_STEP_BYTES: f64 = 300.0;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct DigSpec {
-    /// x_begin [m]; the start is on the ground there.
+    /// x_begin (m); the start is on the ground there.
     pub start_x_m: f64,
-    /// h: depth of the midpoint below the ground [m].
+    /// h: depth of the midpoint below the ground (m).
     pub depth_m: f64,
-    /// s: step of the level-1 search and the level-2 grid [m].
+    /// s: step of the level-1 search and the level-2 grid (m).
     pub step_m: f64,
-    /// V [m³].
+    /// V (m³).
     pub target_volume_m3: f64,
-    /// Attitude angle φ at the start [deg].
+    /// Attitude angle φ at the start (deg).
     pub attitude_start_deg: f64,
-    /// φ at the midpoint [deg].
+    /// φ at the midpoint (deg).
     pub attitude_mid_deg: f64,
-    /// φ at the end [deg].
+    /// φ at the end (deg).
     pub attitude_end_deg: f64,
 }
 
@@ -124,15 +124,15 @@ pub struct DigSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PlannerSpec {
-    /// Margin the forward search keeps from every envelope [m].
+    /// Margin the forward search keeps from every envelope (m).
     pub clearance_m: f64,
-    /// How far beyond the inflated envelope the search grid reaches [m].
+    /// How far beyond the inflated envelope the search grid reaches (m).
     pub search_window_m: f64,
     /// Share of each joint's speed limit a segment may use at its peak.
     pub speed_fraction: f64,
-    /// Shortest segment [s].
+    /// Shortest segment (s).
     pub min_segment_time_s: f64,
-    /// Simulator time step [s].
+    /// Simulator time step (s).
     pub dt_s: f64,
     /// Trapezoids ([HE eq. 2]) per planned segment.
     pub trapezoids: usize,
@@ -142,10 +142,10 @@ pub struct PlannerSpec {
     /// (false: the paper's rule, the nearer of the two last candidates).
     pub refine_volume: bool,
     /// How far a level-1 path may dip below the dig depth (or below its
-    /// start, where that is deeper) [m].
+    /// start, where that is deeper) (m).
     pub max_overdig_m: f64,
     /// The radius the planner assumes for a boulder touched once, and the
-    /// least it ever estimates [m]; absent: the paper's class, a disc across
+    /// least it ever estimates (m); absent: the paper's class, a disc across
     /// the bucket holding 30 % of its volume ([`crate::estimate`]).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub boulder_radius_m: Option<f64>,
@@ -167,7 +167,7 @@ fn default_rock_friction_prior() -> f64 {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
 pub struct SensingSpec {
-    /// Standard deviation of each measured joint torque [N·m].
+    /// Standard deviation of each measured joint torque (N·m).
     pub torque_noise_nm: f64,
     /// Seed of the noise.
     pub seed: u64,

@@ -40,18 +40,18 @@ use crate::preimage::AvoidSide;
 /// Settings of the forward search.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct SearchParams {
-    /// Grid step s [m].
+    /// Grid step s (m).
     pub step_m: f64,
-    /// Margin kept from every envelope [m].
+    /// Margin kept from every envelope (m).
     pub clearance_m: f64,
-    /// How far beyond the inflated envelope the grid reaches [m].
+    /// How far beyond the inflated envelope the grid reaches (m).
     pub window_m: f64,
 }
 
 /// A way round found.
 #[derive(Debug, Clone, Serialize)]
 pub struct SearchPath {
-    /// Grid waypoints from the back-off point to the goal [m].
+    /// Grid waypoints from the back-off point to the goal (m).
     pub waypoints: Vec<[f64; 2]>,
     /// |P|: free points classified.
     pub free_points: usize,

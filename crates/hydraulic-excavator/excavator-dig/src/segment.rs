@@ -43,15 +43,15 @@ impl SegmentKind {
 /// The state of the front at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MotionState {
-    /// Joints [rad].
+    /// Joints (rad).
     pub q: Joints,
-    /// Joint rates [rad/s].
+    /// Joint rates (rad/s).
     pub qd: Joints,
-    /// Joint accelerations [rad/s²].
+    /// Joint accelerations (rad/s²).
     pub qdd: Joints,
-    /// Tooth tip [m].
+    /// Tooth tip (m).
     pub tip: Vec2,
-    /// Tip velocity [m/s].
+    /// Tip velocity (m/s).
     pub tip_velocity: Vec2,
     /// Unit direction of motion, defined even at rest (the path's tangent).
     pub direction: Vec2,
@@ -64,9 +64,9 @@ pub struct DetourMotion {
     pub spline: CubicBSpline,
     d1: CubicBSpline,
     d2: CubicBSpline,
-    /// φ held along the detour [rad].
+    /// φ held along the detour (rad).
     pub attitude_rad: f64,
-    /// T [s].
+    /// T (s).
     pub duration_s: f64,
 }
 
@@ -89,7 +89,7 @@ pub struct Segment {
 }
 
 impl Segment {
-    /// Duration [s].
+    /// Duration (s).
     pub fn duration_s(&self) -> f64 {
         match &self.motion {
             Motion::Joint(j) => j.duration_s,

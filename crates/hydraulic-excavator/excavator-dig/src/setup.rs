@@ -6,7 +6,7 @@ use std::path::Path;
 use autoshovel_core::config::TomlFile;
 
 use crate::error::Result;
-use crate::plan::{excavate, Excavation};
+use crate::excavation::{excavate, Excavation};
 use crate::profile::{MachineProfile, EXCAVATOR_15T, EXCAVATOR_15T_TOML};
 use crate::scenario::Scenario;
 

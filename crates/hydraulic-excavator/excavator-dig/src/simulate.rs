@@ -38,9 +38,9 @@ pub struct SoilSim<'a> {
     pub soil: &'a Soil,
     /// Every boulder, known or not.
     pub obstacles: &'a [Envelope],
-    /// h_b [m].
+    /// h_b (m).
     pub bucket_width_m: f64,
-    /// The machine's digging force, which a boulder stalls [N].
+    /// The machine's digging force, which a boulder stalls (N).
     pub max_force_n: f64,
 }
 
@@ -49,24 +49,24 @@ pub struct SoilSim<'a> {
 pub struct Contact {
     /// Index of the boulder.
     pub obstacle: usize,
-    /// Local time in the segment [s].
+    /// Local time in the segment (s).
     pub t_local_s: f64,
     /// The state of the front at the contact.
     pub state: MotionState,
-    /// The contact point (on the rim, outside by at most rounding) [m].
+    /// The contact point (on the rim, outside by at most rounding) (m).
     pub point: Vec2,
     /// Outward normal of the envelope there.
     pub normal: Vec2,
-    /// V_c: the tip velocity (its direction of motion if at rest) [m/s].
+    /// V_c: the tip velocity (its direction of motion if at rest) (m/s).
     pub velocity: Vec2,
-    /// F_f: the boulder's push on the tooth [N].
+    /// F_f: the boulder's push on the tooth (N).
     pub force: Vec2,
 }
 
 /// What one segment did in the simulator.
 #[derive(Debug, Clone)]
 pub struct SegmentRun {
-    /// (local time [s], state) at every step, from the first step after 0;
+    /// (local time (s), state) at every step, from the first step after 0;
     /// ends at the segment's end or at the contact.
     pub states: Vec<(f64, MotionState)>,
     /// The first contact, if any.
@@ -74,7 +74,7 @@ pub struct SegmentRun {
 }
 
 impl SoilSim<'_> {
-    /// The soil's resistance on the tooth at a state [N].
+    /// The soil's resistance on the tooth at a state (N).
     pub fn resistance(&self, state: &MotionState) -> Vec2 {
         self.soil
             .resistance(self.ground, state.tip, state.direction, self.bucket_width_m)
@@ -190,7 +190,7 @@ impl TorqueSensor {
         }
     }
 
-    /// One reading of the torques `tau` [N·m].
+    /// One reading of the torques `tau` (N·m).
     pub fn measure(&mut self, tau: &Joints) -> Joints {
         match &self.noise {
             Some(n) => tau.map(|t| t + n.sample(&mut self.rng)),

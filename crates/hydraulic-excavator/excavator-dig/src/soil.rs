@@ -9,7 +9,7 @@
 //!     F_n = ψ·F_τ        along n̂ = v̂ turned 90° clockwise, the upper side of the motion
 //! ```
 //!
-//! with the specific cutting resistance k [Pa], the bucket width b = h_b and
+//! with the specific cutting resistance k (Pa), the bucket width b = h_b and
 //! the cut thickness c, here the depth of the tooth below the ground (in one
 //! pass the bucket takes the whole slice above its tip, which is [HE eq. 2]'s
 //! volume model). F_n pushes the tooth out of the uncut bank, towards the
@@ -32,11 +32,11 @@ use crate::ground::Ground;
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Soil {
-    /// k of F_τ = k·b·c [Pa]. Loam ≈ 40–100 kPa, clay ≈ 100–250 kPa.
+    /// k of F_τ = k·b·c (Pa). Loam ≈ 40–100 kPa, clay ≈ 100–250 kPa.
     pub cutting_resistance_pa: f64,
     /// ψ of F_n = ψ·F_τ.
     pub normal_ratio: f64,
-    /// Bank density of the dug soil, carried in the bucket [kg/m³].
+    /// Bank density of the dug soil, carried in the bucket (kg/m³).
     pub density_kg_m3: f64,
     /// μ: Coulomb friction between the tooth and a boulder.
     pub rock_friction: f64,
@@ -44,7 +44,7 @@ pub struct Soil {
 
 impl Soil {
     /// Resistance on the tooth at `tip` moving along `direction` (need not be
-    /// unit), for a bucket `width_m` wide [N]. Zero above the ground or when
+    /// unit), for a bucket `width_m` wide (N). Zero above the ground or when
     /// the direction is undefined.
     #[inline]
     pub fn resistance(&self, ground: &Ground, tip: Vec2, direction: Vec2, width_m: f64) -> Vec2 {
@@ -61,7 +61,7 @@ impl Soil {
 
     /// The boulder's push on a tooth that meets its envelope at a point with
     /// outward normal `normal`, moving with velocity (or direction) `velocity`,
-    /// for a machine of digging force `max_force_n` [N] (module docs).
+    /// for a machine of digging force `max_force_n` (N) (module docs).
     pub fn contact_force(&self, normal: Vec2, velocity: Vec2, max_force_n: f64) -> Vec2 {
         let tangential = velocity - normal * velocity.dot(&normal);
         let t = tangential.norm();

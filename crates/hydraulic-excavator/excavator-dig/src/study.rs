@@ -21,8 +21,8 @@ use rand::{Rng, SeedableRng};
 use rand_chacha::ChaCha8Rng;
 use serde::Serialize;
 
+use crate::excavation::excavate;
 use crate::obstacle::Envelope;
-use crate::plan::excavate;
 use crate::profile::MachineProfile;
 use crate::scenario::Scenario;
 
@@ -33,7 +33,7 @@ pub struct BoulderStudyParams {
     pub cases: usize,
     /// Seed of the draws.
     pub seed: u64,
-    /// Range of radii [m].
+    /// Range of radii (m).
     pub radius_m: [f64; 2],
 }
 
@@ -66,9 +66,9 @@ pub struct CaseOutcome {
     pub contacts: usize,
     /// Contacts beyond the first with each boulder.
     pub extra_contacts: usize,
-    /// Least clearance of a detour from the real boulder [m] (NaN without one).
+    /// Least clearance of a detour from the real boulder (m) (NaN without one).
     pub min_detour_clearance_m: f64,
-    /// Estimated radius after the last touch [m] (NaN without contact).
+    /// Estimated radius after the last touch (m) (NaN without contact).
     pub estimated_radius_m: f64,
 }
 
@@ -88,19 +88,19 @@ pub struct CaseRow {
 pub struct VariantSummary {
     /// Its name.
     pub planner: &'static str,
-    /// Completed digs [%].
+    /// Completed digs (%).
     pub completed_pct: f64,
-    /// Median |volume error| over completed digs [%].
+    /// Median |volume error| over completed digs (%).
     pub median_abs_volume_error_pct: f64,
-    /// 90th percentile |volume error| over completed digs [%].
+    /// 90th percentile |volume error| over completed digs (%).
     pub p90_abs_volume_error_pct: f64,
-    /// Completed digs within 2 % of the target [%].
+    /// Completed digs within 2 % of the target (%).
     pub within_2pct: f64,
     /// Mean contacts per case.
     pub mean_contacts: f64,
-    /// Cases with a second touch on the same boulder [%].
+    /// Cases with a second touch on the same boulder (%).
     pub extra_contact_pct: f64,
-    /// Least detour clearance from the real boulder over the study [m].
+    /// Least detour clearance from the real boulder over the study (m).
     pub min_detour_clearance_m: f64,
 }
 
@@ -113,7 +113,7 @@ pub struct BoulderStudySummary {
     pub params: BoulderStudyParams,
     /// The base scenario.
     pub scenario: String,
-    /// The class prior radius for this bucket [m].
+    /// The class prior radius for this bucket (m).
     pub class_radius_m: f64,
     /// One row per planner.
     pub planners: Vec<VariantSummary>,

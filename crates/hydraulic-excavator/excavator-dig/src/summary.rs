@@ -7,7 +7,7 @@
 
 use serde::Serialize;
 
-use crate::plan::{Excavation, Level1Report, SegmentReport, Summary};
+use crate::excavation::{Excavation, Level1Report, SegmentReport, Summary};
 use crate::preimage::AvoidSide;
 use crate::segment::SegmentKind;
 use crate::setup::Setup;
@@ -29,13 +29,13 @@ pub struct ExcavateSummary {
     pub scenario_source: String,
     /// `builtin excavator-15t` or the profile file's path.
     pub profile: String,
-    /// 100 · (achieved − target)/target [%].
+    /// 100 · (achieved − target)/target (%).
     pub volume_error_pct: f64,
     /// The side chosen at each contact, in order.
     pub avoid_directions: Vec<AvoidSide>,
     /// How many boulders were met.
     pub contact_count: usize,
-    /// Start of the first plan [m].
+    /// Start of the first plan (m).
     pub level1_start_m: [f64; 2],
     /// The first (level-1) plan.
     pub level1: Level1Report,
@@ -45,15 +45,15 @@ pub struct ExcavateSummary {
     pub detours: Vec<DetourSummary>,
     /// Every segment executed, in order.
     pub segments: Vec<SegmentSummary>,
-    /// Peak |F| on the tooth, contacts included [N].
+    /// Peak |F| on the tooth, contacts included (N).
     pub peak_digging_force_n: f64,
-    /// The machine's digging-force rating [N].
+    /// The machine's digging-force rating (N).
     pub max_digging_force_n: f64,
     /// Number of executed samples.
     pub samples: usize,
-    /// s, the step of the step search and the search grid [m].
+    /// s, the step of the step search and the search grid (m).
     pub step_m: f64,
-    /// h, the dig depth [m].
+    /// h, the dig depth (m).
     pub depth_m: f64,
     /// Whether the step search bisected inside its last step.
     pub refine_volume: bool,
@@ -62,11 +62,11 @@ pub struct ExcavateSummary {
 /// One boulder of the scenario.
 #[derive(Debug, Clone, Serialize)]
 pub struct ObstacleSummary {
-    /// Envelope centre [m].
+    /// Envelope centre (m).
     pub center_m: [f64; 2],
-    /// Envelope radius [m].
+    /// Envelope radius (m).
     pub radius_m: f64,
-    /// Its volume across the bucket's width [m³].
+    /// Its volume across the bucket's width (m³).
     pub volume_m3: f64,
     /// True when the tooth met it.
     pub met: bool,
@@ -79,14 +79,14 @@ pub struct DetourSummary {
     pub contact: usize,
     /// The side passed.
     pub side: AvoidSide,
-    /// The goal line x [m].
+    /// The goal line x (m).
     pub goal_x_m: f64,
     /// Least distance of the smoothed detour from the envelope met (null
-    /// when not finite) [m].
+    /// when not finite) (m).
     pub clearance_m: f64,
-    /// Start of its segment [s].
+    /// Start of its segment (s).
     pub t_start_s: f64,
-    /// End of its segment, or the contact that cut it short [s].
+    /// End of its segment, or the contact that cut it short (s).
     pub t_end_s: f64,
     /// False when a contact cut it short.
     pub completed: bool,
@@ -98,7 +98,7 @@ pub struct DetourSummary {
     pub blocked_points: usize,
     /// Points expanded.
     pub expanded: usize,
-    /// Volume counted when it was planned [m³].
+    /// Volume counted when it was planned (m³).
     pub volume_before_replan_m3: f64,
 }
 
@@ -107,15 +107,15 @@ pub struct DetourSummary {
 pub struct SegmentSummary {
     /// Its role.
     pub kind: SegmentKind,
-    /// Start [s].
+    /// Start (s).
     pub t_start_s: f64,
-    /// End, or the contact that cut it short [s].
+    /// End, or the contact that cut it short (s).
     pub t_end_s: f64,
-    /// Start point [m].
+    /// Start point (m).
     pub from_m: [f64; 2],
-    /// Planned end point [m].
+    /// Planned end point (m).
     pub to_m: [f64; 2],
-    /// Volume planned for it (none for a detour) [m³].
+    /// Volume planned for it (none for a detour) (m³).
     pub planned_volume_m3: Option<f64>,
     /// False when a contact cut it short.
     pub completed: bool,

@@ -16,7 +16,7 @@ use autoshovel_core::Vec2;
 use crate::ground::Ground;
 use crate::obstacle::Envelope;
 
-/// [HE eq. 2] as printed: equal intervals on [a, b] with depths y₀ … yₙ, times h_b [m³].
+/// [HE eq. 2] as printed: equal intervals on [a, b] with depths y₀ … yₙ, times h_b (m³).
 pub fn trapezoid_volume(a: f64, b: f64, depths: &[f64], width_m: f64) -> f64 {
     if depths.len() < 2 {
         return 0.0;
@@ -30,7 +30,7 @@ pub fn trapezoid_volume(a: f64, b: f64, depths: &[f64], width_m: f64) -> f64 {
         * width_m
 }
 
-/// Area between the ground and a sampled tip path [m²]: [HE eq. 2] on
+/// Area between the ground and a sampled tip path (m²): [HE eq. 2] on
 /// time samples (module docs).
 pub fn swept_area(ground: &Ground, path: &[Vec2]) -> f64 {
     let mut area = 0.0;
@@ -46,7 +46,7 @@ pub fn swept_area(ground: &Ground, path: &[Vec2]) -> f64 {
 }
 
 /// The strip of one more sample appended to a path: ½(d_prev + d)(x_prev − x),
-/// one trapezoid of [HE eq. 2] [m²].
+/// one trapezoid of [HE eq. 2] (m²).
 #[inline]
 pub fn strip(ground: &Ground, prev: Vec2, next: Vec2) -> f64 {
     let d0 = ground.depth(prev.x, prev.y).max(0.0);
@@ -54,7 +54,7 @@ pub fn strip(ground: &Ground, prev: Vec2, next: Vec2) -> f64 {
     0.5 * (d0 + d1) * (prev.x - next.x) // [HE eq. 2]
 }
 
-/// Area of the part of a disc below the ground [m²]: Simpson over
+/// Area of the part of a disc below the ground (m²): Simpson over
 /// x = x₀ + r sin θ (200 intervals), which removes the square-root ends.
 pub fn disc_area_below(ground: &Ground, center: Vec2, radius: f64) -> f64 {
     let n = 200;
@@ -74,8 +74,8 @@ pub fn disc_area_below(ground: &Ground, center: Vec2, radius: f64) -> f64 {
     s * h / 3.0
 }
 
-/// (soil, boulders) volume [m³] of a dig whose executed tip path `path` has
-/// the [HE eq. 2] area `area` [m²], with a bucket `width_m` wide: the soil is
+/// (soil, boulders) volume (m³) of a dig whose executed tip path `path` has
+/// the [HE eq. 2] area `area` (m²), with a bucket `width_m` wide: the soil is
 /// that area less the part of every boulder lying inside it, times the width;
 /// a boulder counts whole (π r²·b, a disc across the bucket) when it lies
 /// inside the dug area or `met[i]` says the bucket met it (the paper counts a

@@ -211,10 +211,11 @@ fn a_boulder_met_during_a_detour_starts_a_new_cycle() {
     // A second, smaller boulder lies on the way over the first.
     let mut s = Scenario::paper_over();
     s.planner.refine_volume = true;
-    s.obstacles.push(autoshovel_excavator_dig::obstacle::Envelope {
-        center_m: [6.35, -0.30],
-        radius_m: 0.12,
-    });
+    s.obstacles
+        .push(autoshovel_excavator_dig::obstacle::Envelope {
+            center_m: [6.35, -0.30],
+            radius_m: 0.12,
+        });
     let ex = run(&s);
     assert_eq!(ex.contacts.len(), 2);
     use autoshovel_excavator_dig::segment::SegmentKind::Detour;

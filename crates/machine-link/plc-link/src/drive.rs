@@ -30,14 +30,16 @@ use serde::Serialize;
 use tokio::time::Instant;
 
 use crate::error::LinkError;
-use crate::log::{topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, RtkMsg, RunLog, TickMsg};
 use crate::model::{self, Var, Writer, ACKNOWLEDGE, NAMESPACE_URI};
 use crate::pki::{self, Role};
+use autoshovel_run_log::{
+    topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, RtkMsg, RunLog, TickMsg,
+};
 
 /// Messages of any type through one logging closure.
 mod erased {
     use crate::error::LinkError;
-    use crate::log::RunLog;
+    use autoshovel_run_log::RunLog;
 
     pub trait Msg {
         fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError>;
@@ -45,7 +47,7 @@ mod erased {
 
     impl<T: serde::Serialize> Msg for T {
         fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError> {
-            log.write(topic, t, self)
+            Ok(log.write(topic, t, self)?)
         }
     }
 }
@@ -131,7 +133,7 @@ pub struct Link {
 /// What the link saw, in the summary.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct LinkEvent {
-    /// Wall-clock time since the run started [s].
+    /// Wall-clock time since the run started (s).
     pub wall_s: f64,
     /// Kind: `link-lost`, `link-restored`, `plc-fault`, `acknowledged`, `interrupted`, `zeroed`.
     pub kind: &'static str,
@@ -143,6 +145,31 @@ fn connect_err(endpoint: &str, why: impl Into<String>) -> LinkError {
     LinkError::Connect {
         endpoint: endpoint.to_string(),
         why: why.into(),
+        source: None,
+    }
+}
+
+/// A session that did not open for the stack's `source`, with the hint
+/// [`explain`] finds in its words.
+fn connect_failed(
+    endpoint: &str,
+    source: opcua::types::Error,
+    pki_root: &std::path::Path,
+) -> LinkError {
+    let why = explain(&source.to_string(), pki_root);
+    LinkError::Connect {
+        endpoint: endpoint.to_string(),
+        why,
+        source: Some(source),
+    }
+}
+
+/// A service call that failed in the stack or on the wire.
+fn service_err(endpoint: &str, service: &'static str, source: opcua::types::Error) -> LinkError {
+    LinkError::Service {
+        endpoint: endpoint.to_string(),
+        service,
+        source,
     }
 }
 
@@ -192,7 +219,7 @@ impl Link {
         )
         .await
         .map_err(|_| connect_err(&p.endpoint, "no answer (is plc-sim running there?)"))?
-        .map_err(|e| connect_err(&p.endpoint, explain(&e.to_string(), &p.pki)))?;
+        .map_err(|e| connect_failed(&p.endpoint, e, &p.pki))?;
         let policy_uri = p.policy.policy().to_uri();
         let mut endpoint = found
             .into_iter()
@@ -217,7 +244,7 @@ impl Link {
         endpoint.endpoint_url = p.endpoint.as_str().into();
         let (session, event_loop) = client
             .connect_to_endpoint_directly(endpoint, identity)
-            .map_err(|e| connect_err(&p.endpoint, explain(&e.to_string(), &p.pki)))?;
+            .map_err(|e| connect_failed(&p.endpoint, e, &p.pki))?;
         let event_loop = event_loop.spawn();
         let ok = tokio::time::timeout(p.connect_timeout, session.wait_for_connection())
             .await
@@ -264,7 +291,7 @@ impl Link {
             .session
             .read(&ids, TimestampsToReturn::Neither, 0.0)
             .await
-            .map_err(|e| connect_err(&self.endpoint, e.to_string()))?;
+            .map_err(|e| service_err(&self.endpoint, "read", e))?;
         let mut sim_nodes = 0;
         for (v, dv) in model::VARIABLES.iter().zip(got) {
             let status = dv.status.unwrap_or(StatusCode::Good);
@@ -324,7 +351,7 @@ impl Link {
             .session
             .write(&w)
             .await
-            .map_err(|e| connect_err(&self.endpoint, e.to_string()))?;
+            .map_err(|e| service_err(&self.endpoint, "write", e))?;
         for (wv, st) in w.iter().zip(res) {
             if st.is_bad() {
                 return Err(LinkError::Refused {
@@ -345,7 +372,7 @@ impl Link {
             .session
             .call_one(req)
             .await
-            .map_err(|e| connect_err(&self.endpoint, e.to_string()))?;
+            .map_err(|e| service_err(&self.endpoint, "method call", e))?;
         if r.status_code.is_bad() {
             return Err(LinkError::Refused {
                 endpoint: self.endpoint.clone(),
@@ -369,7 +396,7 @@ impl Link {
             .session
             .call_one(req)
             .await
-            .map_err(|e| connect_err(&self.endpoint, e.to_string()))?;
+            .map_err(|e| service_err(&self.endpoint, "method call", e))?;
         if r.status_code.is_bad() {
             return Err(LinkError::Refused {
                 endpoint: self.endpoint.clone(),
@@ -419,7 +446,7 @@ impl Link {
             .session
             .read(&ids, TimestampsToReturn::Neither, 0.0)
             .await
-            .map_err(|e| connect_err(&self.endpoint, e.to_string()))?;
+            .map_err(|e| service_err(&self.endpoint, "read", e))?;
         let mut r = Reader {
             link: self,
             vals: VARS.iter().copied().zip(got).collect(),
@@ -523,21 +550,21 @@ fn explain(e: &str, pki_root: &std::path::Path) -> String {
 /// What one read gives.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PlcState {
-    /// PLC clock [100 ns ticks].
+    /// PLC clock (100 ns ticks).
     pub clock_ticks: i64,
-    /// Fix east [m].
+    /// Fix east (m).
     pub east_m: f64,
-    /// Fix north [m].
+    /// Fix north (m).
     pub north_m: f64,
-    /// Fix heading, north clockwise [deg].
+    /// Fix heading, north clockwise (deg).
     pub heading_deg: f64,
     /// Fix quality (NMEA).
     pub quality: u8,
-    /// Fix timestamp [ticks] (0: none yet).
+    /// Fix timestamp (ticks) (0: none yet).
     pub fix_ticks: i64,
-    /// Left motor [rpm].
+    /// Left motor (rpm).
     pub left_rpm: f64,
-    /// Right motor [rpm].
+    /// Right motor (rpm).
     pub right_rpm: f64,
     /// A latched fault.
     pub fault: bool,
@@ -545,11 +572,11 @@ pub struct PlcState {
     pub fault_text: String,
     /// Mode.
     pub mode: u8,
-    /// Motor limit [rpm].
+    /// Motor limit (rpm).
     pub max_rpm: f64,
-    /// Acceleration limit [rpm/s].
+    /// Acceleration limit (rpm/s).
     pub max_accel: f64,
-    /// Inverter frequency [Hz], current [A], voltage [V] (left, right).
+    /// Inverter frequency (Hz), current (A), voltage (V) (left, right).
     pub motors: [[f64; 3]; 2],
     /// Lockstep step (simulator only).
     pub step: Option<u64>,
@@ -634,9 +661,9 @@ pub struct DriveRun {
     pub link_events: Vec<LinkEvent>,
     /// Whether the metrics are on the simulator's truth (else on the fixes).
     pub truth: bool,
-    /// Round trips of the state read [ms].
+    /// Round trips of the state read (ms).
     pub read_ms: Vec<f64>,
-    /// Round trips of the setpoint write [ms].
+    /// Round trips of the setpoint write (ms).
     pub write_ms: Vec<f64>,
 }
 
@@ -652,7 +679,7 @@ pub const STALE_MARGIN_S: f64 = 0.05;
 /// How long a drive may take and wait, and its stop switch.
 #[derive(Debug, Clone)]
 pub struct DriveOptions {
-    /// Give up after this much machine time [s].
+    /// Give up after this much machine time (s).
     pub t_limit_s: f64,
     /// Give up waiting for a fault's acknowledgement after this long.
     pub ack_timeout: Duration,
@@ -693,7 +720,7 @@ pub async fn drive_logged(
         Ok(log) => log,
         Err(e) => {
             link.close().await;
-            return Err(e);
+            return Err(e.into());
         }
     };
     let run = drive(&link, setup, controller, opts, Some(&mut log)).await;
@@ -941,10 +968,7 @@ async fn run_loop(
                     if lost_since.is_none() =>
                 {
                     return Err(link.read_state().await.err().unwrap_or_else(|| {
-                        LinkError::Connect {
-                            endpoint: link.endpoint.clone(),
-                            why: "a value went bad and came back".into(),
-                        }
+                        connect_err(&link.endpoint, "a value went bad and came back")
                     }));
                 }
                 Err(e) => {
@@ -954,7 +978,10 @@ async fn run_loop(
                             link_events.push(LinkEvent {
                                 wall_s: wall(),
                                 kind: "link-lost",
-                                message: format!("{e}; reconnecting (the PLC stops the machine on its own watchdog)"),
+                                message: format!(
+                                    "{}; reconnecting (the PLC stops the machine on its own watchdog)",
+                                    autoshovel_core::error_chain(&e)
+                                ),
                             });
                             ws.halt();
                         }
@@ -1209,7 +1236,7 @@ async fn run_loop(
     })
 }
 
-/// Quantiles of a set of round trips [ms].
+/// Quantiles of a set of round trips (ms).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Quantiles {
     /// Count.
@@ -1258,9 +1285,9 @@ pub struct LinkSummary {
     pub metrics_on: &'static str,
     /// Link events (lost, restored, PLC faults, acknowledgements).
     pub events: Vec<LinkEvent>,
-    /// Round trip of the state read [ms].
+    /// Round trip of the state read (ms).
     pub read_ms: Quantiles,
-    /// Round trip of the setpoint write [ms].
+    /// Round trip of the setpoint write (ms).
     pub write_ms: Quantiles,
     /// The MCAP run log.
     pub log: Option<String>,

@@ -1,10 +1,14 @@
 //! Errors of the machine link, each naming the endpoint, node, file or
-//! value at fault.
+//! value at fault, with the cause kept as the error's source (printed after
+//! it in an error chain: `error: {e:#}`, `autoshovel_core::error_chain`).
 
 use std::path::PathBuf;
 
+use autoshovel_run_log::RunLogError;
+
 /// What went wrong on the link.
 #[derive(Debug, thiserror::Error)]
+#[non_exhaustive]
 pub enum LinkError {
     /// A certificate folder or file could not be made or read.
     #[error("{path}: {why}")]
@@ -14,14 +18,29 @@ pub enum LinkError {
         /// What happened.
         why: String,
     },
-    /// A run log could not be written or read.
-    #[error("{path}: {why}")]
-    Log {
+    /// A certificate folder or file could not be made, read or written.
+    #[error("{path}")]
+    PkiIo {
+        /// The file or folder.
+        path: PathBuf,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
+    },
+    /// A file is not an X.509 certificate, or one could not be encoded.
+    #[error("{path}: {what}")]
+    Certificate {
         /// The file.
         path: PathBuf,
-        /// What happened.
-        why: String,
+        /// What was being done: `not an X.509 certificate (DER or PEM)`.
+        what: &'static str,
+        /// The certificate library's error.
+        #[source]
+        source: opcua::crypto::X509Error,
     },
+    /// A run log could not be written or read.
+    #[error(transparent)]
+    RunLog(#[from] RunLogError),
     /// No OPC UA session could be opened.
     #[error("{endpoint}: {why}")]
     Connect {
@@ -29,6 +48,21 @@ pub enum LinkError {
         endpoint: String,
         /// What happened, with a hint.
         why: String,
+        /// The OPC UA stack's error, where it gave one.
+        #[source]
+        source: Option<opcua::types::Error>,
+    },
+    /// A service call (read, write, method call) on an open session failed
+    /// in the stack or on the wire (the PLC's own refusals are `Refused`).
+    #[error("{endpoint}: the {service} failed")]
+    Service {
+        /// The endpoint URL.
+        endpoint: String,
+        /// Which call: `read`, `write`, `method call`.
+        service: &'static str,
+        /// The OPC UA stack's error.
+        #[source]
+        source: opcua::types::Error,
     },
     /// Security None asked for without `--insecure`.
     #[error("{endpoint}: security None sends setpoints unsigned and unencrypted; refused without --insecure")]
@@ -97,6 +131,15 @@ pub enum LinkError {
         addr: String,
         /// What happened.
         why: String,
+    },
+    /// The server's address could not be bound or read.
+    #[error("plc-sim on {addr}")]
+    ServeIo {
+        /// The address asked for.
+        addr: String,
+        /// The operating system's error.
+        #[source]
+        source: std::io::Error,
     },
     /// The link was lost and not restored in time.
     #[error("{endpoint}: link lost for {secs:.1} s (limit {limit_s:.0} s); setpoints zeroed where reachable")]

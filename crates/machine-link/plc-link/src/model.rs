@@ -211,7 +211,7 @@ pub const FOLDERS: &[&str] = &[
 /// fault once both motors are at rest; needs a user identity.
 pub const ACKNOWLEDGE: &str = "Shovel.Fault.Acknowledge";
 /// The simulator's fault-injection method (component of
-/// `Shovel.Simulator`): arguments kind (String) and duration [s] (Double).
+/// `Shovel.Simulator`): arguments kind (String) and duration (s) (Double).
 pub const INJECT_FAULT: &str = "Shovel.Simulator.InjectFault";
 
 /// Fault codes of `Shovel.Fault.Code`.

@@ -72,6 +72,13 @@ fn pki_err(path: &Path, why: impl Into<String>) -> LinkError {
     }
 }
 
+fn pki_io(path: &Path, source: std::io::Error) -> LinkError {
+    LinkError::PkiIo {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
 /// The folder of `role` under `root`.
 pub fn role_dir(root: &Path, role: Role) -> PathBuf {
     root.join(role.dir_name())
@@ -116,17 +123,25 @@ pub fn ensure(root: &Path, role: Role, hosts: &[String]) -> Result<bool, LinkErr
 /// Adds the certificate at `cert` (DER or PEM) to the trust list of the
 /// application folder `dir`; returns where it went.
 pub fn trust(dir: &Path, cert: &Path) -> Result<PathBuf, LinkError> {
-    let bytes = fs::read(cert).map_err(|e| pki_err(cert, e.to_string()))?;
+    let bytes = fs::read(cert).map_err(|e| pki_io(cert, e))?;
     let x = X509::from_der(&bytes)
         .or_else(|_| X509::from_pem(&bytes))
-        .map_err(|e| pki_err(cert, format!("not an X.509 certificate (DER or PEM): {e}")))?;
+        .map_err(|source| LinkError::Certificate {
+            path: cert.to_path_buf(),
+            what: "not an X.509 certificate (DER or PEM)",
+            source,
+        })?;
     let store = CertificateStore::new(dir);
     store.ensure_pki_path().map_err(|e| pki_err(dir, e))?;
     let to = store
         .trusted_certs_dir()
         .join(CertificateStore::cert_file_name(&x));
-    let der = x.to_der().map_err(|e| pki_err(cert, e.to_string()))?;
-    fs::write(&to, der).map_err(|e| pki_err(&to, e.to_string()))?;
+    let der = x.to_der().map_err(|source| LinkError::Certificate {
+        path: cert.to_path_buf(),
+        what: "could not be encoded as DER",
+        source,
+    })?;
+    fs::write(&to, der).map_err(|e| pki_io(&to, e))?;
     Ok(to)
 }
 
@@ -186,13 +201,12 @@ fn write_secret(path: &Path, secret: &str) -> Result<(), LinkError> {
             .create_new(true)
             .mode(0o600)
             .open(path)
-            .map_err(|e| pki_err(path, e.to_string()))?;
-        f.write_all(secret.as_bytes())
-            .map_err(|e| pki_err(path, e.to_string()))
+            .map_err(|e| pki_io(path, e))?;
+        f.write_all(secret.as_bytes()).map_err(|e| pki_io(path, e))
     }
     #[cfg(not(unix))]
     {
-        fs::write(path, secret).map_err(|e| pki_err(path, e.to_string()))
+        fs::write(path, secret).map_err(|e| pki_io(path, e))
     }
 }
 

@@ -25,29 +25,29 @@ use crate::model::{fault_code, mode};
 pub enum FaultKind {
     /// The receiver reports nothing for `duration_s`.
     RtkDropout {
-        /// Length [s of machine time].
+        /// Length (s of machine time).
         duration_s: f64,
     },
     /// The next fix is off by `offset_m` east (a multipath jump).
     RtkJump {
-        /// Offset [m].
+        /// Offset (m).
         offset_m: f64,
     },
     /// The receiver's timestamp stops for `duration_s` while it still reports.
     RtkFreeze {
-        /// Length [s of machine time].
+        /// Length (s of machine time).
         duration_s: f64,
     },
     /// The network is cut for `duration_s` (connections dropped, new ones refused).
     LinkCut {
-        /// Length [s of wall time].
+        /// Length (s of wall time).
         duration_s: f64,
     },
     /// The PLC's replies are held back by `delay_s` for `duration_s`.
     Delay {
-        /// Added delay [s].
+        /// Added delay (s).
         delay_s: f64,
-        /// Length [s of wall time].
+        /// Length (s of wall time).
         duration_s: f64,
     },
 }
@@ -76,8 +76,8 @@ impl FaultKind {
         Ok((at, f))
     }
 
-    /// A fault from its name and one number: the duration [s] (for
-    /// `rtk-jump`, the offset [m]; for `delay`, the delay [s] lasting 5 s).
+    /// A fault from its name and one number: the duration (s) (for
+    /// `rtk-jump`, the offset (m); for `delay`, the delay (s) lasting 5 s).
     pub fn parse(name: &str, value: f64) -> Result<FaultKind, String> {
         if !value.is_finite() || !(0.0..=3600.0).contains(&value) {
             return Err(format!(
@@ -110,13 +110,13 @@ impl FaultKind {
 /// acceleration and rolling resistance need.
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize)]
 pub struct MotorReadings {
-    /// Actual speed [rpm].
+    /// Actual speed (rpm).
     pub speed_rpm: f64,
-    /// Output frequency [Hz].
+    /// Output frequency (Hz).
     pub frequency_hz: f64,
-    /// Current [A].
+    /// Current (A).
     pub current_a: f64,
-    /// Voltage [V].
+    /// Voltage (V).
     pub voltage_v: f64,
 }
 
@@ -154,15 +154,15 @@ pub struct PlcSimSummary {
     pub seed: u64,
     /// Where the PLC listened.
     pub endpoint: String,
-    /// Machine time at the end [s].
+    /// Machine time at the end (s).
     pub machine_time_s: f64,
-    /// Distance the crawler travelled [m].
+    /// Distance the crawler travelled (m).
     pub travelled_m: f64,
     /// The fault latched at the end, if any.
     pub fault: Option<String>,
     /// How many faults latched.
     pub faults_latched: usize,
-    /// Machine times [s] at which the workstation brought the setpoints to zero.
+    /// Machine times (s) at which the workstation brought the setpoints to zero.
     pub setpoints_zeroed_at_s: Vec<f64>,
     /// Whether the motors sped up while a fault was latched (must never happen).
     pub moved_while_faulted: bool,
@@ -178,9 +178,9 @@ pub struct PlcSimSummary {
 /// Something the PLC did, on both clocks.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlcEvent {
-    /// Wall-clock time since the PLC started [s].
+    /// Wall-clock time since the PLC started (s).
     pub wall_s: f64,
-    /// Machine time [s].
+    /// Machine time (s).
     pub t_s: f64,
     /// Kind: `fault`, `acknowledged`, `inject`, `setpoint-rejected`, `lockstep`.
     pub kind: &'static str,
@@ -216,7 +216,7 @@ pub struct PlcParams {
     pub heartbeat_timeout: Duration,
     /// Start in auto (else manual: setpoints ignored).
     pub auto: bool,
-    /// Faults to inject at machine times [s].
+    /// Faults to inject at machine times (s).
     pub schedule: Vec<(f64, FaultKind)>,
 }
 
@@ -247,9 +247,9 @@ pub struct Plc {
     next_fault: usize,
     /// Everything the PLC did.
     pub events: Vec<PlcEvent>,
-    /// Wall time [s] at which each fault latched.
+    /// Wall time (s) at which each fault latched.
     pub stops: Vec<f64>,
-    /// Machine time [s] of each write that brought the setpoints from
+    /// Machine time (s) of each write that brought the setpoints from
     /// moving to both zero (the workstation's own stops).
     pub zeroed_at: Vec<f64>,
     /// Network faults due now, for the server to carry out.

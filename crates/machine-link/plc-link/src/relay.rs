@@ -21,7 +21,7 @@ use tokio::time::Instant;
 pub struct RelayControl {
     /// Connections are refused and cut until this instant.
     cut_until: watch::Sender<Option<Instant>>,
-    /// Server → client bytes are held this long [µs].
+    /// Server → client bytes are held this long (µs).
     delay_us: AtomicU64,
     /// Number of connections that have ended (either side, or cut).
     pub closed: AtomicU64,

@@ -33,10 +33,10 @@ use tokio::net::TcpListener;
 use tokio::time::Instant;
 
 use crate::error::LinkError;
-use crate::log::{topic, EventMsg, MotorsMsg, PoseMsg, RtkMsg, RunLog};
 use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, FOLDERS, INJECT_FAULT, NAMESPACE_URI};
 use crate::pki::{self, Role};
 use crate::plc::{FaultKind, Plc, PlcParams};
+use autoshovel_run_log::{topic, EventMsg, MotorsMsg, PoseMsg, RtkMsg, RunLog};
 
 /// How `plc-sim` is reached and secured.
 #[derive(Debug, Clone)]
@@ -164,15 +164,17 @@ impl PlcServer {
             addr: addr_text.clone(),
             why,
         };
+        let serve_io = |source: std::io::Error| LinkError::ServeIo {
+            addr: addr_text.clone(),
+            source,
+        };
         pki::ensure(&serve.pki, Role::Plc, std::slice::from_ref(&serve.host))?;
         let public = TcpListener::bind((serve.host.as_str(), serve.port))
             .await
-            .map_err(|e| serve_err(e.to_string()))?;
-        let addr = public.local_addr().map_err(|e| serve_err(e.to_string()))?;
-        let inner = TcpListener::bind("127.0.0.1:0")
-            .await
-            .map_err(|e| serve_err(e.to_string()))?;
-        let inner_addr = inner.local_addr().map_err(|e| serve_err(e.to_string()))?;
+            .map_err(serve_io)?;
+        let addr = public.local_addr().map_err(serve_io)?;
+        let inner = TcpListener::bind("127.0.0.1:0").await.map_err(serve_io)?;
+        let inner_addr = inner.local_addr().map_err(serve_io)?;
 
         let mut users = BTreeMap::new();
         let mut token_ids: Vec<String> = vec![ANONYMOUS_USER_TOKEN_ID.to_string()];
@@ -327,7 +329,7 @@ impl PlcServer {
         let _ = self.loop_task.await;
         self.handle.cancel();
         let log = self.log.lock().unwrap_or_else(|e| e.into_inner()).take();
-        log.map(RunLog::finish)
+        log.map(|l| Ok(l.finish()?))
     }
 }
 
@@ -646,5 +648,6 @@ fn log_machine(
                 r[1].voltage_v,
             ],
         },
-    )
+    )?;
+    Ok(())
 }

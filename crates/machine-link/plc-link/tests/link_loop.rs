@@ -138,7 +138,7 @@ fn replay_of_the_drive_log_gives_the_drive_metrics() {
     let mut log = RunLog::create(&path, &[("scenario", "v-shape".into())], false).unwrap();
     let run = over_link_logged(&sc.setup, Clock::Lockstep, Some(&mut log));
     log.finish().unwrap();
-    let r = autoshovel_plc_link::replay::replay_mcap(&path).unwrap();
+    let r = autoshovel_run_log::replay_mcap(&path).unwrap();
     assert_eq!(r.measured_on, "simulator truth");
     assert_eq!(r.run.samples.len(), run.samples.len());
     let (a, b) = (&run.metrics, &r.run.metrics);
@@ -188,7 +188,8 @@ fn long_straight() -> Setup {
     let dir = (leg.points[leg.points.len() - 1] - a).normalize();
     sc.setup.legs =
         vec![
-            autoshovel_walk_tracker::RefLeg::new(leg.direction, vec![a, a + dir * 5000.0], None).unwrap(),
+            autoshovel_walk_tracker::RefLeg::new(leg.direction, vec![a, a + dir * 5000.0], None)
+                .unwrap(),
         ];
     sc.setup
 }

@@ -20,7 +20,7 @@
 //! (`DIR/ours_NAME_SIZE.pcd`), for `peer/bench_peers.py`, which runs PCL and
 //! Open3D on the same clouds and compares. `FILTER_BENCH_ONLY=NAME:SIZE`
 //! (e.g. `statistical:1m`) runs one filter on one cloud, `clouds` none.
-//! `FILTER_BENCH_LEAF=M` sets the voxel grid's leaf [m] (e.g. the
+//! `FILTER_BENCH_LEAF=M` sets the voxel grid's leaf (m) (e.g. the
 //! `perceive` voxel stage's, two spacings, on that stage's input given as
 //! `FILTER_BENCH_INPUT`).
 
@@ -32,7 +32,7 @@ use autoshovel_point_cloud::filter::{
 use autoshovel_point_cloud::{Point, PointCloud};
 use criterion::{BenchmarkId, Criterion};
 
-/// The voxel leaf [m]: 0.05, or `FILTER_BENCH_LEAF`.
+/// The voxel leaf (m): 0.05, or `FILTER_BENCH_LEAF`.
 fn voxel_leaf() -> f64 {
     static LEAF: std::sync::OnceLock<f64> = std::sync::OnceLock::new();
     *LEAF.get_or_init(|| {

@@ -1,9 +1,9 @@
 //! The point cloud type: positions only, in metres.
 
-/// One point [m].
+/// One point (m).
 pub type Point = [f32; 3];
 
-/// A cloud of points [m]. Non-finite points never enter one: readers drop
+/// A cloud of points (m). Non-finite points never enter one: readers drop
 /// and count them.
 #[derive(Debug, Clone, Default, PartialEq)]
 pub struct PointCloud {

@@ -1,6 +1,9 @@
 //! Point clouds (SPEC §4.1; rope-shovel paper §3): readers and writers for
-//! PCD, PLY, LAS/LAZ and XYZ/CSV (`io`), and the filters of the paper's
-//! combined filtering process with PCL's semantics (`filter`).
+//! PCD, PLY, LAS/LAZ and XYZ/CSV (`io`), the filters of the paper's
+//! combined filtering process with PCL's semantics (`filter`), the
+//! neighbour searches they stand on (`search`: a grid of columns, a k-d
+//! tree, an octree, and their distance kernels) and the one
+//! instruction-set layer every vectorised kernel goes through ([`simd`]).
 //!
 //! Points are stored as `[f32; 3]`, as PCL, PCD, PLY and LiDAR drivers do:
 //! half the memory of f64 for scans of tens of millions of points, and the
@@ -8,14 +11,15 @@
 //! place the house rule "f64 everywhere" gives way; everything computed from
 //! a cloud (fits, calibration, volumes) is f64.
 
-// Units in brackets ("[m]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 mod cloud;
 mod error;
 pub mod filter;
 pub mod io;
-mod room;
+mod prefault;
+pub(crate) mod search;
+pub mod simd;
+#[cfg(test)]
+mod testing;
 
 pub use cloud::{Point, PointCloud};
 pub use error::{CloudError, Result};

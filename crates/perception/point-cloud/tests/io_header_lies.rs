@@ -29,17 +29,21 @@ fn note(n: usize) {
 unsafe impl GlobalAlloc for Tracking {
     unsafe fn alloc(&self, l: Layout) -> *mut u8 {
         note(l.size());
+        // SAFETY: same contract as our caller's.
         unsafe { System.alloc(l) }
     }
     unsafe fn alloc_zeroed(&self, l: Layout) -> *mut u8 {
         note(l.size());
+        // SAFETY: same contract as our caller's.
         unsafe { System.alloc_zeroed(l) }
     }
     unsafe fn realloc(&self, p: *mut u8, l: Layout, new: usize) -> *mut u8 {
         note(new);
+        // SAFETY: same contract as our caller's.
         unsafe { System.realloc(p, l, new) }
     }
     unsafe fn dealloc(&self, p: *mut u8, l: Layout) {
+        // SAFETY: same contract as our caller's.
         unsafe { System.dealloc(p, l) }
     }
 }
@@ -47,7 +51,7 @@ unsafe impl GlobalAlloc for Tracking {
 #[global_allocator]
 static ALLOC: Tracking = Tracking;
 
-/// Largest allocation a lying file may cause [bytes]: the 1 MiB read
+/// Largest allocation a lying file may cause (bytes): the 1 MiB read
 /// buffers and a little more, nowhere near what the headers claim.
 const LIMIT: usize = 4 << 20;
 

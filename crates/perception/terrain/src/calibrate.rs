@@ -40,7 +40,7 @@
 use autoshovel_point_cloud::{Point, PointCloud};
 use nalgebra::{Matrix3, Vector3};
 
-/// The matrix T of [RS eq. 11]: `level_from_sensor` for roll α and pitch β [rad].
+/// The matrix T of [RS eq. 11]: `level_from_sensor` for roll α and pitch β (rad).
 #[rustfmt::skip]
 pub fn level_from_sensor(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
     // [RS eq. 11]: T(α, β) as printed.
@@ -53,26 +53,26 @@ pub fn level_from_sensor(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
     )
 }
 
-/// The inverse of T, `Tᵀ`: `sensor_from_level` for roll α and pitch β [rad].
+/// The inverse of T, `Tᵀ`: `sensor_from_level` for roll α and pitch β (rad).
 pub fn sensor_from_level(roll_rad: f64, pitch_rad: f64) -> Matrix3<f64> {
     level_from_sensor(roll_rad, pitch_rad).transpose()
 }
 
 /// Eq. 12: the levelled cloud `p = T · p_s` for a sensor with roll α and
-/// pitch β [rad] (see the module docs for which way they turn).
+/// pitch β (rad) (see the module docs for which way they turn).
 pub fn level(cloud: &[Point], roll_rad: f64, pitch_rad: f64) -> PointCloud {
     // [RS eq. 12]: p = T · p_s.
     rotate(cloud, &level_from_sensor(roll_rad, pitch_rad))
 }
 
 /// The inverse of [`level`], `p_s = Tᵀ · p`: what a sensor with roll α and
-/// pitch β [rad] sees of a level scene. `tilt(level(c, α, β), α, β) == c` up
+/// pitch β (rad) sees of a level scene. `tilt(level(c, α, β), α, β) == c` up
 /// to rounding, and so is `level(tilt(c, α, β), α, β)`.
 pub fn tilt(cloud: &[Point], roll_rad: f64, pitch_rad: f64) -> PointCloud {
     rotate(cloud, &sensor_from_level(roll_rad, pitch_rad))
 }
 
-/// Roll α and pitch β [rad] that make a plane with this normal (in sensor
+/// Roll α and pitch β (rad) that make a plane with this normal (in sensor
 /// coordinates) horizontal under [`level`]: `T(α, β) · n̂ = e_z`.
 ///
 /// The normal need not be unit length; it is flipped to point up (`n_z > 0`)

@@ -40,17 +40,17 @@ use crate::error::{Result, SurfaceError};
 /// The kinds of stage, by their command-line flag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 pub enum StageKind {
-    /// `--voxel LEAF` or `--voxel LX,LY,LZ` [m]: PCL's VoxelGrid ([RS eq. 17]–[RS eq. 18]).
+    /// `--voxel LEAF` or `--voxel LX,LY,LZ` (m): PCL's VoxelGrid ([RS eq. 17]–[RS eq. 18]).
     Voxel,
     /// `--statistical K,ALPHA[,both]`: PCL's StatisticalOutlierRemoval
     /// ([RS eq. 14]–[RS eq. 16]); `both` for the two-sided rule as printed.
     Statistical,
     /// `--radius R,MIN`: PCL's RadiusOutlierRemoval ([RS eq. 13]).
     Radius,
-    /// `--pass AXIS:MIN:MAX[:outside]` [m]: PCL's PassThrough, keeping
+    /// `--pass AXIS:MIN:MAX[:outside]` (m): PCL's PassThrough, keeping
     /// MIN ≤ v ≤ MAX (or the rest with `outside`); `-inf`/`inf` for no limit.
     Pass,
-    /// `--level ROLL,PITCH` [deg]: rotate the sensor frame level
+    /// `--level ROLL,PITCH` (deg): rotate the sensor frame level
     /// ([RS eq. 11]–[RS eq. 12]).
     Level,
 }
@@ -92,9 +92,9 @@ pub enum Stage {
     Pass(PassThroughParams),
     /// Levelling by roll and pitch, in degrees as given.
     Level {
-        /// Sensor roll α [deg].
+        /// Sensor roll α (deg).
         roll_deg: f64,
-        /// Sensor pitch β [deg].
+        /// Sensor pitch β (deg).
         pitch_deg: f64,
     },
 }
@@ -110,7 +110,7 @@ pub struct StageReport {
     pub points_in: usize,
     /// Points out (kept).
     pub points_out: usize,
-    /// Wall time [ms].
+    /// Wall time (ms).
     pub ms: f64,
 }
 
@@ -332,11 +332,11 @@ pub struct FilterSummary {
     pub points_out: usize,
     /// Each stage, in the order run.
     pub stages: Vec<StageReport>,
-    /// Reading [ms].
+    /// Reading (ms).
     pub read_ms: f64,
-    /// The stages together [ms].
+    /// The stages together (ms).
     pub filter_ms: f64,
-    /// Writing [ms].
+    /// Writing (ms).
     pub write_ms: f64,
 }
 

@@ -56,7 +56,7 @@ pub enum SurfaceError {
         candidates: usize,
         /// Inliers required.
         required: usize,
-        /// The largest accepted tilt of the floor [deg].
+        /// The largest accepted tilt of the floor (deg).
         max_tilt_deg: f64,
     },
     /// The 8 × 8 samples do not determine even a plane (e.g. all on one line).

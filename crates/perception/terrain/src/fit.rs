@@ -112,7 +112,7 @@ pub struct Term {
     pub x_power: usize,
     /// Power of y (or v).
     pub y_power: usize,
-    /// Coefficient [m / m^(x_power + y_power)] in x, y; [m] in u, v.
+    /// Coefficient [m / m^(x_power + y_power)] in x, y; (m) in u, v.
     pub coefficient: f64,
 }
 
@@ -127,7 +127,7 @@ pub struct DegreeScore {
     pub r2: f64,
     /// Adjusted R² on the samples.
     pub adjusted_r2: f64,
-    /// Leave-one-out RMS prediction error, sqrt(PRESS/n) [m].
+    /// Leave-one-out RMS prediction error, sqrt(PRESS/n) (m).
     pub loo_rms_m: f64,
 }
 
@@ -138,9 +138,9 @@ pub struct SurfaceFit {
     pub degree: usize,
     /// The grid extent; the fit is meant for (x, y) inside it.
     pub extent: Extent,
-    /// Centre (x_c, y_c) of the normalisation [m].
+    /// Centre (x_c, y_c) of the normalisation (m).
     pub centre_m: [f64; 2],
-    /// Half-widths (h_x, h_y) of the normalisation [m].
+    /// Half-widths (h_x, h_y) of the normalisation (m).
     pub half_span_m: [f64; 2],
     /// Coefficients in the normalised u, v (see the module docs).
     pub coefficients: Vec<Term>,
@@ -148,17 +148,17 @@ pub struct SurfaceFit {
     pub r2: f64,
     /// Adjusted R² on the grid samples.
     pub adjusted_r2: f64,
-    /// RMS residual on the grid samples [m].
+    /// RMS residual on the grid samples (m).
     pub rms_residual_m: f64,
-    /// Leave-one-out RMS prediction error on the samples [m].
+    /// Leave-one-out RMS prediction error on the samples (m).
     pub loo_rms_m: f64,
     /// The grid samples fitted.
     pub samples: Vec<GridSample>,
-    /// Residual `z − f(x, y)` per sample [m], in the order of `samples`.
+    /// Residual `z − f(x, y)` per sample (m), in the order of `samples`.
     pub residuals_m: Vec<f64>,
     /// R² against every cloud point inside the extent.
     pub r2_all_points: f64,
-    /// RMS residual against every cloud point inside the extent [m].
+    /// RMS residual against every cloud point inside the extent (m).
     pub rms_all_points_m: f64,
     /// Cloud points inside the extent.
     pub points_in_extent: usize,
@@ -333,7 +333,7 @@ pub fn fit_samples(
 }
 
 impl SurfaceFit {
-    /// Height of the surface at (x, y) [m].
+    /// Height of the surface at (x, y) (m).
     pub fn height(&self, x: f64, y: f64) -> f64 {
         let u = (x - self.centre_m[0]) / self.half_span_m[0];
         let v = (y - self.centre_m[1]) / self.half_span_m[1];
@@ -349,7 +349,7 @@ impl SurfaceFit {
             .sum()
     }
 
-    /// The coefficients in plain x, y [m]: `f = Σ c_ab x^a y^b`, expanded from
+    /// The coefficients in plain x, y (m): `f = Σ c_ab x^a y^b`, expanded from
     /// the normalised ones by the binomial theorem. Readable as [RS eq. 21], but
     /// worse conditioned: prefer [`SurfaceFit::height`] for evaluation.
     pub fn coefficients_xy(&self) -> Vec<Term> {
@@ -395,7 +395,7 @@ impl SurfaceFit {
         HeightMap { xs, ys, z_m }
     }
 
-    /// R², RMS residual [m] and count of the cloud points inside the extent.
+    /// R², RMS residual (m) and count of the cloud points inside the extent.
     fn score_points(&self, cloud: &PointCloud) -> (f64, f64, usize) {
         use rayon::prelude::*;
         // The surface's heights in parallel (most of the work), the sums
@@ -431,16 +431,16 @@ impl SurfaceFit {
 /// Heights of a fitted surface on a rectangular grid.
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct HeightMap {
-    /// Node x [m], ascending.
+    /// Node x (m), ascending.
     pub xs: Vec<f64>,
-    /// Node y [m], ascending.
+    /// Node y (m), ascending.
     pub ys: Vec<f64>,
-    /// Heights [m], row by row: `z_m[iy * xs.len() + ix]`.
+    /// Heights (m), row by row: `z_m[iy * xs.len() + ix]`.
     pub z_m: Vec<f64>,
 }
 
 impl HeightMap {
-    /// Height at node (ix, iy) [m].
+    /// Height at node (ix, iy) (m).
     pub fn at(&self, ix: usize, iy: usize) -> f64 {
         self.z_m[iy * self.xs.len() + ix]
     }

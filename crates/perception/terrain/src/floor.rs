@@ -36,7 +36,7 @@
 
 use std::collections::HashMap;
 
-use autoshovel_point_cloud::filter::Isa;
+use autoshovel_point_cloud::simd::Isa;
 use autoshovel_point_cloud::PointCloud;
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
@@ -47,7 +47,7 @@ use crate::calibrate::angles_from_normal;
 use crate::error::{Result, SurfaceError};
 use crate::ransac::{inliers_of, least_squares_plane, plane_through, Plane, RansacParams};
 
-/// Largest tilt of the floor in the sensor's frame by default [deg]: a
+/// Largest tilt of the floor in the sensor's frame by default (deg): a
 /// sensor is mounted within a few degrees of level, and a muck pile's face
 /// stands at 35–45° (its gentlest parts, a concave toe, near 20°), so a
 /// plane along the face is not taken for the floor.
@@ -144,11 +144,11 @@ impl TiltParams {
 /// The sensor attitude found from the floor.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct TiltEstimate {
-    /// Roll α of [RS eq. 11] [rad]: pass to [`crate::level`].
+    /// Roll α of [RS eq. 11] (rad): pass to [`crate::level`].
     pub roll_rad: f64,
-    /// Pitch β of [RS eq. 11] [rad]: pass to [`crate::level`].
+    /// Pitch β of [RS eq. 11] (rad): pass to [`crate::level`].
     pub pitch_rad: f64,
-    /// Height of the floor in the levelled cloud [m] (negative the sensor's
+    /// Height of the floor in the levelled cloud (m) (negative the sensor's
     /// height above the floor for a sensor-centred scan).
     pub floor_height_m: f64,
     /// Unit floor normal in sensor coordinates, pointing up.
@@ -159,7 +159,7 @@ pub struct TiltEstimate {
     pub candidates: usize,
     /// Points more than the below margin under the floor.
     pub below: usize,
-    /// Root-mean-square distance of the floor inliers from the plane [m].
+    /// Root-mean-square distance of the floor inliers from the plane (m).
     pub rms_m: f64,
     /// Hypotheses drawn.
     pub iterations: usize,
@@ -196,7 +196,7 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
         (0..n).collect()
     };
     let scored: Vec<[f64; 3]> = subset.iter().map(|&i| to_f64(&cloud.points[i])).collect();
-    let grid = Grid::new(&scored);
+    let grid = CellBuckets::new(&scored);
     let min_nz = r.max_tilt_rad.cos() - 1e-12;
     let threshold = r.inlier_threshold_m;
     let below_m = params.below_margin * threshold;
@@ -266,7 +266,7 @@ pub fn estimate_tilt(cloud: &PointCloud, params: &TiltParams) -> Result<TiltEsti
     // in one pass over the cloud (its inliers, where the ground rises off
     // it, the points below it), the f32 points widened as they are read.
     let at = |i: usize| to_f64(&cloud.points[i]);
-    let all_grid = Grid::with_cell(&cloud.points, to_f64, RISE_CELL * threshold, false);
+    let all_grid = CellBuckets::with_cell(&cloud.points, to_f64, RISE_CELL * threshold, false);
     let mut split = Split::of(&cloud.points, &all_grid.of, &plane, threshold, below_m);
     for _ in 0..r.refine_rounds {
         let flat = all_grid.away_from_rises(&split.rising, &split.inliers);
@@ -347,12 +347,12 @@ impl Split {
             .map(|(c, (chunk, cells))| {
                 let base = c * CHUNK;
                 #[cfg(target_arch = "x86_64")]
-                if isa == Isa::Avx512 {
-                    // SAFETY: `Isa::best` and `Isa::available` give AVX-512
-                    // only where the machine has AVX-512F (and POPCNT); the
-                    // chunks of the points and of their cells are alike.
+                if let Some(t) = isa.avx512() {
+                    // SAFETY: `t` proves AVX-512F and POPCNT; the chunks of
+                    // the points and of their cells are alike.
                     let (inliers, rising, below) = unsafe {
                         crate::wide::avx512::split(
+                            t,
                             chunk,
                             cells,
                             base,
@@ -508,7 +508,7 @@ fn grow(
 /// foldhash's fixed hasher: hashing a million keys with the standard
 /// library's SipHash took a third of the levelling; a fixed seed keeps
 /// every run alike.
-struct Grid {
+struct CellBuckets {
     cell_m: f64,
     cells: Cells,
     /// Each point's cell.
@@ -519,7 +519,7 @@ struct Grid {
     members: Vec<u32>,
 }
 
-/// How a grid's cells are numbered (see [`Grid`]).
+/// How a grid's cells are numbered (see [`CellBuckets`]).
 enum Cells {
     /// Cell (x, y) is `(y − y0) · nx + (x − x0)`, over the keys' box.
     Dense { x0: i64, y0: i64, nx: i64, ny: i64 },
@@ -559,7 +559,7 @@ impl Cells {
     }
 }
 
-impl Grid {
+impl CellBuckets {
     fn new(points: &[[f64; 3]]) -> Self {
         let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
         for p in points {
@@ -816,7 +816,7 @@ mod tests {
                 })
                 .collect();
             let of: Vec<u32> = (0..n as u32).map(|i| i % 13).collect();
-            let portable = Split::of_on(Isa::Portable, &points, &of, &plane, threshold, below_m);
+            let portable = Split::of_on(Isa::PORTABLE, &points, &of, &plane, threshold, below_m);
             if n >= 1000 {
                 assert!(portable.count() > 0 && portable.below > 0 && !portable.rising.is_empty());
             }
@@ -894,12 +894,12 @@ mod tests {
         odd.push([f64::NAN, 4.1, 0.0]);
         odd.push([5.2, f64::NAN, 0.0]);
         for (points, dense) in [(patch, true), (far, false), (odd, true)] {
-            let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
+            let grid = CellBuckets::with_cell(&points, |p| *p, 0.5, true);
             assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
             let mut seen = 0;
             grid.cells.each(|key, c| {
                 let want: Vec<u32> = (0..points.len() as u32)
-                    .filter(|&i| Grid::key(0.5, &points[i as usize]) == key)
+                    .filter(|&i| CellBuckets::key(0.5, &points[i as usize]) == key)
                     .collect();
                 assert_eq!(grid.cell(key), &want[..]);
                 assert!(want.iter().all(|&i| grid.of[i as usize] as usize == c));
@@ -917,7 +917,7 @@ mod tests {
         // tenth of its points; on a dense grid and a hashed one.
         let (patch, far) = patch_and_far(600, 30, [0.1, 0.1]);
         for (points, dense) in [(patch, true), (far, false)] {
-            let grid = Grid::with_cell(&points, |p| *p, 0.5, true);
+            let grid = CellBuckets::with_cell(&points, |p| *p, 0.5, true);
             assert_eq!(matches!(grid.cells, Cells::Dense { .. }), dense);
             let is_rising = |i: usize| i.is_multiple_of(7) && i < 300;
             let rising: Vec<u32> = (0..points.len())
@@ -927,7 +927,7 @@ mod tests {
             let inliers: Vec<usize> = (0..points.len()).filter(|i| !i.is_multiple_of(3)).collect();
             let parts = vec![inliers[..150].to_vec(), inliers[150..].to_vec()];
             let got = grid.away_from_rises(&rising, &parts);
-            let key = |i: usize| Grid::key(0.5, &points[i]);
+            let key = |i: usize| CellBuckets::key(0.5, &points[i]);
             let rises = |k: (i64, i64)| {
                 let all = (0..points.len()).filter(|&i| key(i) == k).count();
                 let above = (0..points.len())

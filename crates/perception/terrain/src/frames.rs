@@ -159,7 +159,7 @@ pub struct FrameOptions {
     /// (the default) levels once, on the first frame perceived, as for a
     /// sensor fixed on a standing machine.
     pub relevel_every: usize,
-    /// Edge of a cell of the running height model [m]; `None` (the
+    /// Edge of a cell of the running height model (m); `None` (the
     /// default): four times the first frame's point spacing.
     pub model_cell_m: Option<f64>,
     /// The real-time (`SCHED_FIFO`) priority the caller runs the frames'
@@ -175,13 +175,13 @@ pub struct FrameOptions {
 /// the levelled frame.
 #[derive(Debug, Clone, PartialEq)]
 pub struct HeightModel {
-    /// x, y of the grid's lower corner [m].
+    /// x, y of the grid's lower corner (m).
     pub origin: [f64; 2],
-    /// Cell edge [m].
+    /// Cell edge (m).
     pub cell_m: f64,
     /// Cells along x and y.
     pub size: [usize; 2],
-    /// Height of each cell (row-major, x fastest); NaN where never seen [m].
+    /// Height of each cell (row-major, x fastest); NaN where never seen (m).
     pub z: Vec<f64>,
     /// Frames that saw each cell.
     pub seen: Vec<u32>,
@@ -196,7 +196,7 @@ pub struct ModelUpdate {
     pub cells_updated: usize,
     /// Of them, cells no frame had seen before.
     pub cells_new: usize,
-    /// RMS change of the height of the cells seen before [m].
+    /// RMS change of the height of the cells seen before (m).
     pub change_rms_m: f64,
     /// Cleaned points outside the grid (not in the model).
     pub points_outside: usize,
@@ -224,7 +224,7 @@ impl HeightModel {
         ))
     }
 
-    /// An empty model over the rectangle `lo`–`hi` (x, y) [m], of cells
+    /// An empty model over the rectangle `lo`–`hi` (x, y) (m), of cells
     /// `cell_m` wide (at most 16 384 a side: coarser cells past that).
     pub fn over_box(lo: [f64; 2], hi: [f64; 2], cell_m: f64) -> Self {
         let origin = lo;
@@ -330,13 +330,13 @@ pub struct FrameRecord {
     /// Whether this frame searched the floor and levelled (the first
     /// perceived frame, and every `relevel_every`-th after it).
     pub relevelled: bool,
-    /// Time to read the frame [ms] (0 for a frame given in memory).
+    /// Time to read the frame (ms) (0 for a frame given in memory).
     pub read_ms: f64,
-    /// Time of the pipeline [ms].
+    /// Time of the pipeline (ms).
     pub pipeline_ms: f64,
-    /// Time to update the height model [ms].
+    /// Time to update the height model (ms).
     pub model_ms: f64,
-    /// From the start of the read to the updated model [ms].
+    /// From the start of the read to the updated model (ms).
     pub latency_ms: f64,
     /// The pipeline's stages (counts and times).
     pub stages: Vec<StageRecord>,
@@ -346,7 +346,7 @@ pub struct FrameRecord {
     pub model: Option<ModelUpdate>,
 }
 
-/// Latency statistics over the perceived frames [ms].
+/// Latency statistics over the perceived frames (ms).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Latency {
     /// Of the first perceived frame (it searches the floor).
@@ -385,15 +385,15 @@ pub struct FramesSummary {
     pub output_points: usize,
     /// Points after each stage of the last perceived frame.
     pub stage_points: std::collections::BTreeMap<&'static str, usize>,
-    /// Median time of each stage over the perceived frames [ms].
+    /// Median time of each stage over the perceived frames (ms).
     pub timings_ms: std::collections::BTreeMap<&'static str, f64>,
-    /// Frame latency (read, pipeline and model update) [ms].
+    /// Frame latency (read, pipeline and model update) (ms).
     pub latency: Latency,
     /// Frames per second the sequence was perceived at (wall time).
     pub frames_per_s: f64,
-    /// Roll α in use at the end [deg].
+    /// Roll α in use at the end (deg).
     pub roll_deg: f64,
-    /// Pitch β in use at the end [deg].
+    /// Pitch β in use at the end (deg).
     pub pitch_deg: f64,
     /// R² of the last perceived frame's fit.
     pub r2: f64,
@@ -404,13 +404,13 @@ pub struct FramesSummary {
     /// The real-time (`SCHED_FIFO`) priority the frames ran at (`None`:
     /// ordinary scheduling).
     pub realtime_priority: Option<u8>,
-    /// The height model's cell edge [m].
+    /// The height model's cell edge (m).
     pub model_cell_m: f64,
     /// Its cells along x and y.
     pub model_size: [usize; 2],
     /// Share of its cells seen.
     pub model_coverage: f64,
-    /// Median RMS change of the seen cells between frames [m].
+    /// Median RMS change of the seen cells between frames (m).
     pub model_change_rms_m: f64,
     /// The settings used.
     pub pipeline: PerceptionParams,

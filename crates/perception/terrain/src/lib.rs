@@ -24,9 +24,6 @@
 //! assert_eq!(got.stages.last().unwrap().stage, "fit");
 //! ```
 
-// Units in brackets ("[m]", "[rad]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 mod calibrate;
 pub mod chain;
 mod error;
@@ -34,9 +31,9 @@ mod fit;
 mod floor;
 pub mod frames;
 pub mod perceive;
-mod pile;
 mod ransac;
 mod sample;
+mod synthetic;
 pub mod tiles;
 mod volume;
 mod wide;
@@ -45,8 +42,8 @@ pub use calibrate::{angles_from_normal, level, level_from_sensor, sensor_from_le
 pub use error::{Result, SurfaceError};
 pub use fit::{fit_samples, fit_surface, DegreeScore, FitParams, HeightMap, SurfaceFit, Term};
 pub use floor::{estimate_tilt, TiltEstimate, TiltParams, MAX_FLOOR_TILT_DEG};
-pub use pile::{
-    generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern, MAX_SCALE, MIN_SCALE,
-};
 pub use ransac::{least_squares_plane, ransac_plane, Plane, PlaneFit, RansacParams};
 pub use sample::{sample_grid, Extent, GridSample, SampleParams, Samples};
+pub use synthetic::{
+    generate_pile, GeneratePileSummary, PileParams, PileShape, ScanPattern, MAX_SCALE, MIN_SCALE,
+};

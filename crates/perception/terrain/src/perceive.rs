@@ -34,13 +34,13 @@ use std::collections::BTreeMap;
 use std::path::Path;
 use std::time::Instant;
 
+use autoshovel_core::config::{self, TomlFile};
 use autoshovel_point_cloud::filter::{
     bilateral_normal_smoothing, pass_through, radius_outlier_removal, radius_outlier_removal_then,
     statistical_outlier_removal, voxel_grid, BilateralParams, OutlierSides, PassThroughParams,
     RadiusKept, RadiusOutlierParams, StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_point_cloud::PointCloud;
-use autoshovel_core::config::{self, TomlFile};
 use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
@@ -121,7 +121,7 @@ pub enum AutoWord {
 pub struct PerceptionParams {
     /// Length scale of the scene: a number, or "auto" (larger horizontal extent / 30 m).
     pub scale: ScaleSetting,
-    /// Mean point spacing [m]: a number, or "auto" (√(area / points)).
+    /// Mean point spacing (m): a number, or "auto" (√(area / points)).
     pub spacing: ScaleSetting,
     /// Levelling.
     pub level: LevelStage,
@@ -145,9 +145,9 @@ pub struct PerceptionParams {
 pub struct LevelStage {
     /// estimate, given or none.
     pub mode: LevelMode,
-    /// Roll α [deg] when given.
+    /// Roll α (deg) when given.
     pub roll_deg: f64,
-    /// Pitch β [deg] when given.
+    /// Pitch β (deg) when given.
     pub pitch_deg: f64,
     /// Smallest share of the points the floor must hold (the floor is the
     /// plane with the most points and almost nothing below it; see
@@ -159,7 +159,7 @@ pub struct LevelStage {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GroundStage {
-    /// Keep points this far above the floor and higher [m at scale 1].
+    /// Keep points this far above the floor and higher (m at scale 1).
     pub margin_m: f64,
 }
 
@@ -184,7 +184,7 @@ struct StageWork {
 pub struct RadiusStage {
     /// Run it.
     pub enabled: bool,
-    /// Search radius K_s [point spacings].
+    /// Search radius K_s (point spacings).
     pub radius_spacings: f64,
     /// Fewest neighbours to keep a point.
     pub min_neighbors: usize,
@@ -211,7 +211,7 @@ pub struct StatisticalStage {
 pub struct VoxelStage {
     /// Run it.
     pub enabled: bool,
-    /// Leaf size r [point spacings].
+    /// Leaf size r (point spacings).
     pub leaf_spacings: f64,
 }
 
@@ -221,11 +221,11 @@ pub struct VoxelStage {
 pub struct SmoothStage {
     /// Run it.
     pub enabled: bool,
-    /// Neighbourhood radius [point spacings].
+    /// Neighbourhood radius (point spacings).
     pub radius_spacings: f64,
-    /// σ of w_d [point spacings].
+    /// σ of w_d (point spacings).
     pub sigma_d_spacings: f64,
-    /// σ of w_n [m at scale 1].
+    /// σ of w_n (m at scale 1).
     pub sigma_n_m: f64,
     /// Passes.
     pub iterations: usize,
@@ -568,7 +568,7 @@ pub struct StageRecord {
     pub stage: &'static str,
     /// Points after it (grid samples for the fit).
     pub points: usize,
-    /// Wall-clock time [ms].
+    /// Wall-clock time (ms).
     pub ms: f64,
 }
 
@@ -580,18 +580,18 @@ pub struct Perceived {
     pub cloud: PointCloud,
     /// The fitted surface z = f(x, y) (`[RS eq. 21]`), levelled frame.
     pub fit: SurfaceFit,
-    /// Floor height in the levelled frame [m].
+    /// Floor height in the levelled frame (m).
     pub floor_height_m: f64,
     /// The floor found in the levelled scan (the plane the pass-through cut
     /// stands on): its points, those below it, its RMS.
     pub floor: TiltEstimate,
-    /// Roll α used to level [rad].
+    /// Roll α used to level (rad).
     pub roll_rad: f64,
-    /// Pitch β used to level [rad].
+    /// Pitch β used to level (rad).
     pub pitch_rad: f64,
     /// Length scale of the scene.
     pub scale: f64,
-    /// Mean point spacing [m].
+    /// Mean point spacing (m).
     pub spacing_m: f64,
     /// Every stage run, in order.
     pub stages: Vec<StageRecord>,
@@ -604,7 +604,7 @@ pub struct Perceived {
 }
 
 impl Perceived {
-    /// Wall time of every stage [ms].
+    /// Wall time of every stage (ms).
     pub fn total_ms(&self) -> f64 {
         self.stages.iter().map(|s| s.ms).sum()
     }
@@ -729,15 +729,15 @@ pub fn perceive_with(
 /// spacing, so that every frame of a sequence is filtered alike.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Prior {
-    /// Roll α of [RS eq. 11] [rad].
+    /// Roll α of [RS eq. 11] (rad).
     pub roll_rad: f64,
-    /// Pitch β of [RS eq. 11] [rad].
+    /// Pitch β of [RS eq. 11] (rad).
     pub pitch_rad: f64,
     /// The floor found in the levelled scan.
     pub floor: TiltEstimate,
     /// Length scale.
     pub scale: f64,
-    /// Point spacing [m].
+    /// Point spacing (m).
     pub spacing_m: f64,
 }
 
@@ -1063,11 +1063,11 @@ pub struct FitSummary {
     pub r2: f64,
     /// Adjusted R².
     pub adjusted_r2: f64,
-    /// RMS residual on the samples [m].
+    /// RMS residual on the samples (m).
     pub rms_residual_m: f64,
     /// R² on every cleaned point.
     pub r2_all_points: f64,
-    /// RMS residual on every cleaned point [m].
+    /// RMS residual on every cleaned point (m).
     pub rms_all_points_m: f64,
     /// Grid samples used.
     pub samples: usize,
@@ -1110,11 +1110,11 @@ pub struct PerceiveSummary {
     pub stage_points: BTreeMap<&'static str, usize>,
     /// Every stage, in order.
     pub stages: Vec<StageRecord>,
-    /// Roll α used to level [deg].
+    /// Roll α used to level (deg).
     pub roll_deg: f64,
-    /// Pitch β used to level [deg].
+    /// Pitch β used to level (deg).
     pub pitch_deg: f64,
-    /// Floor height, levelled frame [m].
+    /// Floor height, levelled frame (m).
     pub floor_height_m: f64,
     /// Points on the floor plane (within its inlier band).
     pub floor_points: usize,
@@ -1122,17 +1122,17 @@ pub struct PerceiveSummary {
     pub floor_share: f64,
     /// Points more than the below margin under the floor (multipath, ruts).
     pub points_below_floor: usize,
-    /// RMS distance of the floor points from the plane [m].
+    /// RMS distance of the floor points from the plane (m).
     pub floor_rms_m: f64,
     /// Length scale used.
     pub scale: f64,
-    /// Point spacing used [m].
+    /// Point spacing used (m).
     pub spacing_m: f64,
     /// R² of the fit on the grid samples.
     pub r2: f64,
-    /// Wall time of each stage [ms].
+    /// Wall time of each stage (ms).
     pub timings_ms: BTreeMap<&'static str, f64>,
-    /// Wall time of all stages [ms].
+    /// Wall time of all stages (ms).
     pub total_ms: f64,
     /// The fit.
     pub fit: FitSummary,

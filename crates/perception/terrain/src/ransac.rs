@@ -18,7 +18,7 @@
 //!    covariance, which minimises Σ (n·p − d)² — then inliers are collected
 //!    again and the fit repeated ([`RansacParams::refine_rounds`] times).
 
-use autoshovel_point_cloud::filter::Isa;
+use autoshovel_point_cloud::simd::Isa;
 use nalgebra::{Matrix3, SymmetricEigen, Vector3};
 use rand::seq::index::sample;
 use rand::{Rng, SeedableRng};
@@ -31,7 +31,7 @@ use crate::error::{Result, SurfaceError};
 pub struct Plane {
     /// Unit normal, `n_z ≥ 0`.
     pub normal: [f64; 3],
-    /// Offset d [m]: signed distance of the plane from the origin along `normal`.
+    /// Offset d (m): signed distance of the plane from the origin along `normal`.
     pub offset_m: f64,
 }
 
@@ -54,12 +54,12 @@ impl Plane {
         })
     }
 
-    /// Signed distance of a point [m], positive on the side the normal points to.
+    /// Signed distance of a point (m), positive on the side the normal points to.
     pub fn signed_distance(&self, p: [f64; 3]) -> f64 {
         self.normal[0] * p[0] + self.normal[1] * p[1] + self.normal[2] * p[2] - self.offset_m
     }
 
-    /// Angle between the normal and the z axis [rad].
+    /// Angle between the normal and the z axis (rad).
     pub fn tilt_rad(&self) -> f64 {
         self.normal[2].clamp(-1.0, 1.0).acos()
     }
@@ -69,7 +69,7 @@ impl Plane {
 #[derive(Debug, Clone, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default)]
 pub struct RansacParams {
-    /// Largest distance of an inlier from the plane [m]. Default 0.05 m: a
+    /// Largest distance of an inlier from the plane (m). Default 0.05 m: a
     /// few times the 2 cm range noise of a mine-scale scan; use ~2 mm for the
     /// paper's 1:30 model.
     pub inlier_threshold_m: f64,
@@ -81,7 +81,7 @@ pub struct RansacParams {
     /// Hypotheses are drawn from and scored on a random subset of at most
     /// this many points (refinement uses all of them). Default 20 000.
     pub max_scored_points: usize,
-    /// Largest angle between a candidate's normal and the z axis [rad];
+    /// Largest angle between a candidate's normal and the z axis (rad);
     /// `π/2` accepts any plane. Default 30°.
     pub max_tilt_rad: f64,
     /// Least-squares refinement rounds on the inliers. Default 2.
@@ -156,7 +156,7 @@ pub struct PlaneFit {
     pub plane: Plane,
     /// Indices of the inliers of the refined plane, ascending.
     pub inliers: Vec<usize>,
-    /// Root-mean-square distance of the inliers from the plane [m].
+    /// Root-mean-square distance of the inliers from the plane (m).
     pub rms_m: f64,
     /// Hypotheses drawn.
     pub iterations: usize,
@@ -328,11 +328,16 @@ fn inliers_from_on(
     threshold: f64,
 ) -> Vec<usize> {
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
-        // SAFETY: `Isa::best` and `Isa::available` give AVX-512 only where
-        // the machine has AVX-512F (and POPCNT).
+    if let Some(t) = isa.avx512() {
+        // SAFETY: `t` proves AVX-512F and POPCNT, the kernel's requirements.
         return unsafe {
-            crate::wide::avx512::inliers(points, first, (plane.normal, plane.offset_m), threshold)
+            crate::wide::avx512::inliers(
+                t,
+                points,
+                first,
+                (plane.normal, plane.offset_m),
+                threshold,
+            )
         };
     }
     let _ = isa;
@@ -397,7 +402,7 @@ mod tests {
             let (points, plane) = near_a_plane(n, n as u64);
             let on_edge = plane.signed_distance([0.0, 0.0, 1.55]).abs();
             for threshold in [0.05, on_edge] {
-                let portable = inliers_from_on(Isa::Portable, &points, 3, &plane, threshold);
+                let portable = inliers_from_on(Isa::PORTABLE, &points, 3, &plane, threshold);
                 assert!(portable.iter().all(|&i| i >= 3 && i < n + 3));
                 for isa in Isa::available() {
                     let got = inliers_from_on(isa, &points, 3, &plane, threshold);
@@ -406,7 +411,7 @@ mod tests {
             }
             // The edge case occurs: points exactly at the threshold kept.
             if n > 0 {
-                let kept = inliers_from_on(Isa::Portable, &points, 0, &plane, on_edge);
+                let kept = inliers_from_on(Isa::PORTABLE, &points, 0, &plane, on_edge);
                 assert!(kept.contains(&0), "{n} points");
             }
         }

@@ -37,16 +37,16 @@ use rayon::prelude::*;
 
 use crate::error::{Result, SurfaceError};
 
-/// A rectangle in the (x, y) plane [m].
+/// A rectangle in the (x, y) plane (m).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Extent {
-    /// Smallest x [m].
+    /// Smallest x (m).
     pub x_min_m: f64,
-    /// Largest x [m].
+    /// Largest x (m).
     pub x_max_m: f64,
-    /// Smallest y [m].
+    /// Smallest y (m).
     pub y_min_m: f64,
-    /// Largest y [m].
+    /// Largest y (m).
     pub y_max_m: f64,
 }
 
@@ -56,12 +56,12 @@ impl Extent {
         x >= self.x_min_m && x <= self.x_max_m && y >= self.y_min_m && y <= self.y_max_m
     }
 
-    /// Width along x [m].
+    /// Width along x (m).
     pub fn x_span_m(&self) -> f64 {
         self.x_max_m - self.x_min_m
     }
 
-    /// Width along y [m].
+    /// Width along y (m).
     pub fn y_span_m(&self) -> f64 {
         self.y_max_m - self.y_min_m
     }
@@ -165,11 +165,11 @@ pub struct GridSample {
     pub ix: usize,
     /// Node row (0-based, along y).
     pub iy: usize,
-    /// x of the sample [m] (the node's, or the centroid of its points near an edge).
+    /// x of the sample (m) (the node's, or the centroid of its points near an edge).
     pub x_m: f64,
-    /// y of the sample [m].
+    /// y of the sample (m).
     pub y_m: f64,
-    /// Height: robust local plane through the points used [m].
+    /// Height: robust local plane through the points used (m).
     pub z_m: f64,
     /// Points used.
     pub points: usize,

@@ -10,7 +10,7 @@ use crate::fit::SurfaceFit;
 
 impl SurfaceFit {
     /// Volume of the material above the plane `z = z0_m` and below the
-    /// surface over `x_range_m × y_range_m` [m³], by the midpoint rule on an
+    /// surface over `x_range_m × y_range_m` (m³), by the midpoint rule on an
     /// `n × n` grid. Empty ranges or `n == 0` give 0.
     pub fn volume_above(
         &self,

@@ -1,5 +1,5 @@
 //! The floor search's passes over the points, eight a step on AVX-512
-//! (`autoshovel_point_cloud::filter::Isa`): the distance of each point from a
+//! (`autoshovel_point_cloud::simd`): the distance of each point from a
 //! plane, and the points kept by it packed by a compress instruction where
 //! the portable loop stores every index and moves a count on by the test.
 //! On a 100 k-point frame those stores were two fifths of the floor
@@ -13,6 +13,8 @@
 #[cfg(target_arch = "x86_64")]
 pub(crate) mod avx512 {
     use std::arch::x86_64::*;
+
+    use autoshovel_point_cloud::simd::Avx512;
 
     /// A plane n · p = d as (n, d), n of unit length (`ransac::Plane`'s
     /// normal and offset).
@@ -117,9 +119,10 @@ pub(crate) mod avx512 {
     /// `plane`, ascending (`ransac::inliers_from`'s portable loop).
     ///
     /// # Safety
-    /// The machine has AVX-512F and POPCNT.
+    /// The machine has AVX-512F and POPCNT (the proof).
     #[target_feature(enable = "avx512f,popcnt")]
     pub(crate) unsafe fn inliers(
+        _: Avx512,
         points: &[[f64; 3]],
         first: usize,
         plane: Coefficients,
@@ -167,9 +170,11 @@ pub(crate) mod avx512 {
     /// of those more than `below` under it.
     ///
     /// # Safety
-    /// The machine has AVX-512F and POPCNT; `cells` is as long as `points`.
+    /// The machine has AVX-512F and POPCNT (the proof); `cells` is as long
+    /// as `points`.
     #[target_feature(enable = "avx512f,popcnt")]
     pub(crate) unsafe fn split(
+        _: Avx512,
         points: &[[f32; 3]],
         cells: &[u32],
         first: usize,

@@ -14,7 +14,7 @@ use rand::seq::SliceRandom;
 use rand::SeedableRng;
 use rand_chacha::ChaCha8Rng;
 
-/// Largest tilt error accepted [deg].
+/// Largest tilt error accepted (deg).
 const TOLERANCE_DEG: f64 = 0.02;
 
 /// Which points of a generated scan are floor: levelled with the true angles,

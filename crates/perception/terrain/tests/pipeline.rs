@@ -11,7 +11,7 @@ use autoshovel_terrain::{
     estimate_tilt, generate_pile, PileParams, PileShape, SurfaceFit, TiltParams,
 };
 
-/// Tilt recovery tolerance of the issue [deg].
+/// Tilt recovery tolerance of the issue (deg).
 const TILT_TOL_DEG: f64 = 0.2;
 
 struct Outcome {

@@ -2,8 +2,8 @@
 //! on 121 samples) and one whole plan: the paper's GWO (50 wolves × 100
 //! iterations) and the default search (that, then a CMA-ES polish of 20 000).
 
-use autoshovel_rope_shovel_dig::{plan_dig, Decision, DigModel, MachineProfile};
 use autoshovel_optim::GwoParams;
+use autoshovel_rope_shovel_dig::{plan_dig, Decision, DigModel, MachineProfile};
 use autoshovel_terrain::PileShape;
 use criterion::{black_box, criterion_group, criterion_main, Criterion};
 

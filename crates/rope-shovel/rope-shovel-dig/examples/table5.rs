@@ -4,10 +4,10 @@
 //!
 //! `cargo run --release -p autoshovel-rope-shovel-dig --example table5`
 
+use autoshovel_optim::GwoParams;
 use autoshovel_rope_shovel_dig::{
     paper_pile, plan_dig, search_preset, DigModel, DigSearch, MachineProfile, PAPER_TABLES_4_5,
 };
-use autoshovel_optim::GwoParams;
 
 fn main() {
     let profile = MachineProfile::scale_model();

@@ -14,14 +14,14 @@
 //! 0.056 per unit of ε), backing off when the limits leave no feasible plan. The result is calibrated on one pile and then used
 //! unchanged to *predict* the others.
 
+use crate::dig_surface::DigSurface;
 use crate::error::{DigError, Result};
 use crate::plan::{plan_dig, DigModel, DigSearch};
 use crate::profile::MachineProfile;
-use crate::terrain::DigSurface;
 
 /// How much the planned fill factor falls per unit of ε, about.
 const FILL_SLOPE: f64 = 0.056;
-/// How much f1 rises per unit of ε at a fixed k_F, about [J/kg].
+/// How much f1 rises per unit of ε at a fixed k_F, about (J/kg).
 const F1_PER_EPS: f64 = 1.08;
 /// Share of the Newton step taken.
 const DAMPING: f64 = 0.6;
@@ -29,7 +29,7 @@ const DAMPING: f64 = 0.6;
 /// What to match.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct CalibrationTarget {
-    /// f1 [J/kg].
+    /// f1 (J/kg).
     pub f1_j_per_kg: f64,
     /// Fill factor V/V_cd.
     pub fill_factor: f64,
@@ -49,11 +49,11 @@ impl CalibrationTarget {
 /// The outcome of [`calibrate`].
 #[derive(Debug, Clone, PartialEq, serde::Serialize)]
 pub struct Calibration {
-    /// k_F [Pa].
+    /// k_F (Pa).
     pub cutting_resistance_pa: f64,
     /// ε.
     pub fill_resistance_ratio: f64,
-    /// f1 of the final plan [J/kg].
+    /// f1 of the final plan (J/kg).
     pub f1_j_per_kg: f64,
     /// Fill factor of the final plan.
     pub fill_factor: f64,

@@ -19,7 +19,7 @@ use crate::plan::DigModel;
 pub struct PaperPlanCheck {
     /// f on our model.
     pub f: f64,
-    /// m_dig on our model [kg].
+    /// m_dig on our model (kg).
     pub m_dig_kg: f64,
     /// Fill factor on our model.
     pub fill_factor: f64,
@@ -68,7 +68,7 @@ pub struct AllSurfacesSummary {
     pub init: &'static str,
     /// The profile's path or "builtin scale-model".
     pub profile: String,
-    /// Cutting resistance k_F [Pa].
+    /// Cutting resistance k_F (Pa).
     pub k_f_pa: f64,
     /// Fill resistance ratio ε.
     pub epsilon: f64,
@@ -78,7 +78,7 @@ pub struct AllSurfacesSummary {
     pub feasible: bool,
     /// Same as `feasible`.
     pub success: bool,
-    /// Wall time of the four plans [ms].
+    /// Wall time of the four plans (ms).
     pub plan_time_ms: f64,
 }
 
@@ -336,13 +336,13 @@ pub struct TableSummary {
     pub init: &'static str,
     /// The profile.
     pub profile: String,
-    /// Cutting resistance k_F [Pa].
+    /// Cutting resistance k_F (Pa).
     pub k_f_pa: f64,
     /// Fill resistance ratio ε.
     pub epsilon: f64,
     /// Whether every pile has a feasible plan.
     pub success: bool,
-    /// Wall time [ms].
+    /// Wall time (ms).
     pub plan_time_ms: f64,
     /// One row per pile, keyed by its name.
     #[serde(flatten)]

@@ -32,20 +32,20 @@
 use crate::kinematics::{JointState, RopeShovel};
 use crate::profile::MachineProfile;
 
-const G: f64 = 9.81;
+use autoshovel_core::G;
 
 /// Mass properties of the moving front end.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MassModel {
-    /// m_d [kg].
+    /// m_d (kg).
     pub handle_mass: f64,
-    /// L_d [m].
+    /// L_d (m).
     pub handle_length: f64,
-    /// Empty dipper [kg].
+    /// Empty dipper (kg).
     pub dipper_mass: f64,
-    /// L_c [m].
+    /// L_c (m).
     pub dipper_length: f64,
-    /// Dipper centroid offset e off the handle axis [m].
+    /// Dipper centroid offset e off the handle axis (m).
     pub dipper_offset: f64,
 }
 
@@ -132,28 +132,28 @@ pub struct LagrangeTerms {
 /// Forces, speeds and powers of the hoist and crowd at one instant.
 #[derive(Debug, Clone, Copy, PartialEq, Default, serde::Serialize)]
 pub struct Drive {
-    /// Hoist rope tension F_h [N].
+    /// Hoist rope tension F_h (N).
     pub hoist_force_n: f64,
-    /// Crowd force F_c along the handle [N].
+    /// Crowd force F_c along the handle (N).
     pub crowd_force_n: f64,
-    /// Hoist rope speed v_h, positive when hoisting (rope shortening) [m/s].
+    /// Hoist rope speed v_h, positive when hoisting (rope shortening) (m/s).
     pub hoist_speed_m_s: f64,
-    /// Crowd speed v_c = ḋ₂, positive when crowding out [m/s].
+    /// Crowd speed v_c = ḋ₂, positive when crowding out (m/s).
     pub crowd_speed_m_s: f64,
-    /// θ₂: angle between the rope and the handle [rad].
+    /// θ₂: angle between the rope and the handle (rad).
     pub rope_handle_angle_rad: f64,
-    /// Tangential digging resistance F_τ [N].
+    /// Tangential digging resistance F_τ (N).
     pub resistance_tangential_n: f64,
-    /// Normal digging resistance F_n [N].
+    /// Normal digging resistance F_n (N).
     pub resistance_normal_n: f64,
 }
 
 impl Drive {
-    /// Hoist power P_h = F_h v_h [W].
+    /// Hoist power P_h = F_h v_h (W).
     pub fn hoist_power_w(&self) -> f64 {
         self.hoist_force_n * self.hoist_speed_m_s
     }
-    /// Crowd power P_c = F_c v_c [W].
+    /// Crowd power P_c = F_c v_c (W).
     pub fn crowd_power_w(&self) -> f64 {
         self.crowd_force_n * self.crowd_speed_m_s
     }

@@ -63,7 +63,7 @@ pub enum DigError {
     ScanHasNoPile {
         /// The scan.
         path: PathBuf,
-        /// The floor height found by perception [m].
+        /// The floor height found by perception (m).
         floor_height_m: f64,
     },
     /// The fitted surface of a scan cannot be cut into a dig profile.
@@ -74,7 +74,7 @@ pub enum DigError {
     ScanCut {
         /// The scan.
         path: PathBuf,
-        /// The dig plane [m].
+        /// The dig plane (m).
         dig_plane_y_m: f64,
         /// Why the cut failed.
         source: Box<DigError>,
@@ -148,15 +148,15 @@ pub enum DigError {
     NoOverlap {
         /// The measured file.
         path: PathBuf,
-        /// Its first time [s].
+        /// Its first time (s).
         record_start_s: f64,
-        /// Its last time [s].
+        /// Its last time (s).
         record_end_s: f64,
-        /// The planned dig time [s].
+        /// The planned dig time (s).
         td_s: f64,
-        /// The lag window searched, either side of the record's start [s].
+        /// The lag window searched, either side of the record's start (s).
         max_lag_s: f64,
-        /// The least share of the dig a record must cover [%].
+        /// The least share of the dig a record must cover (%).
         min_overlap_pct: f64,
     },
 }
@@ -206,9 +206,9 @@ pub enum RecordProblem {
     /// Time not strictly increasing.
     #[error("t_s = {t_s} does not increase (the line before has {previous_t_s})")]
     TimeNotIncreasing {
-        /// The time of this line [s].
+        /// The time of this line (s).
         t_s: f64,
-        /// The time of the line before [s].
+        /// The time of the line before (s).
         previous_t_s: f64,
     },
     /// Too few rows to compare.
@@ -295,7 +295,7 @@ pub enum PackProblem {
     /// A dig duration that is not positive.
     #[error("td_s = {td_s} must be > 0")]
     DurationNotPositive {
-        /// The duration read [s].
+        /// The duration read (s).
         td_s: f64,
     },
     /// A header and no wolves.

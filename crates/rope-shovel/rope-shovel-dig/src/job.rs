@@ -14,6 +14,7 @@ use autoshovel_terrain::perceive::Perceived;
 use autoshovel_terrain::PileShape;
 use serde::Serialize;
 
+use crate::dig_surface::DigSurface;
 use crate::error::{DigError, Result};
 use crate::pack::read_pack;
 use crate::plan::{
@@ -21,7 +22,6 @@ use crate::plan::{
 };
 use crate::profile::{Geometry, MachineProfile};
 use crate::scan::{cut_scan, PerceptionSummary, ScanSource};
-use crate::terrain::DigSurface;
 use crate::trajectory::Decision;
 
 /// The machine and the optimiser settings of a run.
@@ -178,13 +178,13 @@ pub struct DigHeader {
     /// The warm start, if any.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub warm_start: Option<WarmStartSummary>,
-    /// Cutting resistance k_F [Pa].
+    /// Cutting resistance k_F (Pa).
     pub k_f_pa: f64,
     /// Fill resistance ratio ε.
     pub epsilon: f64,
     /// Normal-to-tangential resistance ratio ψ.
     pub psi: f64,
-    /// Material density [kg/m³].
+    /// Material density (kg/m³).
     pub density_kg_m3: f64,
     /// Weight of f1 in f.
     pub k1: f64,
@@ -278,35 +278,35 @@ pub fn constraint_reports(
 /// The fields of a plan that came out.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanFields {
-    /// a_x6 [m/s⁶].
+    /// a_x6 (m/s⁶).
     pub ax6: f64,
-    /// a_y6 [m/s⁶].
+    /// a_y6 (m/s⁶).
     pub ay6: f64,
-    /// Dig duration t_d [s].
+    /// Dig duration t_d (s).
     pub td_s: f64,
-    /// End point g_x [m].
+    /// End point g_x (m).
     pub gx_m: f64,
-    /// End point g_y [m].
+    /// End point g_y (m).
     pub gy_m: f64,
-    /// Mid-dig bend in x [m].
+    /// Mid-dig bend in x (m).
     pub bend_x_m: f64,
-    /// Mid-dig bend in y [m].
+    /// Mid-dig bend in y (m).
     pub bend_y_m: f64,
     /// f = k1·f1 + k2·f2 ([RS eq. 27]).
     pub f: f64,
-    /// f1 [J/kg] ([RS eq. 25]).
+    /// f1 (J/kg) ([RS eq. 25]).
     pub f1_j_per_kg: f64,
-    /// f2 [s/kg] ([RS eq. 26]).
+    /// f2 (s/kg) ([RS eq. 26]).
     pub f2_s_per_kg: f64,
-    /// Mass dug [kg].
+    /// Mass dug (kg).
     pub m_dig_kg: f64,
-    /// Volume dug [m³].
+    /// Volume dug (m³).
     pub volume_m3: f64,
     /// Fill factor V/V_cd.
     pub fill_factor: f64,
-    /// Hoist energy [J].
+    /// Hoist energy (J).
     pub hoist_energy_j: f64,
-    /// Crowd energy [J].
+    /// Crowd energy (J).
     pub crowd_energy_j: f64,
     /// c1–c18 by name.
     pub constraints: BTreeMap<&'static str, ConstraintReport>,
@@ -384,7 +384,7 @@ pub struct DigSummary {
     /// Why no plan came out.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub error: Option<String>,
-    /// Wall time of the plan [ms].
+    /// Wall time of the plan (ms).
     pub plan_time_ms: f64,
 }
 

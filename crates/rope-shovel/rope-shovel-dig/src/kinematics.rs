@@ -10,7 +10,7 @@
 //!     p = O + l₃ n + (d₂ + d₂₀) u                                  ([RS eq. 6])
 //! ```
 //!
-//! which [`RopeShovel::forward_poe`] builds as [RS eq. 1], e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T(0),
+//! which [`RopeShovel::forward_poe`] builds as [RS eq. 1], e^{\[ξ₁\]θ₁} e^{\[ξ₂\]d₂} T(0),
 //! from the twists ξ₁ (revolute about z through O) and ξ₂ (prismatic along
 //! the handle at home, −y). The inverse is closed form ([RS eqs. 7–8], with atan2
 //! so that every quadrant is right):
@@ -29,12 +29,12 @@ use nalgebra::{Matrix4, Vector3};
 
 use crate::profile::Geometry;
 
-/// Joint values: handle angle θ₁ [rad] and extension d₂ [m] ([RS eq. 1]).
+/// Joint values: handle angle θ₁ (rad) and extension d₂ (m) ([RS eq. 1]).
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct Joints {
-    /// θ₁: handle angle from the downward vertical, counter-clockwise [rad].
+    /// θ₁: handle angle from the downward vertical, counter-clockwise (rad).
     pub theta1: f64,
-    /// d₂: handle extension beyond the retracted d₂₀ [m].
+    /// d₂: handle extension beyond the retracted d₂₀ (m).
     pub d2: f64,
 }
 
@@ -43,13 +43,13 @@ pub struct Joints {
 pub struct JointState {
     /// Positions.
     pub q: Joints,
-    /// θ̇₁ [rad/s].
+    /// θ̇₁ (rad/s).
     pub theta1_dot: f64,
-    /// ḋ₂, the crowd speed v_c [m/s].
+    /// ḋ₂, the crowd speed v_c (m/s).
     pub d2_dot: f64,
-    /// θ̈₁ [rad/s²].
+    /// θ̈₁ (rad/s²).
     pub theta1_ddot: f64,
-    /// d̈₂ [m/s²].
+    /// d̈₂ (m/s²).
     pub d2_ddot: f64,
     /// Handle direction u = (sin θ₁, −cos θ₁).
     pub u: [f64; 2],
@@ -88,7 +88,7 @@ impl RopeShovel {
         [g.l1 + g.l3 * n[0] + d * u[0], g.l2 + g.l3 * n[1] + d * u[1]] // [RS eq. 6]
     }
 
-    /// [RS eq. 1]: the full tip pose T_BW(q) = e^{[ξ₁]θ₁} e^{[ξ₂]d₂} T_BW(0) by PoE
+    /// [RS eq. 1]: the full tip pose T_BW(q) = e^{\[ξ₁\]θ₁} e^{\[ξ₂\]d₂} T_BW(0) by PoE
     /// (z out of the dig plane). Its translation equals [`RopeShovel::forward`].
     pub fn forward_poe(&self, q: Joints) -> Matrix4<f64> {
         let g = &self.geometry;

@@ -2,7 +2,7 @@
 //! product-of-exponentials kinematics of the 1R-1P dipper ([`kinematics`],
 //! [RS eqs. 1–8]), Lagrange dynamics with digging resistance
 //! ([`dynamics`], [RS eq. 10]), the 6th-order tooth path ([`trajectory`],
-//! [RS eqs. 22–24]), the pile as the planner sees it ([`terrain`],
+//! [RS eqs. 22–24]), the pile as the planner sees it ([`dig_surface`],
 //! [RS eq. 21] and [RS eq. 28]), and the planner that puts them under the
 //! 18 constraints and the Grey Wolf Optimizer ([`plan`], [RS eqs. 25–37]).
 //! The machine is a [`MachineProfile`] read from TOML.
@@ -16,11 +16,9 @@
 //! The `validate-dig` job, planned against measured ([RS §5], Table 6,
 //! Fig. 20), is [`validate`].
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod calibrate;
 pub mod compare;
+pub mod dig_surface;
 pub mod dynamics;
 mod error;
 pub mod job;
@@ -31,7 +29,6 @@ pub mod plan;
 pub mod profile;
 pub mod scan;
 pub mod similar;
-pub mod terrain;
 pub mod trajectory;
 pub mod validate;
 
@@ -40,6 +37,7 @@ pub use compare::{
     all_surfaces, table_summary, AllSurfaces, AllSurfacesSummary, ComparedPile, PaperPlanCheck,
     SurfaceComparison, TableColumn, TableRow, TableSummary, TABLE_COLUMNS,
 };
+pub use dig_surface::DigSurface;
 pub use error::{DigError, PackProblem, PlanDirProblem, RecordProblem, Result};
 pub use job::{
     plan_pile, ConstraintReport, DigHeader, DigSetup, DigSummary, Pile, PlanFields, PlannedPile,
@@ -55,5 +53,4 @@ pub use plan::{
 pub use profile::{Geometry, MachineProfile};
 pub use scan::{cut_scan, PerceptionSummary, ScanCut, ScanSource, TOE_RISE_SHARE};
 pub use similar::Similarity;
-pub use terrain::DigSurface;
 pub use trajectory::{Decision, Trajectory};

@@ -6,10 +6,10 @@
 use autoshovel_terrain::{PileParams, PileShape};
 use serde::Serialize;
 
+use crate::dig_surface::DigSurface;
 use crate::error::{DigError, Result};
 use crate::plan::DigModel;
 use crate::profile::MachineProfile;
-use crate::terrain::DigSurface;
 use crate::trajectory::Decision;
 
 /// One row of the paper's Tables 4 and 5. Serialises as the summary's
@@ -19,25 +19,25 @@ pub struct PaperRow {
     /// The pile.
     #[serde(skip)]
     pub shape: PileShape,
-    /// a_x6 [1e-7 m/s⁶] (Table 4).
+    /// a_x6 (1e-7 m/s⁶) (Table 4).
     pub ax6_1e7: f64,
-    /// a_y6 [1e-7 m/s⁶] (Table 4).
+    /// a_y6 (1e-7 m/s⁶) (Table 4).
     pub ay6_1e7: f64,
-    /// g_x [m] (Table 4).
+    /// g_x (m) (Table 4).
     pub gx_m: f64,
-    /// g_y [m] (Table 4).
+    /// g_y (m) (Table 4).
     pub gy_m: f64,
-    /// t_d [s] (Table 4).
+    /// t_d (s) (Table 4).
     pub td_s: f64,
     /// f = k1·f1 + k2·f2 (Table 5).
     pub f: f64,
-    /// f1 [J/kg] (Table 5).
+    /// f1 (J/kg) (Table 5).
     pub f1_j_per_kg: f64,
-    /// f2 [s/kg] (Table 5).
+    /// f2 (s/kg) (Table 5).
     pub f2_s_per_kg: f64,
-    /// m_dig [kg] (Table 5).
+    /// m_dig (kg) (Table 5).
     pub m_dig_kg: f64,
-    /// Dipper fill factor [%] (Table 5).
+    /// Dipper fill factor (%) (Table 5).
     pub fill_pct: f64,
 }
 
@@ -134,9 +134,9 @@ pub fn paper_row(shape: PileShape) -> &'static PaperRow {
         .expect("Tables 4-5 hold every pile of Fig. 7")
 }
 
-/// Lowest and highest face height tried by [`paper_pile`] [m].
+/// Lowest and highest face height tried by [`paper_pile`] (m).
 const PILE_HEIGHTS_M: (f64, f64) = (0.02, 0.60);
-/// Step of [`paper_pile`]'s scan for the fill's crossings [m].
+/// Step of [`paper_pile`]'s scan for the fill's crossings (m).
 const PILE_SCAN_STEP_M: f64 = 0.005;
 
 /// A pile of Fig. 7 rebuilt from Tables 4–5: the paper prints neither the
@@ -154,7 +154,7 @@ pub struct PaperPile {
     /// The pile.
     #[serde(skip)]
     pub shape: PileShape,
-    /// Fitted face height, toe to crest [m].
+    /// Fitted face height, toe to crest (m).
     pub face_height_m: f64,
     /// Fill factor of Table 4's decision on the fitted pile.
     pub fill_factor: f64,

@@ -34,14 +34,14 @@ use autoshovel_optim::{
     Problem,
 };
 
+use crate::dig_surface::{swept_width, DigSurface};
 use crate::dynamics::{inverse_dynamics, Drive, MassModel};
 use crate::error::{DigError, Result};
 use crate::kinematics::{Joints, RopeShovel};
 use crate::profile::MachineProfile;
-use crate::terrain::{swept_width, DigSurface};
 use crate::trajectory::Decision;
 
-const G: f64 = 9.81;
+use autoshovel_core::G;
 
 /// Names of c1–c18, as in the summary.
 pub const CONSTRAINT_NAMES: [&str; 18] = [
@@ -112,19 +112,19 @@ pub struct ConstraintLimit {
 /// The state of the dig at one sample.
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize)]
 pub struct DigSample {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
-    /// Tooth tip x, y in the dig frame [m].
+    /// Tooth tip x, y in the dig frame (m).
     pub tip_m: [f64; 2],
     /// Joint values.
     pub joints: Joints,
     /// Forces and speeds.
     pub drive: Drive,
-    /// Cut thickness c normal to the path [m].
+    /// Cut thickness c normal to the path (m).
     pub cut_thickness_m: f64,
-    /// Material in the dipper so far [kg].
+    /// Material in the dipper so far (kg).
     pub load_kg: f64,
-    /// Digging back angle β [rad].
+    /// Digging back angle β (rad).
     pub back_angle_rad: f64,
 }
 
@@ -182,17 +182,17 @@ pub struct DigOutcome {
     pub decision: Decision,
     /// f of [RS eq. 27].
     pub f: f64,
-    /// f1 of [RS eq. 25]: energy per kilogram [J/kg].
+    /// f1 of [RS eq. 25]: energy per kilogram (J/kg).
     pub f1_j_per_kg: f64,
-    /// f2 of [RS eq. 26]: time per kilogram [s/kg].
+    /// f2 of [RS eq. 26]: time per kilogram (s/kg).
     pub f2_s_per_kg: f64,
-    /// ∫ v_h F_h dt [J].
+    /// ∫ v_h F_h dt (J).
     pub hoist_energy_j: f64,
-    /// ∫ v_c F_c dt [J].
+    /// ∫ v_c F_c dt (J).
     pub crowd_energy_j: f64,
-    /// V of [RS eq. 28] [m³].
+    /// V of [RS eq. 28] (m³).
     pub volume_m3: f64,
-    /// m_dig = ρV [kg].
+    /// m_dig = ρV (kg).
     pub m_dig_kg: f64,
     /// V / V_cd.
     pub fill_factor: f64,

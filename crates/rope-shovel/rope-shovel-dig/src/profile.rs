@@ -39,30 +39,30 @@ pub const SCALE_MODEL_TOML: &str = include_str!("../profiles/scale-model.toml");
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct GeometrySpec {
-    /// R1: boom point sheave radius [m].
+    /// R1: boom point sheave radius (m).
     pub sheave_radius_m: f64,
-    /// R2: crowd pinion pitch radius [m] (reported as crowd motor speed).
+    /// R2: crowd pinion pitch radius (m) (reported as crowd motor speed).
     pub pinion_radius_m: f64,
-    /// l_AB: boom length, foot to sheave centre [m].
+    /// l_AB: boom length, foot to sheave centre (m).
     pub boom_length_m: f64,
-    /// l_OB: saddle centre to sheave centre along the boom [m].
+    /// l_OB: saddle centre to sheave centre along the boom (m).
     pub saddle_to_sheave_m: f64,
-    /// l_OC: saddle centre to the bail pin on the handle axis, retracted [m].
+    /// l_OC: saddle centre to the bail pin on the handle axis, retracted (m).
     pub saddle_to_bail_m: f64,
-    /// l_OD: saddle centre to the tooth tip, retracted [m].
+    /// l_OD: saddle centre to the tooth tip, retracted (m).
     pub saddle_to_tip_m: f64,
-    /// H: saddle centre above the floor [m].
+    /// H: saddle centre above the floor (m).
     pub saddle_height_m: f64,
-    /// α: repose angle of the ideal face [deg].
+    /// α: repose angle of the ideal face (deg).
     pub pile_angle_deg: f64,
-    /// β: boom angle to the horizontal [deg].
+    /// β: boom angle to the horizontal (deg).
     pub boom_angle_deg: f64,
     /// δ1: tilt of the tooth back face from the normal to the tooth line OD
-    /// [deg] (so δ1 + δ2 from the handle normal; docs/dig.md).
+    /// (deg) (so δ1 + δ2 from the handle normal; docs/dig.md).
     pub dipper_pitch_deg: f64,
-    /// δ2: angle at O between the handle axis and OD [deg].
+    /// δ2: angle at O between the handle axis and OD (deg).
     pub tip_angle_deg: f64,
-    /// Horizontal distance from O to the toe [m]; default: the tip meets the
+    /// Horizontal distance from O to the toe (m); default: the tip meets the
     /// floor with the handle retracted.
     #[serde(default)]
     pub toe_distance_m: Option<f64>,
@@ -72,15 +72,15 @@ pub struct GeometrySpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct DipperSpec {
-    /// b: width across the dig plane [m].
+    /// b: width across the dig plane (m).
     pub width_m: f64,
-    /// L_c: length from the tip back along the handle [m].
+    /// L_c: length from the tip back along the handle (m).
     pub length_m: f64,
-    /// H_cd: height from the tip to the bottom [m].
+    /// H_cd: height from the tip to the bottom (m).
     pub height_m: f64,
-    /// V_cd: rated capacity [m³].
+    /// V_cd: rated capacity (m³).
     pub capacity_m3: f64,
-    /// Empty mass [kg].
+    /// Empty mass (kg).
     pub mass_kg: f64,
 }
 
@@ -88,9 +88,9 @@ pub struct DipperSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct HandleSpec {
-    /// L_d = L_dg: length, which is also the crowd stroke limit of c17 [m].
+    /// L_d = L_dg: length, which is also the crowd stroke limit of c17 (m).
     pub length_m: f64,
-    /// m_d [kg].
+    /// m_d (kg).
     pub mass_kg: f64,
 }
 
@@ -98,9 +98,9 @@ pub struct HandleSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct MaterialSpec {
-    /// Bank density ρ [kg/m³] (limestone 2540, Table 2).
+    /// Bank density ρ (kg/m³) (limestone 2540, Table 2).
     pub density_kg_m3: f64,
-    /// k_F of F_τ = k_F·b·c [Pa = J/m³].
+    /// k_F of F_τ = k_F·b·c (Pa = J/m³).
     pub cutting_resistance_pa: f64,
     /// ψ of F_n = ψ·F_τ.
     pub normal_ratio: f64,
@@ -117,27 +117,27 @@ pub struct LimitsSpec {
     pub fill_min: f64,
     /// c2: greatest fill factor.
     pub fill_max: f64,
-    /// c3: shortest dig [s].
+    /// c3: shortest dig (s).
     pub time_min_s: f64,
-    /// c4: longest dig [s].
+    /// c4: longest dig (s).
     pub time_max_s: f64,
-    /// c5: least digging back (clearance) angle [deg].
+    /// c5: least digging back (clearance) angle (deg).
     pub back_angle_min_deg: f64,
-    /// c6: greatest digging back angle [deg].
+    /// c6: greatest digging back angle (deg).
     pub back_angle_max_deg: f64,
-    /// c8: hoist rope speed limit [m/s].
+    /// c8: hoist rope speed limit (m/s).
     pub hoist_speed_max_m_s: f64,
-    /// c10: crowd speed limit [m/s].
+    /// c10: crowd speed limit (m/s).
     pub crowd_speed_max_m_s: f64,
-    /// c11: hoist force rating [N].
+    /// c11: hoist force rating (N).
     pub hoist_force_max_n: f64,
-    /// c12: crowd force rating [N].
+    /// c12: crowd force rating (N).
     pub crowd_force_max_n: f64,
-    /// c13: hoist power rating [W].
+    /// c13: hoist power rating (W).
     pub hoist_power_max_w: f64,
-    /// c14: crowd power rating [W].
+    /// c14: crowd power rating (W).
     pub crowd_power_max_w: f64,
-    /// c16: H_kk, hopper height above the floor [m].
+    /// c16: H_kk, hopper height above the floor (m).
     pub hopper_height_m: f64,
 }
 
@@ -145,9 +145,9 @@ pub struct LimitsSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct ObjectiveSpec {
-    /// k1, on f1 [J/kg].
+    /// k1, on f1 (J/kg).
     pub k1: f64,
-    /// k2, on f2 [s/kg].
+    /// k2, on f2 (s/kg).
     pub k2: f64,
 }
 
@@ -157,19 +157,19 @@ pub struct ObjectiveSpec {
 #[derive(Debug, Clone, PartialEq, Deserialize, serde::Serialize)]
 #[serde(deny_unknown_fields)]
 pub struct SearchSpec {
-    /// Mid-dig bend of the x path [m].
+    /// Mid-dig bend of the x path (m).
     pub bend_x_m: [f64; 2],
-    /// Mid-dig bend of the y path [m].
+    /// Mid-dig bend of the y path (m).
     pub bend_y_m: [f64; 2],
-    /// a_x6 [m/s⁶].
+    /// a_x6 (m/s⁶).
     pub ax6: [f64; 2],
-    /// a_y6 [m/s⁶].
+    /// a_y6 (m/s⁶).
     pub ay6: [f64; 2],
-    /// t_d [s].
+    /// t_d (s).
     pub td_s: [f64; 2],
-    /// g_x [m].
+    /// g_x (m).
     pub gx_m: [f64; 2],
-    /// g_y [m].
+    /// g_y (m).
     pub gy_m: [f64; 2],
 }
 
@@ -263,7 +263,7 @@ impl MachineProfile {
             ("limits", "time_min_s", self.limits.time_min_s),
         ];
         config::check_each(text, file, &positive, config::POSITIVE)?;
-        // The first ten are the machine's lengths [m].
+        // The first ten are the machine's lengths (m).
         config::check_each(text, file, &positive[..10], config::LENGTH)?;
         let non_negative = [
             (

@@ -21,9 +21,9 @@ use autoshovel_terrain::perceive::Perceived;
 use autoshovel_terrain::{Extent, SurfaceFit};
 use serde::Serialize;
 
+use crate::dig_surface::DigSurface;
 use crate::error::{DigError, Result};
 use crate::profile::MachineProfile;
-use crate::terrain::DigSurface;
 
 /// Share of the face height above the floor that marks the toe of a scanned pile.
 pub const TOE_RISE_SHARE: f64 = 0.03;
@@ -37,11 +37,11 @@ pub const SCALE_MISMATCH_REACH_RATIO: f64 = 2.0;
 pub struct ScanCut {
     /// The profile in the dig plane.
     pub surface: DigSurface,
-    /// The dig plane y [m] (levelled frame).
+    /// The dig plane y (m) (levelled frame).
     pub dig_plane_y_m: f64,
-    /// Face height: the highest grid sample above the floor [m].
+    /// Face height: the highest grid sample above the floor (m).
     pub face_height_m: f64,
-    /// Rise above the floor that marks the toe [m].
+    /// Rise above the floor that marks the toe (m).
     pub toe_rise_m: f64,
     /// Why a plan on this pile may fail (the scale check), if it may.
     pub hint: Option<String>,
@@ -111,11 +111,11 @@ pub struct PerceptionSummary {
     pub input_points: usize,
     /// Points left after filtering.
     pub output_points: usize,
-    /// Roll used to level [deg].
+    /// Roll used to level (deg).
     pub roll_deg: f64,
-    /// Pitch used to level [deg].
+    /// Pitch used to level (deg).
     pub pitch_deg: f64,
-    /// Floor height in the levelled frame [m].
+    /// Floor height in the levelled frame (m).
     pub floor_height_m: f64,
     /// Length scale of the scene.
     pub scale: f64,
@@ -125,13 +125,13 @@ pub struct PerceptionSummary {
     pub r2: f64,
     /// The fitted extent.
     pub extent: Extent,
-    /// The dig plane y [m].
+    /// The dig plane y (m).
     pub dig_plane_y_m: f64,
-    /// Face height above the floor [m].
+    /// Face height above the floor (m).
     pub face_height_m: f64,
-    /// Rise that marks the toe [m].
+    /// Rise that marks the toe (m).
     pub toe_rise_m: f64,
-    /// Time spent in perception [ms].
+    /// Time spent in perception (ms).
     pub perceive_ms: f64,
 }
 

@@ -14,10 +14,10 @@
 //! | times (c3, c4, t_d) | × λ^½ | 9–15 s → 49–82 s |
 //! | speeds (c8, c10) | × λ^½ | 0.1 m/s → 0.55 m/s |
 //! | powers (c13, c14) | × λ^3.5 | 15 W → 2.22 MW |
-//! | cutting resistance k_F [Pa] | × λ | 16.8 kPa → 503 kPa |
-//! | a_x6, a_y6 [m/s⁶] | × λ⁻² | |
+//! | cutting resistance k_F (Pa) | × λ | 16.8 kPa → 503 kPa |
+//! | a_x6, a_y6 (m/s⁶) | × λ⁻² | |
 //! | angles, fills, ψ, ε, density | × 1 | |
-//! | k1 (on f1 [J/kg] ∝ λ), k2 (on f2 [s/kg] ∝ λ^−2.5) | × λ⁻¹, × λ^2.5 | f itself unchanged |
+//! | k1 (on f1 (J/kg) ∝ λ), k2 (on f2 (s/kg) ∝ λ^−2.5) | × λ⁻¹, × λ^2.5 | f itself unchanged |
 //!
 //! Energy (force × length) grows as λ⁴. The weights k1 and k2 are scaled so
 //! that the objective of [RS eq. 27] has the same value on a path and on its
@@ -46,32 +46,32 @@ impl Similarity {
     /// The paper's scale: the model is 1:30.
     pub const PAPER: Similarity = Similarity { lambda: 30.0 };
 
-    /// A length [m].
+    /// A length (m).
     pub fn length(&self, v: f64) -> f64 {
         v * self.lambda
     }
 
-    /// A time [s].
+    /// A time (s).
     pub fn time(&self, v: f64) -> f64 {
         v * self.lambda.sqrt()
     }
 
-    /// A speed [m/s].
+    /// A speed (m/s).
     pub fn speed(&self, v: f64) -> f64 {
         v * self.lambda.sqrt()
     }
 
-    /// A mass [kg] or a force [N] (λ³), or a volume [m³].
+    /// A mass (kg) or a force (N) (λ³), or a volume (m³).
     pub fn cube(&self, v: f64) -> f64 {
         v * self.lambda.powi(3)
     }
 
-    /// An energy [J] (λ⁴).
+    /// An energy (J) (λ⁴).
     pub fn energy(&self, v: f64) -> f64 {
         v * self.lambda.powi(4)
     }
 
-    /// A power [W] (λ^3.5).
+    /// A power (W) (λ^3.5).
     pub fn power(&self, v: f64) -> f64 {
         v * self.lambda.powf(3.5)
     }
@@ -118,7 +118,7 @@ impl Similarity {
         for r in [&mut s.bend_x_m, &mut s.bend_y_m, &mut s.gx_m, &mut s.gy_m] {
             *r = r.map(|v| v * l);
         }
-        // a₆ [m/s⁶]: a length over a time to the sixth.
+        // a₆ (m/s⁶): a length over a time to the sixth.
         for r in [&mut s.ax6, &mut s.ay6] {
             *r = r.map(|v| v / (l * l));
         }
@@ -143,8 +143,8 @@ impl Similarity {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::dig_surface::DigSurface;
     use crate::plan::DigModel;
-    use crate::terrain::DigSurface;
     use crate::trajectory::Decision;
     use approx::assert_relative_eq;
     use autoshovel_terrain::PileShape;
@@ -171,7 +171,7 @@ mod tests {
                 l * x1,
                 "image",
             )
-            .with_deepest_cut(l * crate::terrain::DEEPEST_CUT_M);
+            .with_deepest_cut(l * crate::dig_surface::DEEPEST_CUT_M);
             let small = DigModel::new(&model_profile, surface).unwrap();
             let big = DigModel::new(&big_profile, image).unwrap();
             let search = crate::plan::search_preset();

@@ -17,15 +17,15 @@
 /// The decision vector of [RS eq. 24].
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 pub struct Decision {
-    /// a_x6 [m/s⁶].
+    /// a_x6 (m/s⁶).
     pub ax6: f64,
-    /// a_y6 [m/s⁶].
+    /// a_y6 (m/s⁶).
     pub ay6: f64,
-    /// t_d: dig time [s].
+    /// t_d: dig time (s).
     pub td_s: f64,
-    /// g_x: final tip x [m].
+    /// g_x: final tip x (m).
     pub gx_m: f64,
-    /// g_y: final tip y [m].
+    /// g_y: final tip y (m).
     pub gy_m: f64,
 }
 
@@ -62,7 +62,7 @@ impl Decision {
         }
     }
 
-    /// Mid-dig bends [x, y] of the a₆ terms [m] (see [`Decision::from_bends`]).
+    /// Mid-dig bends [x, y] of the a₆ terms (m) (see [`Decision::from_bends`]).
     pub fn bends(&self) -> [f64; 2] {
         let k = (0.5 * self.td_s).powi(6);
         [-self.ax6 * k, -self.ay6 * k]
@@ -128,20 +128,20 @@ pub struct Trajectory {
     pub x: Sextic,
     /// g_y(t).
     pub y: Sextic,
-    /// t_d [s].
+    /// t_d (s).
     pub td_s: f64,
 }
 
 /// Tip position, velocity and acceleration at one instant.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct TipState {
-    /// Time [s].
+    /// Time (s).
     pub t: f64,
-    /// Position [m].
+    /// Position (m).
     pub p: [f64; 2],
-    /// Velocity [m/s].
+    /// Velocity (m/s).
     pub v: [f64; 2],
-    /// Acceleration [m/s²].
+    /// Acceleration (m/s²).
     pub a: [f64; 2],
 }
 

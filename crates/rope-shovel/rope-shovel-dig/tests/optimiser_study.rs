@@ -14,11 +14,11 @@
 //! Slow (a few minutes in release): `cargo test --release -p
 //! autoshovel-rope-shovel-dig --test optimiser_study -- --ignored --nocapture`.
 
+use autoshovel_optim::GwoParams;
 use autoshovel_rope_shovel_dig::{
     gwo_preset, paper_pile, plan_dig, search_preset, DigModel, DigSearch, MachineProfile,
     PAPER_TABLES_4_5,
 };
-use autoshovel_optim::GwoParams;
 
 fn long_search(model: &DigModel) -> f64 {
     (100..104)

@@ -1,10 +1,10 @@
 //! The warm-start pack file: what `write_pack` writes, `read_pack` reads
 //! back bit for bit; a damaged file is refused with its line.
 
+use autoshovel_optim::Evaluation;
 use autoshovel_rope_shovel_dig::{
     read_pack, write_pack, DigError, DigModel, DigSurface, MachineProfile, PackProblem,
 };
-use autoshovel_optim::Evaluation;
 use autoshovel_terrain::PileShape;
 
 #[test]

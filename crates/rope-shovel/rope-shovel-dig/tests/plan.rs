@@ -1,11 +1,11 @@
 //! The dig planner against the rope-shovel paper's Tables 4–5, and its
 //! refusals.
 
+use autoshovel_optim::GwoParams;
 use autoshovel_rope_shovel_dig::{
     paper_pile, plan_dig, search_preset, DigError, DigModel, DigSearch, DigSurface, MachineProfile,
     SearchSpace, CONSTRAINT_NAMES, PAPER_TABLES_4_5,
 };
-use autoshovel_optim::GwoParams;
 use autoshovel_terrain::PileShape;
 
 /// The pile `shape` of Fig. 7 rebuilt from Tables 4–5 for the built-in profile.

@@ -16,12 +16,12 @@
 //! Slow (several minutes in release): `cargo test --release -p
 //! autoshovel-rope-shovel-dig --test rating_study -- --ignored --nocapture`.
 
+use autoshovel_optim::GwoParams;
 use autoshovel_rope_shovel_dig::calibrate::{calibrate, CalibrationTarget};
 use autoshovel_rope_shovel_dig::{
     paper_pile, paper_row, plan_dig, search_preset, DigModel, DigSearch, DigSurface,
     MachineProfile, PAPER_TABLES_4_5,
 };
-use autoshovel_optim::GwoParams;
 use autoshovel_terrain::PileShape;
 
 /// The ratings tried: name, index in `DigOutcome::measured`, bisection range.

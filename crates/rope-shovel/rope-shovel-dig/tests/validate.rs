@@ -6,12 +6,14 @@ use std::path::Path;
 use std::sync::OnceLock;
 
 use approx::assert_relative_eq;
+use autoshovel_optim::GwoParams;
 use autoshovel_rope_shovel_dig::validate::{
     simulate_measurement, validate, AlignParams, MeasuredRecord, MeasurementModel, PlannedRecord,
     Validation,
 };
-use autoshovel_rope_shovel_dig::{gwo_preset, plan_dig, DigModel, DigSearch, DigSurface, MachineProfile};
-use autoshovel_optim::GwoParams;
+use autoshovel_rope_shovel_dig::{
+    gwo_preset, plan_dig, DigModel, DigSearch, DigSurface, MachineProfile,
+};
 use autoshovel_terrain::PileShape;
 
 /// The plan of the typical pile (seed 1, the paper's GWO setting), made once.

@@ -70,28 +70,28 @@ impl FieldKind {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct ApfParams {
-    /// Attraction gain η ([W eq. 1]) [1/m, force per metre].
+    /// Attraction gain η ([W eq. 1]) (1/m, force per metre).
     pub eta: f64,
-    /// Attraction cap distance ρ_d ([W eq. 6]) [m]; improved field only.
+    /// Attraction cap distance ρ_d ([W eq. 6]) (m); improved field only.
     pub rho_d_m: f64,
     /// Repulsion gain k ([W eqs. 3, 9]).
     pub k_rep: f64,
-    /// Repulsion influence range ρ0 ([W eq. 3]) [m].
+    /// Repulsion influence range ρ0 ([W eq. 3]) (m).
     pub rho0_m: f64,
     /// Exponent n of ρⁿ(q, q_t) ([W eq. 9]); improved field only.
     pub n: f64,
     /// Virtual-obstacle gain μ ([W eq. 12]), below η; improved field only.
     pub mu: f64,
-    /// Virtual-obstacle cap distance ρ_t ([W eq. 12]) [m].
+    /// Virtual-obstacle cap distance ρ_t ([W eq. 12]) (m).
     pub rho_t_m: f64,
-    /// Descent step δ [m].
+    /// Descent step δ (m).
     pub step_m: f64,
-    /// The leg ends within this distance of the target [m].
+    /// The leg ends within this distance of the target (m).
     pub goal_tolerance_m: f64,
-    /// Straight run along the start heading before the field takes over [m]
+    /// Straight run along the start heading before the field takes over (m)
     /// (a crawler leaves the way it faces; 0 disables).
     pub lead_in_m: f64,
-    /// Floor of the clearance in the repulsion, against division by zero [m].
+    /// Floor of the clearance in the repulsion, against division by zero (m).
     pub min_clearance_m: f64,
     /// Steps over which progress is judged.
     pub stall_window: usize,
@@ -185,9 +185,9 @@ impl ApfParams {
 /// The target of one descent.
 #[derive(Debug, Clone, Copy)]
 pub struct Target {
-    /// Goal position [m].
+    /// Goal position (m).
     pub position: Vec2,
-    /// Required heading of *motion* on arrival [rad].
+    /// Required heading of *motion* on arrival (rad).
     pub motion_heading_rad: f64,
 }
 
@@ -412,7 +412,7 @@ pub fn descend(
 /// obstacle's boundary), as summaries report it.
 pub const ESCAPE_STRATEGY: &str = "boundary-following";
 
-/// Closest the boundary-following escape goes to an obstacle [m].
+/// Closest the boundary-following escape goes to an obstacle (m).
 const MIN_FOLLOW_CLEARANCE_M: f64 = 0.05;
 
 /// Tangent-bug escape: walk along the level set of the map's distance field
@@ -420,7 +420,7 @@ const MIN_FOLLOW_CLEARANCE_M: f64 = 0.05;
 /// `side` (+1: on the left), until closer to the target than the
 /// stall point with the field pointing onwards. `None` when it cannot get
 /// past within `budget` steps. `keep` is the footprint clearance to hold and
-/// `margin` how much closer than the stall it must get before leaving [m].
+/// `margin` how much closer than the stall it must get before leaving (m).
 #[allow(clippy::too_many_arguments)]
 fn follow_boundary(
     map: &Map,

@@ -23,7 +23,7 @@ pub const REFERENCE_PLANNER: &str = "theta-star";
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct AstarParams {
-    /// Cell size [m].
+    /// Cell size (m).
     pub resolution_m: f64,
     /// Refuse grids larger than this many cells.
     pub max_cells: usize,
@@ -41,9 +41,9 @@ impl Default for AstarParams {
 /// A reference route.
 #[derive(Debug, Clone)]
 pub struct Route {
-    /// Waypoints after line-of-sight shortening [m].
+    /// Waypoints after line-of-sight shortening (m).
     pub points: Vec<Vec2>,
-    /// Length [m].
+    /// Length (m).
     pub length_m: f64,
     /// Cells expanded.
     pub expanded: usize,

@@ -48,7 +48,7 @@ pub enum PropelError {
         line: usize,
         /// The table and key.
         key: String,
-        /// The value given [m].
+        /// The value given (m).
         value: f64,
     },
     /// A value in a scenario outside its range.
@@ -72,9 +72,9 @@ pub enum PropelError {
         file: String,
         /// 1-based line of `[site]`.
         line: usize,
-        /// Lower corner [m].
+        /// Lower corner (m).
         min_m: [f64; 2],
-        /// Upper corner [m].
+        /// Upper corner (m).
         max_m: [f64; 2],
     },
     /// The site is larger than a planning site may be.
@@ -84,9 +84,9 @@ pub enum PropelError {
         file: String,
         /// 1-based line of `[site]`.
         line: usize,
-        /// Larger side of the site [m].
+        /// Larger side of the site (m).
         extent_m: f64,
-        /// The limit [m].
+        /// The limit (m).
         limit_m: f64,
     },
     /// A polygon obstacle that is not a convex polygon.
@@ -150,9 +150,9 @@ pub enum PropelError {
     BadPose {
         /// "start", "midpoint" or "goal".
         which: &'static str,
-        /// East [m].
+        /// East (m).
         x: f64,
-        /// North [m].
+        /// North (m).
         y: f64,
         /// Why the machine cannot take the pose.
         fault: PoseFault,
@@ -162,15 +162,15 @@ pub enum PropelError {
         "local minimum at ({x:.3}, {y:.3}) after {iterations} steps, {distance_to_goal_m:.3} m from the goal of leg {leg} ({escapes} escape attempts)"
     )]
     LocalMinimum {
-        /// East [m].
+        /// East (m).
         x: f64,
-        /// North [m].
+        /// North (m).
         y: f64,
         /// Leg index (0-based).
         leg: usize,
         /// Steps taken.
         iterations: usize,
-        /// Remaining straight-line distance [m].
+        /// Remaining straight-line distance (m).
         distance_to_goal_m: f64,
         /// Escapes tried before giving up.
         escapes: usize,
@@ -182,17 +182,17 @@ pub enum PropelError {
         stage: &'static str,
         /// Leg index (0-based).
         leg: usize,
-        /// East [m].
+        /// East (m).
         x: f64,
-        /// North [m].
+        /// North (m).
         y: f64,
-        /// Clearance of the footprint [m] (≤ 0).
+        /// Clearance of the footprint (m) (≤ 0).
         clearance_m: f64,
         /// Name of the obstacle hit.
         obstacle: String,
     },
     /// A path that arrives at the end of a leg off its required heading:
-    /// the machine would have to turn on the spot (see [`crate::Verdict`]).
+    /// the machine would have to turn on the spot (see [`crate::outcome::Failure`]).
     #[error(
         "the required heading cannot be met: the path arrives at {} {error_deg:.2} deg off it (tolerance {tolerance_deg} deg); the machine would have to turn on the spot",
         leg_end(*leg, *legs)
@@ -202,9 +202,9 @@ pub enum PropelError {
         leg: usize,
         /// Legs of the plan.
         legs: usize,
-        /// Heading error at the end of the leg [deg] (NaN when unknown).
+        /// Heading error at the end of the leg (deg) (NaN when unknown).
         error_deg: f64,
-        /// The tolerance it exceeds [deg].
+        /// The tolerance it exceeds (deg).
         tolerance_deg: f64,
     },
     /// The reference planner found no path.
@@ -231,15 +231,15 @@ pub enum PoseFault {
     /// A coordinate or the heading is NaN or infinite.
     #[error("not finite (heading {heading_rad})")]
     NotFinite {
-        /// The heading given [rad].
+        /// The heading given (rad).
         heading_rad: f64,
     },
     /// Outside the site rectangle.
     #[error("outside the site [{}, {}] x [{}, {}]", min_m[0], max_m[0], min_m[1], max_m[1])]
     OutsideSite {
-        /// Lower corner of the site [m].
+        /// Lower corner of the site (m).
         min_m: [f64; 2],
-        /// Upper corner of the site [m].
+        /// Upper corner of the site (m).
         max_m: [f64; 2],
     },
     /// The footprint overlaps an obstacle or boundary.
@@ -247,9 +247,9 @@ pub enum PoseFault {
     TooClose {
         /// The nearest obstacle or boundary.
         element: String,
-        /// Footprint clearance [m] (≤ 0).
+        /// Footprint clearance (m) (≤ 0).
         clearance_m: f64,
-        /// Footprint radius [m].
+        /// Footprint radius (m).
         footprint_radius_m: f64,
     },
     /// The straight stretch along the motion heading is blocked.
@@ -258,11 +258,11 @@ pub enum PoseFault {
         if *arriving { "behind it" } else { "ahead of it" }
     )]
     HeadingBlocked {
-        /// The pose's heading [deg].
+        /// The pose's heading (deg).
         heading_deg: f64,
         /// The obstacle or boundary in the way.
         element: String,
-        /// Length of the stretch checked [m].
+        /// Length of the stretch checked (m).
         within_m: f64,
         /// Arriving (the stretch is behind the pose) or leaving (ahead of it).
         arriving: bool,
@@ -276,7 +276,7 @@ pub enum NoPathFault {
     /// The grid resolution is not a positive number.
     #[error("resolution_m = {resolution_m} must be positive")]
     BadResolution {
-        /// The resolution given [m].
+        /// The resolution given (m).
         resolution_m: f64,
     },
     /// The site needs more grid cells than allowed.
@@ -294,9 +294,9 @@ pub enum NoPathFault {
     NoFreeCell {
         /// "start" or "goal".
         which: &'static str,
-        /// East [m].
+        /// East (m).
         x: f64,
-        /// North [m].
+        /// North (m).
         y: f64,
     },
     /// The search ran out of cells.

@@ -12,9 +12,6 @@
 //! assert!(plan.metrics.min_clearance_m > 0.0);
 //! ```
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod apf;
 pub mod astar;
 mod error;

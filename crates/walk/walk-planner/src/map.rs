@@ -13,14 +13,14 @@ use autoshovel_core::{perp, segment_nearest, Vec2};
 pub enum Shape {
     /// A disc.
     Circle {
-        /// Centre [m].
+        /// Centre (m).
         center: Vec2,
-        /// Radius [m].
+        /// Radius (m).
         radius: f64,
     },
     /// A convex polygon, vertices counter-clockwise.
     Polygon {
-        /// Vertices [m], counter-clockwise, without repeating the first.
+        /// Vertices (m), counter-clockwise, without repeating the first.
         vertices: Vec<Vec2>,
     },
 }
@@ -39,14 +39,14 @@ pub struct Obstacle {
 pub struct Boundary {
     /// Name for messages and plots.
     pub name: String,
-    /// Vertices [m].
+    /// Vertices (m).
     pub points: Vec<Vec2>,
 }
 
 /// The nearest point of one map element to a query point.
 #[derive(Debug, Clone, Copy)]
 pub struct Nearest {
-    /// Signed distance from the query point to the element [m], negative inside.
+    /// Signed distance from the query point to the element (m), negative inside.
     pub distance: f64,
     /// Unit direction in which the distance grows (away from the element).
     pub normal: Vec2,
@@ -222,9 +222,9 @@ fn polyline_nearest(points: &[Vec2], p: Vec2) -> (f64, Vec2) {
 /// A planning site: bounds, obstacles and road boundaries.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Map {
-    /// Lower-left corner of the site [m].
+    /// Lower-left corner of the site (m).
     pub min: Vec2,
-    /// Upper-right corner of the site [m].
+    /// Upper-right corner of the site (m).
     pub max: Vec2,
     /// Obstacles.
     pub obstacles: Vec<Obstacle>,
@@ -326,7 +326,7 @@ impl Map {
     }
 
     /// Clearance of a disc footprint of radius `footprint_radius_m` centred at
-    /// `p`: distance from the disc to the nearest element [m], negative on
+    /// `p`: distance from the disc to the nearest element (m), negative on
     /// contact or overlap.
     pub fn clearance(&self, p: Vec2, footprint_radius_m: f64) -> f64 {
         self.nearest(p).distance - footprint_radius_m

@@ -23,7 +23,7 @@ use crate::plan::{plan_path, LegStats, Plan, PlanOptions};
 use crate::scenario::Scenario;
 use crate::smooth::SmoothParams;
 
-/// The heading tolerance of "success" unless told otherwise [deg].
+/// The heading tolerance of "success" unless told otherwise (deg).
 pub const DEFAULT_HEADING_TOLERANCE_DEG: f64 = 2.0;
 
 /// The first leg whose end misses its required heading by more than
@@ -59,7 +59,7 @@ pub fn reference_routes(scenario: &Scenario) -> Option<Vec<Route>> {
         .collect()
 }
 
-/// Total length of a per-leg reference [m].
+/// Total length of a per-leg reference (m).
 pub fn reference_length_m(routes: &[Route]) -> f64 {
     routes.iter().map(|r| r.length_m).sum()
 }
@@ -69,7 +69,7 @@ pub fn reference_length_m(routes: &[Route]) -> f64 {
 pub struct ReferenceComparison {
     /// The reference planner's name.
     pub planner: &'static str,
-    /// Reference length [m] (null when the reference finds no route).
+    /// Reference length (m) (null when the reference finds no route).
     pub length_m: Option<f64>,
     /// Plan length over reference length (null without a plan or a reference).
     pub length_ratio: Option<f64>,
@@ -235,29 +235,29 @@ pub struct PlanPathSummary {
     pub success: bool,
     /// Why it is not a success.
     pub error: Option<String>,
-    /// Where planning failed [m], when the error has a place.
+    /// Where planning failed (m), when the error has a place.
     pub error_at_m: Option<[f64; 2]>,
     /// Planning failed in a local minimum.
     pub local_minimum: bool,
-    /// Heading tolerance of success [deg].
+    /// Heading tolerance of success (deg).
     pub heading_tolerance_deg: f64,
-    /// Smoothed length [m].
+    /// Smoothed length (m).
     pub length_m: Option<f64>,
-    /// Smallest footprint clearance [m].
+    /// Smallest footprint clearance (m).
     pub min_clearance_m: Option<f64>,
-    /// Where it is [m].
+    /// Where it is (m).
     pub min_clearance_at_m: Option<[f64; 2]>,
-    /// Heading error on arrival at the goal [deg].
+    /// Heading error on arrival at the goal (deg).
     pub final_heading_error_deg: Option<f64>,
-    /// Heading error leaving the start [deg].
+    /// Heading error leaving the start (deg).
     pub start_heading_error_deg: Option<f64>,
-    /// Largest heading mismatch at a cusp [deg].
+    /// Largest heading mismatch at a cusp (deg).
     pub cusp_heading_error_deg: Option<f64>,
-    /// Largest |curvature| [1/m].
+    /// Largest |curvature| (1/m).
     pub max_curvature_per_m: Option<f64>,
-    /// Mean |curvature| [1/m].
+    /// Mean |curvature| (1/m).
     pub mean_abs_curvature_per_m: Option<f64>,
-    /// Wall-clock planning time [ms].
+    /// Wall-clock planning time (ms).
     pub plan_time_ms: Option<f64>,
     /// Descent steps on all legs.
     pub iterations: Option<usize>,
@@ -265,7 +265,7 @@ pub struct PlanPathSummary {
     pub escapes: usize,
     /// The escape used, when one was.
     pub escape_strategy: Option<&'static str>,
-    /// Footprint radius [m].
+    /// Footprint radius (m).
     pub footprint_radius_m: f64,
     /// Per-leg statistics (empty when planning failed).
     pub legs: Vec<LegStats>,

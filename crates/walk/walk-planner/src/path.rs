@@ -5,50 +5,16 @@
 use autoshovel_core::{Pose2, Vec2};
 use serde::{Deserialize, Serialize};
 
-/// Direction of travel along a leg.
-#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
-#[serde(rename_all = "lowercase")]
-pub enum Direction {
-    /// The machine moves the way it faces.
-    Forward,
-    /// The machine backs up: it moves opposite to its heading.
-    Reverse,
-}
-
-impl Direction {
-    /// +1 forward, −1 reverse.
-    pub fn sign(self) -> f64 {
-        match self {
-            Direction::Forward => 1.0,
-            Direction::Reverse => -1.0,
-        }
-    }
-
-    /// Heading of motion for a machine heading `theta_rad`.
-    pub fn motion_heading(self, theta_rad: f64) -> f64 {
-        match self {
-            Direction::Forward => theta_rad,
-            Direction::Reverse => theta_rad + std::f64::consts::PI,
-        }
-    }
-
-    /// Lower-case name.
-    pub fn name(self) -> &'static str {
-        match self {
-            Direction::Forward => "forward",
-            Direction::Reverse => "reverse",
-        }
-    }
-}
+pub use autoshovel_core::Direction;
 
 /// One sample of a smoothed path.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PathPoint {
     /// Centroid pose; θ is the *machine* heading (opposite to the motion on a reverse leg).
     pub pose: Pose2,
-    /// Arc length from the start of the whole path [m].
+    /// Arc length from the start of the whole path (m).
     pub s_m: f64,
-    /// Signed curvature of the centroid's track, positive turning left in the direction of motion [1/m].
+    /// Signed curvature of the centroid's track, positive turning left in the direction of motion (1/m).
     pub curvature_per_m: f64,
 }
 
@@ -57,14 +23,14 @@ pub struct PathPoint {
 pub struct Leg {
     /// Forward or reverse.
     pub direction: Direction,
-    /// The raw potential-field polyline, start to goal [m].
+    /// The raw potential-field polyline, start to goal (m).
     pub raw: Vec<Vec2>,
     /// The smoothed, resampled path.
     pub points: Vec<PathPoint>,
 }
 
 impl Leg {
-    /// Length of the smoothed leg [m].
+    /// Length of the smoothed leg (m).
     pub fn length_m(&self) -> f64 {
         match (self.points.first(), self.points.last()) {
             (Some(a), Some(b)) => b.s_m - a.s_m,
@@ -81,7 +47,7 @@ pub struct Path {
 }
 
 impl Path {
-    /// Total length [m].
+    /// Total length (m).
     pub fn length_m(&self) -> f64 {
         self.legs.iter().map(Leg::length_m).sum()
     }

@@ -50,40 +50,40 @@ pub struct LegStats {
     pub iterations: usize,
     /// Local-minimum escapes used (boundary following).
     pub escapes: usize,
-    /// Control-point spacing the smoothing finally used [m].
+    /// Control-point spacing the smoothing finally used (m).
     pub control_spacing_m: f64,
-    /// Length of the raw descent polyline [m].
+    /// Length of the raw descent polyline (m).
     pub raw_length_m: f64,
-    /// Length of the smoothed leg [m].
+    /// Length of the smoothed leg (m).
     pub length_m: f64,
-    /// Heading error at the end of the leg [deg].
+    /// Heading error at the end of the leg (deg).
     pub end_heading_error_deg: f64,
 }
 
 /// Measures of a whole plan.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct PlanMetrics {
-    /// Total smoothed length [m].
+    /// Total smoothed length (m).
     pub length_m: f64,
-    /// Smallest footprint clearance along the smoothed path [m].
+    /// Smallest footprint clearance along the smoothed path (m).
     pub min_clearance_m: f64,
     /// Where that is.
     pub min_clearance_at: [f64; 2],
-    /// Heading error on arrival at the goal [deg].
+    /// Heading error on arrival at the goal (deg).
     pub final_heading_error_deg: f64,
-    /// Heading error when leaving the start [deg].
+    /// Heading error when leaving the start (deg).
     pub start_heading_error_deg: f64,
-    /// Largest heading mismatch at a cusp between legs (V-shape midpoint) [deg].
+    /// Largest heading mismatch at a cusp between legs (V-shape midpoint) (deg).
     pub cusp_heading_error_deg: f64,
-    /// Largest |curvature| [1/m].
+    /// Largest |curvature| (1/m).
     pub max_curvature_per_m: f64,
-    /// Mean |curvature| over the samples [1/m].
+    /// Mean |curvature| over the samples (1/m).
     pub mean_abs_curvature_per_m: f64,
     /// Escapes used on all legs.
     pub escapes: usize,
     /// Descent steps on all legs.
     pub iterations: usize,
-    /// Wall-clock planning time [ms].
+    /// Wall-clock planning time (ms).
     pub plan_time_ms: f64,
 }
 
@@ -99,7 +99,7 @@ pub struct Plan {
 }
 
 /// The goal-approach check distance: the machine arrives along the required
-/// heading, so this much of the ray behind the goal must be free [m].
+/// heading, so this much of the ray behind the goal must be free (m).
 const APPROACH_CHECK_M: f64 = 1.0;
 
 /// Checks that the machine can stand at `pose` and leave or arrive along its

@@ -68,7 +68,7 @@ pub struct Scenario {
     pub name: String,
     /// The site.
     pub map: Map,
-    /// Radius of the machine's footprint disc [m].
+    /// Radius of the machine's footprint disc (m).
     pub footprint_radius_m: f64,
     /// Start pose (θ = machine heading).
     pub start: Pose2,
@@ -211,7 +211,7 @@ struct BoundarySpec {
     points_m: Vec<[f64; 2]>,
 }
 
-/// Default footprint radius: the 1:7 prototype's half-width plus a margin [m].
+/// Default footprint radius: the 1:7 prototype's half-width plus a margin (m).
 pub const DEFAULT_FOOTPRINT_RADIUS_M: f64 = 1.0;
 
 impl TomlFile for ScenarioFile {
@@ -222,9 +222,9 @@ impl TomlFile for ScenarioFile {
     }
 }
 
-/// Largest |coordinate| a site may have [m] (a planning site, not a globe).
+/// Largest |coordinate| a site may have (m) (a planning site, not a globe).
 const MAX_COORDINATE_M: f64 = 1e6;
-/// Largest side of a site [m].
+/// Largest side of a site (m).
 const MAX_SITE_EXTENT_M: f64 = 10_000.0;
 /// Most vertices of a polygon obstacle.
 const MAX_POLYGON_VERTICES: usize = 1000;

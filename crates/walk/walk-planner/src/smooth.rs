@@ -15,11 +15,11 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SmoothParams {
-    /// Target distance between B-spline control points [m].
+    /// Target distance between B-spline control points (m).
     pub control_spacing_m: f64,
-    /// Spacing of the output samples [m].
+    /// Spacing of the output samples (m).
     pub sample_spacing_m: f64,
-    /// Smallest control spacing tried when the smoothed path collides [m].
+    /// Smallest control spacing tried when the smoothed path collides (m).
     pub min_control_spacing_m: f64,
 }
 

@@ -33,9 +33,9 @@ pub struct StudyParams {
     pub min_obstacles: usize,
     /// Most obstacles on a map.
     pub max_obstacles: usize,
-    /// Road length [m].
+    /// Road length (m).
     pub road_length_m: f64,
-    /// Heading tolerance for success [deg].
+    /// Heading tolerance for success (deg).
     pub heading_tolerance_deg: f64,
 }
 
@@ -190,18 +190,18 @@ pub struct Outcome {
     pub success: bool,
     /// Failed in a local minimum.
     pub local_minimum: bool,
-    /// Smoothed length [m] (NaN on failure).
+    /// Smoothed length (m) (NaN on failure).
     #[serde(deserialize_with = "nan_if_null")]
     pub length_m: f64,
-    /// Smallest footprint clearance [m] (NaN on failure).
+    /// Smallest footprint clearance (m) (NaN on failure).
     #[serde(deserialize_with = "nan_if_null")]
     pub min_clearance_m: f64,
-    /// Final heading error [deg] (NaN on failure).
+    /// Final heading error (deg) (NaN on failure).
     #[serde(deserialize_with = "nan_if_null")]
     pub final_heading_error_deg: f64,
     /// Escapes used.
     pub escapes: usize,
-    /// Planning time [ms].
+    /// Planning time (ms).
     #[serde(deserialize_with = "nan_if_null")]
     pub plan_time_ms: f64,
     /// The error, if any.
@@ -233,7 +233,7 @@ pub struct MapRow {
     pub index: usize,
     /// Obstacles on the map.
     pub obstacles: usize,
-    /// Reference length [m], `None` when the reference finds no path.
+    /// Reference length (m), `None` when the reference finds no path.
     pub reference_length_m: Option<f64>,
     /// Classic field.
     pub classic: Outcome,
@@ -309,9 +309,9 @@ pub struct Aggregate {
     pub planner: &'static str,
     /// Maps counted (those the reference solves).
     pub maps: usize,
-    /// Share reaching the goal collision-free [%].
+    /// Share reaching the goal collision-free (%).
     pub reached_pct: f64,
-    /// Share reaching it within the heading tolerance [%].
+    /// Share reaching it within the heading tolerance (%).
     pub success_pct: f64,
     /// Local minima (failures).
     pub local_minima: usize,
@@ -321,17 +321,17 @@ pub struct Aggregate {
     pub mean_length_ratio: f64,
     /// Largest length ratio.
     pub max_length_ratio: f64,
-    /// Mean of the minimum clearance [m].
+    /// Mean of the minimum clearance (m).
     pub mean_min_clearance_m: f64,
-    /// Smallest minimum clearance [m].
+    /// Smallest minimum clearance (m).
     pub min_min_clearance_m: f64,
-    /// Mean final heading error over reached maps [deg].
+    /// Mean final heading error over reached maps (deg).
     pub mean_final_heading_error_deg: f64,
-    /// Largest final heading error over reached maps [deg].
+    /// Largest final heading error over reached maps (deg).
     pub max_final_heading_error_deg: f64,
     /// Maps where an escape was used.
     pub maps_with_escapes: usize,
-    /// Mean planning time [ms].
+    /// Mean planning time (ms).
     pub mean_plan_time_ms: f64,
 }
 
@@ -382,7 +382,7 @@ pub fn aggregate(rows: &[MapRow], field: FieldKind) -> Aggregate {
     }
 }
 
-/// Success rate [%] of `field` by obstacle count, over the maps the
+/// Success rate (%) of `field` by obstacle count, over the maps the
 /// reference solves: `(obstacles, percent)` for each count in
 /// `min_obstacles..=max_obstacles` that has such maps.
 pub fn success_by_obstacles(
@@ -415,7 +415,7 @@ pub struct StudyReference {
     pub planner: &'static str,
     /// Maps it solves.
     pub solved: usize,
-    /// Share of maps it solves [%].
+    /// Share of maps it solves (%).
     pub solved_pct: f64,
 }
 
@@ -430,7 +430,7 @@ pub struct StudySummary {
     pub maps: usize,
     /// Seed of the map generator.
     pub seed: u64,
-    /// Heading tolerance of success [deg].
+    /// Heading tolerance of success (deg).
     pub heading_tolerance_deg: f64,
     /// The reference planner's record.
     pub reference: StudyReference,
@@ -472,7 +472,7 @@ pub fn summarize(params: &StudyParams, rows: &[MapRow]) -> StudySummary {
     }
 }
 
-/// Heading error helper for callers comparing poses [deg].
+/// Heading error helper for callers comparing poses (deg).
 pub fn heading_error_deg(a: Pose2, b: Pose2) -> f64 {
     angle_diff(a.theta, b.theta).abs().to_degrees()
 }

@@ -28,9 +28,9 @@ pub struct ControlInput<'a> {
     pub pose: Pose2,
     /// Deviations at this pose.
     pub dev: &'a Deviations,
-    /// Reference centroid speed, signed (negative in reverse) [m/s].
+    /// Reference centroid speed, signed (negative in reverse) (m/s).
     pub speed_mps: f64,
-    /// Time since the previous tick [s].
+    /// Time since the previous tick (s).
     pub dt_s: f64,
     /// The machine.
     pub crawler: &'a CrawlerParams,
@@ -42,7 +42,7 @@ pub trait Controller {
     fn name(&self) -> &'static str;
     /// Forgets internal state (between legs, after a stop).
     fn reset(&mut self);
-    /// Speed difference n_right − n_left [rpm]; positive turns left.
+    /// Speed difference n_right − n_left (rpm); positive turns left.
     fn step(&mut self, input: &ControlInput) -> f64;
     /// The gains this controller runs with.
     fn gains(&self) -> Gains;
@@ -85,16 +85,16 @@ pub struct ControllerParams {
 pub struct FuzzyParams {
     /// Weight α of the centroid deviation in e [W eq. 23].
     pub alpha: f64,
-    /// Scaling factor k1 of e [W eq. 24] [1/m]: e_f = k1·e.
+    /// Scaling factor k1 of e [W eq. 24] (1/m): e_f = k1·e.
     pub k1: f64,
-    /// Scaling factor k2 of ec [W eq. 24] [s/m]: ec_f = k2·ec.
+    /// Scaling factor k2 of ec [W eq. 24] (s/m): ec_f = k2·ec.
     pub k2: f64,
     /// Scaling factor k3 of u [W eq. 24]: u = k3·u_f.
     pub k3: f64,
-    /// Time constant of the first-order low-pass on ec [s] (0 = none): the
+    /// Time constant of the first-order low-pass on ec (s) (0 = none): the
     /// rate of a centimetre-noisy RTK error at 10 Hz is mostly noise.
     pub ec_filter_s: f64,
-    /// Growth of α with the path's curvature [m]: α(κ) = alpha +
+    /// Growth of α with the path's curvature (m): α(κ) = alpha +
     /// alpha_curvature_m·|κ| [W eq. 23] ("its value is related to the
     /// curvature of the trajectory"). 0 keeps α constant.
     pub alpha_curvature_m: f64,
@@ -154,15 +154,15 @@ impl Default for FuzzyParams {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PidParams {
-    /// Proportional gain [rpm/m].
+    /// Proportional gain (rpm/m).
     pub kp: f64,
-    /// Integral gain [rpm/(m·s)].
+    /// Integral gain (rpm/(m·s)).
     pub ki: f64,
-    /// Derivative gain [rpm·s/m].
+    /// Derivative gain (rpm·s/m).
     pub kd: f64,
     /// Weight α of the centroid deviation in e [W eq. 23].
     pub alpha: f64,
-    /// Output limit [rpm].
+    /// Output limit (rpm).
     pub max_steer_rpm: f64,
     /// The error it acts on ([`PidError`]).
     pub error: PidError,
@@ -269,11 +269,11 @@ impl Controller for Pid {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct PurePursuitParams {
-    /// Look-ahead at standstill [m].
+    /// Look-ahead at standstill (m).
     pub lookahead_m: f64,
-    /// Look-ahead growth with speed [s].
+    /// Look-ahead growth with speed (s).
     pub lookahead_gain_s: f64,
-    /// Output limit [rpm].
+    /// Output limit (rpm).
     pub max_steer_rpm: f64,
 }
 
@@ -340,13 +340,13 @@ impl Controller for PurePursuit {
 #[derive(Debug, Clone, Copy, PartialEq, serde::Serialize, serde::Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct StanleyParams {
-    /// k, the cross-track gain [1/s].
+    /// k, the cross-track gain (1/s).
     pub k_per_s: f64,
-    /// v_s, the softening speed that keeps the law finite at rest [m/s].
+    /// v_s, the softening speed that keeps the law finite at rest (m/s).
     pub softening_mps: f64,
-    /// τ, the time in which the heading correction is closed [s].
+    /// τ, the time in which the heading correction is closed (s).
     pub heading_time_s: f64,
-    /// Output limit [rpm].
+    /// Output limit (rpm).
     pub max_steer_rpm: f64,
 }
 
@@ -391,6 +391,6 @@ impl Controller for Stanley {
     }
 }
 
-/// Half the arc over which a controller measures the path's curvature [m]:
+/// Half the arc over which a controller measures the path's curvature (m):
 /// wider than the planner's point spacing, narrower than the tightest turn.
 pub const CURVATURE_WINDOW_M: f64 = 0.5;

@@ -67,9 +67,9 @@ pub enum TrackError {
         file: String,
         /// 1-based line of `[start]`'s `x_m` (0 when unknown).
         line: usize,
-        /// Distance of the start from the first leg [m].
+        /// Distance of the start from the first leg (m).
         distance_m: f64,
-        /// The largest distance allowed [m].
+        /// The largest distance allowed (m).
         max_m: f64,
     },
     /// A travel scenario (a file with `[site]`) could not be loaded.

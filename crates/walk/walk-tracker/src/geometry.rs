@@ -18,11 +18,11 @@ use autoshovel_walk_planner::Direction;
 pub struct RefLeg {
     /// Forward or reverse.
     pub direction: Direction,
-    /// Path points in travel order [m].
+    /// Path points in travel order (m).
     pub points: Vec<Vec2>,
-    /// Arc length at each point [m].
+    /// Arc length at each point (m).
     pub s: Vec<f64>,
-    /// Required machine heading at the end [rad].
+    /// Required machine heading at the end (rad).
     pub end_heading_rad: f64,
 }
 
@@ -87,7 +87,7 @@ impl RefLeg {
         })
     }
 
-    /// Length [m].
+    /// Length (m).
     pub fn length_m(&self) -> f64 {
         *self.s.last().unwrap_or(&0.0)
     }
@@ -121,7 +121,7 @@ impl RefLeg {
     }
 
     /// Signed curvature κ of the leg at arc length `s`, positive turning
-    /// left in travel order [1/m]: the turn between the segments at
+    /// left in travel order (1/m): the turn between the segments at
     /// `s − window_m` and `s + window_m`, over the arc between their
     /// midpoints (0 on a straight leg, 1/R on an arc of radius R sampled
     /// finer than the window).
@@ -158,13 +158,13 @@ impl RefLeg {
 /// The deviations of [W eq. 21]–[W eq. 22] (signed, left positive).
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Deviations {
-    /// Preview deviation d: signed distance of C from the line AB [m].
+    /// Preview deviation d: signed distance of C from the line AB (m).
     pub d_m: f64,
-    /// Centroid deviation d0: signed |O − A| [m].
+    /// Centroid deviation d0: signed |O − A| (m).
     pub d0_m: f64,
-    /// Arc length of A along the leg [m].
+    /// Arc length of A along the leg (m).
     pub s_a_m: f64,
-    /// Heading of motion minus the path's tangent at A [rad].
+    /// Heading of motion minus the path's tangent at A (rad).
     pub heading_error_rad: f64,
     /// The preview point C.
     pub c: Vec2,
@@ -178,7 +178,7 @@ fn cross(u: Vec2, v: Vec2) -> f64 {
     u.x * v.y - u.y * v.x
 }
 
-/// How far back and ahead of the last A the nearest-point search looks [m].
+/// How far back and ahead of the last A the nearest-point search looks (m).
 pub const SEARCH_BACK_M: f64 = 2.0;
 /// See [`SEARCH_BACK_M`].
 pub const SEARCH_AHEAD_M: f64 = 10.0;

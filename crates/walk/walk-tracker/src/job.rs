@@ -27,7 +27,7 @@ pub struct ControllerRun {
     pub gains: Gains,
     /// The run.
     pub run: Run,
-    /// Wall-clock time of the simulation [ms].
+    /// Wall-clock time of the simulation (ms).
     pub sim_time_ms: f64,
 }
 
@@ -127,7 +127,7 @@ pub struct RunSummary {
     pub metrics: Metrics,
     /// Safety and runner interventions (every event but a leg's end).
     pub safety_events: usize,
-    /// Wall-clock time of the simulation [ms].
+    /// Wall-clock time of the simulation (ms).
     pub sim_time_ms: f64,
     /// The gains the controller ran with.
     pub gains: Gains,

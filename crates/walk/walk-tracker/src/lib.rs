@@ -6,9 +6,6 @@
 //! closed-loop runner with a safety layer and metrics, tracking scenarios
 //! and the `track` job's typed summary.
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod choice;
 pub mod controller;
 pub mod error;

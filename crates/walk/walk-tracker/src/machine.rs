@@ -32,7 +32,7 @@ impl Machine {
         }
     }
 
-    /// The machine's clock [s].
+    /// The machine's clock (s).
     pub fn time_s(&self) -> f64 {
         self.t_s
     }
@@ -42,12 +42,12 @@ impl Machine {
         self.crawler.state.pose
     }
 
-    /// Distance really travelled by the centroid (the simulator's truth) [m].
+    /// Distance really travelled by the centroid (the simulator's truth) (m).
     pub fn travelled_m(&self) -> f64 {
         self.travelled_m
     }
 
-    /// Actual motor speeds (left, right) [rpm], as the inverters report them.
+    /// Actual motor speeds (left, right) (rpm), as the inverters report them.
     pub fn motors_rpm(&self) -> (f64, f64) {
         (self.crawler.state.left_rpm, self.crawler.state.right_rpm)
     }

@@ -5,29 +5,29 @@
 //! switchable: motor speed and acceleration limits, per-track longitudinal
 //! slip, lateral (skid) slip in turns.
 //!
-//! Motor speed n [rpm] → track speed v = n·2π·r_s/(60·i) (SPEC §3). Each step
+//! Motor speed n (rpm) → track speed v = n·2π·r_s/(60·i) (SPEC §3). Each step
 //! integrates the exact circular arc of constant v_c and θ̇ over `dt`
 //! ([W eq. 19], the integral of [W eq. 18] / [W eq. 20], in closed form).
 
 use autoshovel_core::{wrap_angle, Pose2};
 use serde::{Deserialize, Serialize};
 
-/// Below this motor speed [rpm] the machine counts as at rest.
+/// Below this motor speed (rpm) the machine counts as at rest.
 pub const AT_REST_RPM: f64 = 1.0;
 
 /// Machine parameters of the crawler (defaults: SPEC §3, 1:7 prototype).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct CrawlerParams {
-    /// Track gauge B: distance between the track centre lines [m].
+    /// Track gauge B: distance between the track centre lines (m).
     pub gauge_m: f64,
-    /// Drive sprocket radius r_s [m].
+    /// Drive sprocket radius r_s (m).
     pub sprocket_radius_m: f64,
     /// Gear ratio i between motor and sprocket.
     pub gear_ratio: f64,
-    /// Motor speed limit [rpm].
+    /// Motor speed limit (rpm).
     pub motor_max_rpm: f64,
-    /// Motor acceleration limit [rpm/s] (0 = unlimited).
+    /// Motor acceleration limit (rpm/s) (0 = unlimited).
     pub motor_max_accel_rpm_per_s: f64,
 }
 
@@ -44,12 +44,12 @@ impl Default for CrawlerParams {
 }
 
 impl CrawlerParams {
-    /// Track speed per motor rpm [m/s per rpm].
+    /// Track speed per motor rpm (m/s per rpm).
     pub fn mps_per_rpm(&self) -> f64 {
         2.0 * std::f64::consts::PI * self.sprocket_radius_m / (60.0 * self.gear_ratio)
     }
 
-    /// Fastest track speed [m/s].
+    /// Fastest track speed (m/s).
     pub fn max_track_speed_mps(&self) -> f64 {
         self.motor_max_rpm * self.mps_per_rpm()
     }
@@ -63,7 +63,7 @@ pub struct SlipParams {
     pub left: f64,
     /// Longitudinal slip ratio of the right track.
     pub right: f64,
-    /// Lateral skid in turns: sideways speed = −gain·v_c·θ̇ (outwards of the turn) [s].
+    /// Lateral skid in turns: sideways speed = −gain·v_c·θ̇ (outwards of the turn) (s).
     pub lateral_gain_s: f64,
 }
 
@@ -94,12 +94,12 @@ impl SlipParams {
     }
 }
 
-/// Motor speed commands [rpm] (positive drives the machine forward).
+/// Motor speed commands (rpm) (positive drives the machine forward).
 #[derive(Debug, Clone, Copy, PartialEq, Default, Serialize, Deserialize)]
 pub struct TrackCommand {
-    /// Left motor [rpm].
+    /// Left motor (rpm).
     pub left_rpm: f64,
-    /// Right motor [rpm].
+    /// Right motor (rpm).
     pub right_rpm: f64,
 }
 
@@ -138,9 +138,9 @@ impl TrackCommand {
 pub struct CrawlerState {
     /// Pose of the centroid; θ is the crawler's heading.
     pub pose: Pose2,
-    /// Left motor speed [rpm].
+    /// Left motor speed (rpm).
     pub left_rpm: f64,
-    /// Right motor speed [rpm].
+    /// Right motor speed (rpm).
     pub right_rpm: f64,
 }
 
@@ -169,7 +169,7 @@ impl Crawler {
         }
     }
 
-    /// Centroid speed over ground along the heading [m/s].
+    /// Centroid speed over ground along the heading (m/s).
     pub fn speed_mps(&self) -> f64 {
         let k = self.params.mps_per_rpm();
         0.5 * (self.state.left_rpm * k * (1.0 - self.slip.left)

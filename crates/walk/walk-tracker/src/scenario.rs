@@ -25,30 +25,30 @@
 //! [sim]                         # SimParams fields
 //! [controller.fuzzy]            # FuzzyParams: the fuzzy tracker's gains
 //! alpha = 0.30                  # weight of d0 in e = d + α·d0 [W eq. 23], >= 0
-//! k1 = 2.42                     # e_f = k1·e [W eq. 24] [1/m], > 0
-//! k2 = 32.1                     # ec_f = k2·ec [W eq. 24] [s/m], > 0
+//! k1 = 2.42                     # e_f = k1·e [W eq. 24] (1/m), > 0
+//! k2 = 32.1                     # ec_f = k2·ec [W eq. 24] (s/m), > 0
 //! k3 = 1.11                     # u = k3·u_f [W eq. 24], > 0
-//! ec_filter_s = 0.34            # low-pass time constant on ec [s], >= 0 (0 = none)
-//! alpha_curvature_m = 0.0       # α(κ) = alpha + alpha_curvature_m·|κ| [W eq. 23] [m], >= 0
+//! ec_filter_s = 0.34            # low-pass time constant on ec (s), >= 0 (0 = none)
+//! alpha_curvature_m = 0.0       # α(κ) = alpha + alpha_curvature_m·|κ| [W eq. 23] (m), >= 0
 //! universe = "fixed"            # or "variable": contraction–expansion factors [W eq. 24]
 //! vu_tau = 0.5                  # variable universe: α(x) = (|x|/E)^τ + ε, τ in (0, 1]
 //! vu_epsilon = 0.1              # ε in (0, 1]
 //! [controller.pid]              # PidParams: the PID baseline (§5.4)
-//! kp = 800.0                    # [rpm/m], >= 0
-//! ki = 100.0                    # [rpm/(m·s)], >= 0
-//! kd = 300.0                    # [rpm·s/m], >= 0
+//! kp = 800.0                    # (rpm/m), >= 0
+//! ki = 100.0                    # (rpm/(m·s)), >= 0
+//! kd = 300.0                    # (rpm·s/m), >= 0
 //! alpha = 0.5                   # weight of d0 in e [W eq. 23], >= 0
-//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! max_steer_rpm = 2700.0        # output limit (rpm), > 0
 //! error = "preview"             # e = d + α·d0; "position": the centroid's d0 alone
 //! [controller.pure_pursuit]     # PurePursuitParams
-//! lookahead_m = 1.5             # look-ahead at standstill [m], > 0
-//! lookahead_gain_s = 1.0        # growth of the look-ahead with speed [s], >= 0
-//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! lookahead_m = 1.5             # look-ahead at standstill (m), > 0
+//! lookahead_gain_s = 1.0        # growth of the look-ahead with speed (s), >= 0
+//! max_steer_rpm = 2700.0        # output limit (rpm), > 0
 //! [controller.stanley]          # StanleyParams
-//! k_per_s = 1.0                 # cross-track gain k [1/s], >= 0
-//! softening_mps = 0.3           # softening speed [m/s], > 0
-//! heading_time_s = 0.8          # time to close the heading correction [s], > 0
-//! max_steer_rpm = 2700.0        # output limit [rpm], > 0
+//! k_per_s = 1.0                 # cross-track gain k (1/s), >= 0
+//! softening_mps = 0.3           # softening speed (m/s), > 0
+//! heading_time_s = 0.8          # time to close the heading correction (s), > 0
+//! max_steer_rpm = 2700.0        # output limit (rpm), > 0
 //! ```
 //!
 //! Every field of the `[controller.*]` tables is optional; the values shown
@@ -57,7 +57,9 @@
 
 use autoshovel_core::config::{self, line_of_key, TomlFile};
 use autoshovel_core::{rad, Pose2, Vec2};
-use autoshovel_walk_planner::{plan_path, Direction, FieldKind, PlanOptions, Scenario as TravelScenario};
+use autoshovel_walk_planner::{
+    plan_path, Direction, FieldKind, PlanOptions, Scenario as TravelScenario,
+};
 use serde::{Deserialize, Serialize};
 
 use crate::controller::ControllerParams;
@@ -115,7 +117,7 @@ pub struct TrackScenario {
     pub controllers: ControllerParams,
 }
 
-/// Farthest the start may be from the first leg [m].
+/// Farthest the start may be from the first leg (m).
 pub const MAX_START_OFFSET_M: f64 = 20.0;
 
 /// The built-in tracking scenarios written as tracking-scenario TOML (the
@@ -224,7 +226,7 @@ pub struct ScenarioFile {
     /// Name (default: the file name).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub name: Option<String>,
-    /// Cruise speed [m/s], overriding `[sim] speed_mps`.
+    /// Cruise speed (m/s), overriding `[sim] speed_mps`.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub speed_mps: Option<f64>,
     /// RTK noise and loose-bench slip on or off (default off).
@@ -256,11 +258,11 @@ pub struct ScenarioFile {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct StartSpec {
-    /// East [m].
+    /// East (m).
     pub x_m: f64,
-    /// North [m].
+    /// North (m).
     pub y_m: f64,
-    /// Heading from +x, counter-clockwise [deg].
+    /// Heading from +x, counter-clockwise (deg).
     pub heading_deg: f64,
 }
 
@@ -270,10 +272,10 @@ pub struct StartSpec {
 pub struct LegSpec {
     /// Forward or reverse.
     pub direction: Direction,
-    /// Path points [m].
+    /// Path points (m).
     #[serde(deserialize_with = "config::xy_list")]
     pub points_m: Vec<[f64; 2]>,
-    /// Required heading at the end [deg] (default: along the last segment).
+    /// Required heading at the end (deg) (default: along the last segment).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub end_heading_deg: Option<f64>,
 }

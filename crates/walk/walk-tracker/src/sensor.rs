@@ -15,18 +15,18 @@ use serde::{Deserialize, Serialize};
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct RtkParams {
-    /// Fix rate [Hz].
+    /// Fix rate (Hz).
     pub rate_hz: f64,
-    /// Position noise, standard deviation per axis [m].
+    /// Position noise, standard deviation per axis (m).
     pub position_sigma_m: f64,
-    /// Heading noise, standard deviation [deg]; draws are truncated at 3σ.
+    /// Heading noise, standard deviation (deg); draws are truncated at 3σ.
     pub heading_sigma_deg: f64,
-    /// Constant offset of the reported heading from the crawler's [deg]
+    /// Constant offset of the reported heading from the crawler's (deg)
     /// (upper works not square to the crawler, §5.3).
     pub heading_offset_deg: f64,
     /// Mean number of dropouts per minute (0 = none).
     pub dropouts_per_min: f64,
-    /// Length of each dropout [s].
+    /// Length of each dropout (s).
     pub dropout_s: f64,
     /// Seed of the noise.
     pub seed: u64,
@@ -70,13 +70,13 @@ impl RtkParams {
 /// One RTK fix, in the receiver's own terms.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct RtkFix {
-    /// Time of the fix [s].
+    /// Time of the fix (s).
     pub time_s: f64,
-    /// East [m].
+    /// East (m).
     pub east_m: f64,
-    /// North [m].
+    /// North (m).
     pub north_m: f64,
-    /// Heading from north, clockwise [rad].
+    /// Heading from north, clockwise (rad).
     pub heading_north_cw_rad: f64,
 }
 
@@ -112,7 +112,7 @@ impl Rtk {
         }
     }
 
-    /// Period between fixes [s].
+    /// Period between fixes (s).
     pub fn period_s(&self) -> f64 {
         1.0 / self.params.rate_hz
     }

@@ -22,7 +22,7 @@ pub use crate::workstation::{Event, SimParams};
 /// A sample of the run at one control tick.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Sample {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
     /// Leg index.
     pub leg: usize,
@@ -30,21 +30,21 @@ pub struct Sample {
     pub truth: Pose2,
     /// Measured pose (the last fix).
     pub measured: Pose2,
-    /// True signed centroid deviation from the path [m].
+    /// True signed centroid deviation from the path (m).
     pub centroid_dev_m: f64,
-    /// True heading of motion minus the path's tangent [rad].
+    /// True heading of motion minus the path's tangent (rad).
     pub heading_error_rad: f64,
-    /// Measured preview deviation d [m].
+    /// Measured preview deviation d (m).
     pub d_m: f64,
-    /// Measured centroid deviation d0 [m].
+    /// Measured centroid deviation d0 (m).
     pub d0_m: f64,
-    /// Reference speed [m/s].
+    /// Reference speed (m/s).
     pub speed_ref_mps: f64,
-    /// Commanded steering n_r − n_l [rpm].
+    /// Commanded steering n_r − n_l (rpm).
     pub steer_rpm: f64,
     /// Commanded motors.
     pub command: TrackCommand,
-    /// Distance travelled so far [m].
+    /// Distance travelled so far (m).
     pub travelled_m: f64,
 }
 
@@ -52,31 +52,31 @@ pub struct Sample {
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Metrics {
     /// Largest |centroid deviation| once the machine has reached the path
-    /// (first |deviation| < `converged_below_m`) [m].
+    /// (first |deviation| < `converged_below_m`) (m).
     pub max_centroid_dev_m: f64,
-    /// Mean |centroid deviation| once on the path [m].
+    /// Mean |centroid deviation| once on the path (m).
     pub mean_centroid_dev_m: f64,
-    /// RMS centroid deviation once on the path [m].
+    /// RMS centroid deviation once on the path (m).
     pub rms_centroid_dev_m: f64,
-    /// Travel until |deviation| < `converged_below_m` for the first time [m] (NaN: never).
+    /// Travel until |deviation| < `converged_below_m` for the first time (m) (NaN: never).
     pub reached_distance_m: f64,
-    /// Travel until |deviation| < 1 cm for good [m] (NaN: never).
+    /// Travel until |deviation| < 1 cm for good (m) (NaN: never).
     pub settled_1cm_distance_m: f64,
-    /// Largest |centroid deviation| over the whole run [m].
+    /// Largest |centroid deviation| over the whole run (m).
     pub max_centroid_dev_overall_m: f64,
-    /// Mean |centroid deviation| over the whole run [m].
+    /// Mean |centroid deviation| over the whole run (m).
     pub mean_centroid_dev_overall_m: f64,
-    /// Travel until |deviation| < `converged_below_m` for good [m] (NaN: never).
+    /// Travel until |deviation| < `converged_below_m` for good (m) (NaN: never).
     pub convergence_distance_m: f64,
-    /// The convergence threshold [m].
+    /// The convergence threshold (m).
     pub converged_below_m: f64,
-    /// Distance of the final centroid from the path's end [m].
+    /// Distance of the final centroid from the path's end (m).
     pub final_position_error_m: f64,
-    /// Final heading minus the required one [deg].
+    /// Final heading minus the required one (deg).
     pub final_heading_error_deg: f64,
-    /// Distance travelled [m].
+    /// Distance travelled (m).
     pub travelled_m: f64,
-    /// Simulated time [s].
+    /// Simulated time (s).
     pub duration_s: f64,
     /// The run ended at the path's end (no safety stop, no timeout).
     pub completed: bool,
@@ -110,7 +110,7 @@ pub struct Setup {
     pub sim: SimParams,
 }
 
-/// Convergence threshold: |centroid deviation| below this for good (SPEC §3) [m].
+/// Convergence threshold: |centroid deviation| below this for good (SPEC §3) (m).
 pub const CONVERGED_BELOW_M: f64 = 0.05;
 
 /// Most plant steps one run may take (each a few tens of nanoseconds).
@@ -122,7 +122,7 @@ pub const MAX_CONTROL_STEPS: f64 = 1e6;
 pub const SAMPLE_BYTES: f64 = 150.0;
 
 /// The most a run of `setup` can take, before it runs: the time limit
-/// (30 s plus `time_per_m_limit_s` per metre of path) [s], the plant steps
+/// (30 s plus `time_per_m_limit_s` per metre of path) (s), the plant steps
 /// and the control steps (samples) up to it.
 pub fn worst_case(setup: &Setup) -> (f64, f64, f64) {
     let sp = setup.sim;
@@ -183,7 +183,7 @@ impl Evaluator {
     }
 }
 
-/// Plant steps per control tick and their length [s].
+/// Plant steps per control tick and their length (s).
 pub fn plant_steps(sp: &SimParams) -> (usize, f64) {
     let control_dt = 1.0 / sp.control_rate_hz;
     let substeps = ((control_dt / sp.plant_dt_s).round() as usize).max(1);

@@ -9,8 +9,8 @@
 //!   `long-v-slip` (a 40 m V with 3 % / 15 % slip), seeds 1–6.
 //! - **Objective**, the same for every tracker, averaged over the runs:
 //!   J = mean |centroid deviation| over the whole run + 0.2·largest deviation
-//!   once on the path + 0.5·final position error [m] + 0.01·|final heading
-//!   error| [deg], plus 10 for a run that does not complete.
+//!   once on the path + 0.5·final position error (m) + 0.01·|final heading
+//!   error| (deg), plus 10 for a run that does not complete.
 //! - **Search**, the same for every tracker: `budget` evaluations of the whole
 //!   training set, seeded; the first is the tracker's default gains, then
 //!   60 % of the budget random in the tracker's box (log-uniform where the
@@ -368,13 +368,13 @@ pub fn tune(tracker: Tunable, training: &[Case], budget: usize, seed: u64) -> Tu
 pub struct SetScore {
     /// The objective, averaged.
     pub cost: f64,
-    /// Mean over runs of the mean |centroid deviation| over the whole run [m].
+    /// Mean over runs of the mean |centroid deviation| over the whole run (m).
     pub mean_dev_m: f64,
-    /// Largest |centroid deviation| once on the path, over runs [m].
+    /// Largest |centroid deviation| once on the path, over runs (m).
     pub max_dev_m: f64,
-    /// Mean |final heading error| [deg].
+    /// Mean |final heading error| (deg).
     pub mean_abs_final_heading_deg: f64,
-    /// Runs that completed [%].
+    /// Runs that completed (%).
     pub completed_pct: f64,
 }
 

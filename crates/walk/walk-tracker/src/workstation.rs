@@ -21,30 +21,30 @@ pub use crate::plant::AT_REST_RPM;
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct SimParams {
-    /// Plant integration step [s].
+    /// Plant integration step (s).
     pub plant_dt_s: f64,
-    /// Control loop rate [Hz] (the RTK delivers fixes at its own rate).
+    /// Control loop rate (Hz) (the RTK delivers fixes at its own rate).
     pub control_rate_hz: f64,
-    /// Cruise centroid speed [m/s].
+    /// Cruise centroid speed (m/s).
     pub speed_mps: f64,
-    /// Acceleration and braking of the speed profile [m/s²].
+    /// Acceleration and braking of the speed profile (m/s²).
     pub accel_mps2: f64,
-    /// Slowest speed before the end of a leg [m/s].
+    /// Slowest speed before the end of a leg (m/s).
     pub creep_mps: f64,
-    /// Preview distance L at standstill [W eq. 21] [m].
+    /// Preview distance L at standstill [W eq. 21] (m).
     pub preview_m: f64,
-    /// Growth of L with speed [s].
+    /// Growth of L with speed (s).
     pub preview_gain_s: f64,
-    /// Within `terminal_zone_m` of a leg's end, L is at least this [m]: the
+    /// Within `terminal_zone_m` of a leg's end, L is at least this (m): the
     /// preview then runs onto the path's continued last tangent, so the
     /// machine lines up with it as it stops (at creep speed L would shrink
     /// to where centimetre RTK noise hides the heading).
     pub terminal_preview_m: f64,
-    /// See `terminal_preview_m` [m].
+    /// See `terminal_preview_m` (m).
     pub terminal_zone_m: f64,
-    /// Stop when the newest fix is older than this [s].
+    /// Stop when the newest fix is older than this (s).
     pub pose_timeout_s: f64,
-    /// Largest plausible speed over ground; a fix implying more is a jump [m/s].
+    /// Largest plausible speed over ground; a fix implying more is a jump (m/s).
     pub max_plausible_speed_mps: f64,
     /// Give up after this much simulated time per metre of path (plus 30 s).
     pub time_per_m_limit_s: f64,
@@ -72,7 +72,7 @@ impl Default for SimParams {
 /// Something the safety layer or the runner did.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Event {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
     /// Kind: "stale-pose", "pose-jump", "pose-recovered", "leg-end", "timeout".
     pub kind: &'static str,
@@ -100,9 +100,9 @@ pub struct Decision {
     pub measured: Pose2,
     /// Deviations of [W eq. 21]–[W eq. 22] at that pose.
     pub dev: Deviations,
-    /// Reference speed [m/s].
+    /// Reference speed (m/s).
     pub speed_ref_mps: f64,
-    /// Steering n_r − n_l from the controller [rpm].
+    /// Steering n_r − n_l from the controller (rpm).
     pub steer_rpm: f64,
     /// The motor setpoints.
     pub command: TrackCommand,

@@ -7,8 +7,9 @@ use autoshovel_walk_tracker::tune::{evaluate, tune, CaseSets, Tunable};
 #[test]
 fn every_tracker_gets_the_same_budget_and_the_sets_are_disjoint() {
     let sets = CaseSets::standard().unwrap();
-    let names =
-        |c: &[autoshovel_walk_tracker::tune::Case]| c.iter().map(|c| c.name.clone()).collect::<Vec<_>>();
+    let names = |c: &[autoshovel_walk_tracker::tune::Case]| {
+        c.iter().map(|c| c.name.clone()).collect::<Vec<_>>()
+    };
     let (train, held, unseen) = (
         names(&sets.training),
         names(&sets.held_out),

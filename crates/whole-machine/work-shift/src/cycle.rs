@@ -17,24 +17,23 @@
 
 use serde::Serialize;
 
-/// Standard gravity [m/s²].
-pub const G: f64 = 9.81;
+use autoshovel_core::G;
 
 /// The swing drive: rest-to-rest moves at a top speed and a fixed acceleration.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct SwingDrive {
-    /// Top speed ω [rad/s].
+    /// Top speed ω (rad/s).
     pub speed_rad_s: f64,
-    /// Acceleration and braking α [rad/s²].
+    /// Acceleration and braking α (rad/s²).
     pub accel_rad_s2: f64,
-    /// Inertia of the upper works and boom, empty dipper [kg·m²].
+    /// Inertia of the upper works and boom, empty dipper (kg·m²).
     pub inertia_kg_m2: f64,
-    /// Radius at which the load swings [m].
+    /// Radius at which the load swings (m).
     pub radius_m: f64,
 }
 
 impl SwingDrive {
-    /// Time to swing through `angle` [rad], rest to rest [s].
+    /// Time to swing through `angle` (rad), rest to rest (s).
     pub fn time_s(&self, angle: f64) -> f64 {
         let (w, a, th) = (self.speed_rad_s, self.accel_rad_s2, angle.abs());
         if th >= w * w / a {
@@ -44,13 +43,13 @@ impl SwingDrive {
         }
     }
 
-    /// The top speed reached on a swing of `angle` [rad/s].
+    /// The top speed reached on a swing of `angle` (rad/s).
     pub fn peak_speed(&self, angle: f64) -> f64 {
         let (w, a, th) = (self.speed_rad_s, self.accel_rad_s2, angle.abs());
         w.min((th * a).sqrt())
     }
 
-    /// Motoring energy of a swing through `angle` carrying `load_kg` [J]
+    /// Motoring energy of a swing through `angle` carrying `load_kg` (J)
     /// (module docs).
     pub fn energy_j(&self, angle: f64, load_kg: f64) -> f64 {
         let j = self.inertia_kg_m2 + load_kg * self.radius_m * self.radius_m;
@@ -58,7 +57,7 @@ impl SwingDrive {
     }
 }
 
-/// Energy the propel drives spend to walk `distance_m` [J] (module docs).
+/// Energy the propel drives spend to walk `distance_m` (J) (module docs).
 pub fn propel_energy_j(mass_kg: f64, rolling_resistance: f64, distance_m: f64) -> f64 {
     rolling_resistance * mass_kg * G * distance_m
 }

@@ -27,9 +27,9 @@ pub enum ShiftError {
     /// off the world.
     #[error("the machine cannot start at ({x_m:.1}, {y_m:.1}) m: {why}")]
     BadStart {
-        /// Swing axis x [m].
+        /// Swing axis x (m).
         x_m: f64,
-        /// Swing axis y [m].
+        /// Swing axis y (m).
         y_m: f64,
         /// Why.
         why: String,

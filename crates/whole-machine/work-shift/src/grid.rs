@@ -7,9 +7,9 @@
 /// Square cells of `cell_m` from `origin`, `size` along x and y, numbered x fastest.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Layout {
-    /// Lower-left corner [m].
+    /// Lower-left corner (m).
     pub origin: [f64; 2],
-    /// Cell edge [m].
+    /// Cell edge (m).
     pub cell_m: f64,
     /// Cells along x and y.
     pub size: [usize; 2],
@@ -51,14 +51,14 @@ impl Layout {
         ]
     }
 
-    /// What heights `z` (one a cell) hold above the floor [m³], each cell a
+    /// What heights `z` (one a cell) hold above the floor (m³), each cell a
     /// prism; NaN cells (never seen) count nothing.
     pub fn volume_m3(&self, z: &[f64]) -> f64 {
         z.iter().filter(|z| z.is_finite()).sum::<f64>() * self.cell_m * self.cell_m
     }
 
     /// Takes the material above `cut`'s tooth path within its width out of
-    /// heights `z` (never below the floor) and returns its volume [m³]:
+    /// heights `z` (never below the floor) and returns its volume (m³):
     /// each cell the swept strip covers is lowered to the path, one it
     /// covers in part by that share of its height above the path; a NaN
     /// cell is left as it is.
@@ -127,15 +127,15 @@ impl Layout {
 /// along the line, y up from the floor; `half_width_m` each side.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Cut {
-    /// A point of the dig line (the swing axis) [m].
+    /// A point of the dig line (the swing axis) (m).
     pub origin: [f64; 2],
-    /// Direction of the line [rad from +x].
+    /// Direction of the line (rad from +x).
     pub heading: f64,
-    /// Distance along the line to the dig frame's origin (the toe) [m].
+    /// Distance along the line to the dig frame's origin (the toe) (m).
     pub toe_s_m: f64,
-    /// Half the dipper's width [m].
+    /// Half the dipper's width (m).
     pub half_width_m: f64,
-    /// The tooth path in the dig frame (x along, y up) [m].
+    /// The tooth path in the dig frame (x along, y up) (m).
     pub path: Vec<[f64; 2]>,
 }
 

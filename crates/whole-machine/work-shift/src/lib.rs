@@ -17,9 +17,6 @@
 //! mass balance and the figures of merit; [`cycle`] holds the swing,
 //! dump and energy models.
 
-// Units in brackets ("[m]", "[deg]") are the house style, not intra-doc links.
-#![allow(rustdoc::broken_intra_doc_links)]
-
 pub mod cycle;
 mod error;
 pub mod grid;

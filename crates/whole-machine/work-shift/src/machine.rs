@@ -5,8 +5,8 @@
 //! has perceived ([`next_stands`]) and builds its walking map from its
 //! scans ([`walking_map`]). Nothing here reads [`crate::world::World`].
 
-use autoshovel_point_cloud::PointCloud;
 use autoshovel_core::{Pose2, Vec2};
+use autoshovel_point_cloud::PointCloud;
 use autoshovel_rope_shovel_dig::DigSurface;
 use autoshovel_walk_planner::{Map, Obstacle, Shape};
 
@@ -26,10 +26,10 @@ pub fn perception() -> autoshovel_terrain::perceive::PerceptionParams {
 /// Returns a cell needs before a scan without perception sets its height.
 pub const RAW_RETURNS: usize = 3;
 
-/// Height above which a cell of the model is an obstacle to walking [m].
+/// Height above which a cell of the model is an obstacle to walking (m).
 pub const OBSTACLE_HEIGHT_M: f64 = 0.4;
 
-/// Band width of the walking map's obstacle rectangles (along y) [m].
+/// Band width of the walking map's obstacle rectangles (along y) (m).
 pub const MAP_BAND_M: f64 = 2.0;
 
 /// Share of the face's height at which the machine reads the face's
@@ -40,10 +40,10 @@ pub const MAP_BAND_M: f64 = 2.0;
 /// follows the face above it.
 pub const FACE_RISE_SHARE: f64 = 0.25;
 
-/// Length of a dig profile from the swing axis [m].
+/// Length of a dig profile from the swing axis (m).
 pub const PROFILE_LENGTH_M: f64 = 40.0;
 
-/// How far ahead the machine looks for a face when choosing a stand [m].
+/// How far ahead the machine looks for a face when choosing a stand (m).
 pub const LOOK_AHEAD_M: f64 = 90.0;
 
 /// The machine's height model of the pit, from its scans: each cell the
@@ -52,13 +52,13 @@ pub const LOOK_AHEAD_M: f64 = 90.0;
 /// no scan has looked.
 #[derive(Debug, Clone, PartialEq)]
 pub struct PileModel {
-    /// Lower-left corner [m].
+    /// Lower-left corner (m).
     pub origin: [f64; 2],
-    /// Cell edge [m].
+    /// Cell edge (m).
     pub cell_m: f64,
     /// Cells along x and y.
     pub size: [usize; 2],
-    /// Heights above the floor [m] (NaN: never seen).
+    /// Heights above the floor (m) (NaN: never seen).
     pub z: Vec<f64>,
 }
 
@@ -216,7 +216,7 @@ impl PileModel {
         self.cell_of(x, y).map_or(0.0, |k| self.z[k])
     }
 
-    /// What the model holds above the floor [m³] (unseen cells count nothing).
+    /// What the model holds above the floor (m³) (unseen cells count nothing).
     pub fn volume_m3(&self) -> f64 {
         self.layout().volume_m3(&self.z)
     }
@@ -297,15 +297,15 @@ fn fill_gaps(track: &mut [f64]) {
 /// One way the machine could dig from where it stands.
 #[derive(Debug, Clone)]
 pub struct DigOption {
-    /// Swing angle from the machine's heading [rad].
+    /// Swing angle from the machine's heading (rad).
     pub swing: f64,
-    /// The dig line's direction in the world [rad].
+    /// The dig line's direction in the world (rad).
     pub heading: f64,
-    /// Distance from the swing axis to the toe along the line [m].
+    /// Distance from the swing axis to the toe along the line (m).
     pub toe_s_m: f64,
     /// The profile in the dig frame (x from the toe).
     pub surface: DigSurface,
-    /// Material within the planner's reach along the line [m³] (model).
+    /// Material within the planner's reach along the line (m³) (model).
     pub material_m3: f64,
 }
 
@@ -364,9 +364,9 @@ pub fn dig_options(
 pub struct StandCandidate {
     /// Where the swing axis would stand, facing the face.
     pub pose: Pose2,
-    /// Material within reach over the dig angles [m³] (model).
+    /// Material within reach over the dig angles (m³) (model).
     pub material_m3: f64,
-    /// Sideways from the current stand (left positive) [m].
+    /// Sideways from the current stand (left positive) (m).
     pub lateral_m: f64,
 }
 
@@ -455,7 +455,7 @@ fn along_of(base: [f64; 2], stand: Pose2, heading: f64) -> f64 {
     (stand.x - base[0]) * heading.cos() + (stand.y - base[1]) * heading.sin()
 }
 
-/// What the model holds above the floor [m³] in the fan a stand can dig:
+/// What the model holds above the floor (m³) in the fan a stand can dig:
 /// within the swing angles (and half a dig line's spread more either
 /// side), from `toe_m` out to `toe_m + reach_m` from the swing axis.
 pub fn fan_material(
@@ -513,7 +513,7 @@ pub fn footprint_clear(map: &Map, pose: Pose2, radius_m: f64) -> bool {
     inside && map.clearance(p, radius_m) >= FOOTPRINT_MARGIN_M
 }
 
-/// Clearance a stand keeps from everything on the walking map [m]: more
+/// Clearance a stand keeps from everything on the walking map (m): more
 /// than the metre the walk planner wants free ahead of a machine that
 /// starts to move (so the next walk may start forward).
 pub const FOOTPRINT_MARGIN_M: f64 = 1.2;

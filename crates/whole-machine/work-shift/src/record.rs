@@ -11,7 +11,7 @@ use crate::world::World;
 /// One entry of the timeline.
 #[derive(Debug, Clone, PartialEq, Serialize)]
 pub struct Event {
-    /// Simulated time [s].
+    /// Simulated time (s).
     pub t_s: f64,
     /// What happened (module docs list the kinds).
     pub kind: &'static str,
@@ -28,13 +28,13 @@ pub struct PassRecord {
     pub pass: usize,
     /// Stand number (from 1).
     pub stand: usize,
-    /// Start of the dig [s].
+    /// Start of the dig (s).
     pub t_start_s: f64,
-    /// Swing angle dug at [deg].
+    /// Swing angle dug at (deg).
     pub swing_deg: f64,
-    /// Saddle to toe along the dig line, as the machine perceived it [m].
+    /// Saddle to toe along the dig line, as the machine perceived it (m).
     pub toe_distance_m: f64,
-    /// Digging, swinging to the truck, dumping, returning, waiting for a truck [s].
+    /// Digging, swinging to the truck, dumping, returning, waiting for a truck (s).
     pub dig_s: f64,
     /// (see `dig_s`)
     pub swing_s: f64,
@@ -44,30 +44,30 @@ pub struct PassRecord {
     pub return_s: f64,
     /// (see `dig_s`)
     pub wait_s: f64,
-    /// Volume the plan expected, on the perceived pile ([RS eq. 28]) [m³].
+    /// Volume the plan expected, on the perceived pile ([RS eq. 28]) (m³).
     pub planned_m3: f64,
-    /// Volume of the same path on the true pile ([RS eq. 28]) [m³] (NaN
+    /// Volume of the same path on the true pile ([RS eq. 28]) (m³) (NaN
     /// where the true pile along the line is too small for the planner's model).
     pub executed_m3: f64,
-    /// Volume taken out of the pit (cells under the path) [m³].
+    /// Volume taken out of the pit (cells under the path) (m³).
     pub dug_m3: f64,
-    /// Mass taken [t].
+    /// Mass taken (t).
     pub dug_t: f64,
     /// Dug volume over the dipper's capacity.
     pub fill_factor: f64,
-    /// Hoist and crowd energy of the dig [J] (on the true pile where known).
+    /// Hoist and crowd energy of the dig (J) (on the true pile where known).
     pub hoist_j: f64,
     /// (see `hoist_j`)
     pub crowd_j: f64,
-    /// Swing energy, loaded and back [J].
+    /// Swing energy, loaded and back (J).
     pub swing_j: f64,
-    /// Wall time of perception and of planning [ms].
+    /// Wall time of perception and of planning (ms).
     pub perceive_ms: f64,
     /// (see `perceive_ms`)
     pub plan_ms: f64,
-    /// Wall time of the whole pass, scan to return [ms].
+    /// Wall time of the whole pass, scan to return (ms).
     pub wall_ms: f64,
-    /// The tooth path in the world (x, y, height) [m].
+    /// The tooth path in the world (x, y, height) (m).
     #[serde(skip)]
     pub path: Vec<[f64; 3]>,
     /// The truck loaded (from 1).
@@ -83,25 +83,25 @@ pub struct WalkRecord {
     pub to_stand: usize,
     /// A V-shaped move (reverse, stop, forward).
     pub v_move: bool,
-    /// Planned path length [m].
+    /// Planned path length (m).
     pub planned_m: f64,
-    /// Distance the crawlers travelled [m].
+    /// Distance the crawlers travelled (m).
     pub travelled_m: f64,
-    /// Time of the walk [s].
+    /// Time of the walk (s).
     pub time_s: f64,
-    /// Propel energy [J].
+    /// Propel energy (J).
     pub energy_j: f64,
-    /// Distance of the stop from the stand [m].
+    /// Distance of the stop from the stand (m).
     pub final_error_m: f64,
-    /// Largest centroid deviation from the planned path [m].
+    /// Largest centroid deviation from the planned path (m).
     pub max_deviation_m: f64,
-    /// The planned path (x, y) [m].
+    /// The planned path (x, y) (m).
     #[serde(skip)]
     pub planned: Vec<[f64; 2]>,
-    /// The path driven (x, y), true [m].
+    /// The path driven (x, y), true (m).
     #[serde(skip)]
     pub driven: Vec<[f64; 2]>,
-    /// The shift's time [s] and the true heading [rad] at each point of `driven`.
+    /// The shift's time (s) and the true heading (rad) at each point of `driven`.
     #[serde(skip)]
     pub driven_at: Vec<[f64; 2]>,
 }
@@ -111,17 +111,17 @@ pub struct WalkRecord {
 pub struct StandRecord {
     /// Stand number (from 1).
     pub stand: usize,
-    /// The swing axis, true (x, y) [m] and heading [deg].
+    /// The swing axis, true (x, y) (m) and heading (deg).
     pub x_m: f64,
     /// (see `x_m`)
     pub y_m: f64,
     /// (see `x_m`)
     pub heading_deg: f64,
-    /// Arrival [s].
+    /// Arrival (s).
     pub t_arrive_s: f64,
     /// Passes dug from it.
     pub passes: usize,
-    /// Mass dug from it [t].
+    /// Mass dug from it (t).
     pub dug_t: f64,
     /// Why the machine left it.
     pub left_because: String,
@@ -137,15 +137,15 @@ pub struct StandRecord {
 /// `frame_size` cells at `frame_cell_m`.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Frame {
-    /// Simulated time [s].
+    /// Simulated time (s).
     pub t_s: f64,
     /// The machine (true).
     pub pose: Pose2,
-    /// Heights [m], x fastest.
+    /// Heights (m), x fastest.
     pub z: Vec<f32>,
 }
 
-/// The time of a cycle's stages, mean over the passes [s].
+/// The time of a cycle's stages, mean over the passes (s).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct CycleTimes {
     /// Digging.
@@ -162,7 +162,7 @@ pub struct CycleTimes {
     pub total_s: f64,
 }
 
-/// Energy per tonne dug, by drive [kWh/t].
+/// Energy per tonne dug, by drive (kWh/t).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EnergyPerTonne {
     /// Hoist.
@@ -180,19 +180,19 @@ pub struct EnergyPerTonne {
 /// The mass balance: what the pit lost, what the trucks got, what the plans expected.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct MassBalance {
-    /// The pit's volume at the start less at the end, × density [t].
+    /// The pit's volume at the start less at the end, × density (t).
     pub pit_lost_t: f64,
-    /// Sum of the passes' dug mass [t].
+    /// Sum of the passes' dug mass (t).
     pub dug_t: f64,
-    /// Sum of the trucks' payloads [t].
+    /// Sum of the trucks' payloads (t).
     pub dumped_t: f64,
-    /// Sum of the plans' expected mass (on the perceived pile) [t].
+    /// Sum of the plans' expected mass (on the perceived pile) (t).
     pub planned_t: f64,
-    /// Sum of the paths' mass on the true pile ([RS eq. 28]), where known [t].
+    /// Sum of the paths' mass on the true pile ([RS eq. 28]), where known (t).
     pub executed_t: f64,
-    /// |pit lost − dumped| [t].
+    /// |pit lost − dumped| (t).
     pub error_t: f64,
-    /// The tolerance: rounding of the pit's sum, 1e-9 of its mass [t].
+    /// The tolerance: rounding of the pit's sum, 1e-9 of its mass (t).
     pub tolerance_t: f64,
     /// Whether the balance closes within the tolerance.
     pub closes: bool,
@@ -219,7 +219,7 @@ pub struct ShiftSummary {
     /// Whether the shift ran to its end (its hours or cycles) rather than
     /// running out of stands.
     pub completed: bool,
-    /// Simulated time [h].
+    /// Simulated time (h).
     pub hours: f64,
     /// Loading cycles.
     pub passes: usize,
@@ -227,21 +227,21 @@ pub struct ShiftSummary {
     pub stands: usize,
     /// Walks between stands.
     pub walks: usize,
-    /// Mass dug [t].
+    /// Mass dug (t).
     pub tonnes: f64,
-    /// Mass dug over the simulated time [t/h].
+    /// Mass dug over the simulated time (t/h).
     pub tonnes_per_hour: f64,
     /// Mean cycle time by stage.
     pub cycle_time_s: CycleTimes,
-    /// Time spent walking [s].
+    /// Time spent walking (s).
     pub walk_time_s: f64,
-    /// Distance walked [m].
+    /// Distance walked (m).
     pub walked_m: f64,
     /// Energy per tonne by drive.
     pub energy_kwh_per_t: EnergyPerTonne,
     /// Fill factor per pass.
     pub fill_factor: FillStats,
-    /// Pile left in the pit [m³].
+    /// Pile left in the pit (m³).
     pub volume_left_m3: f64,
     /// The mass balance.
     pub mass_balance: MassBalance,
@@ -249,13 +249,13 @@ pub struct ShiftSummary {
     pub safety_events: usize,
     /// Events by kind.
     pub events: std::collections::BTreeMap<&'static str, usize>,
-    /// The full-size machine: λ, dipper capacity [m³], dig time range [s].
+    /// The full-size machine: λ, dipper capacity (m³), dig time range (s).
     pub lambda: f64,
     /// (see `lambda`)
     pub dipper_m3: f64,
     /// (see `lambda`)
     pub dig_time_range_s: [f64; 2],
-    /// Wall time of the run [ms], per pass (mean, first and last quarter of the passes).
+    /// Wall time of the run (ms), per pass (mean, first and last quarter of the passes).
     pub wall_ms: f64,
     /// (see `wall_ms`)
     pub ms_per_pass: f64,
@@ -288,6 +288,6 @@ pub struct ShiftRun {
     pub frames: Vec<Frame>,
     /// (x, y) cells of a frame.
     pub frame_size: [usize; 2],
-    /// Edge of a frame's cell [m].
+    /// Edge of a frame's cell (m).
     pub frame_cell_m: f64,
 }

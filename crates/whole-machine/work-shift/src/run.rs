@@ -28,9 +28,11 @@ use rand_distr::{Distribution, Normal};
 use serde::Serialize;
 
 use autoshovel_core::{Pose2, Vec2};
-use autoshovel_rope_shovel_dig::{plan_dig, DigModel, DigSearch, DigSurface, MachineProfile, Similarity};
-use autoshovel_walk_planner::{plan_path, Direction, FieldKind, PlanOptions, Scenario as Travel};
+use autoshovel_rope_shovel_dig::{
+    plan_dig, DigModel, DigSearch, DigSurface, MachineProfile, Similarity,
+};
 use autoshovel_terrain::perceive::perceive;
+use autoshovel_walk_planner::{plan_path, Direction, FieldKind, PlanOptions, Scenario as Travel};
 use autoshovel_walk_tracker::{
     simulate, ControllerKind, ControllerParams, CrawlerParams, RefLeg, RtkParams, Setup, SimParams,
     SlipParams,
@@ -88,13 +90,13 @@ impl Default for ShiftOptions {
     }
 }
 
-/// Greatest share of a walk's stop error the machine accepts as arrived [m].
+/// Greatest share of a walk's stop error the machine accepts as arrived (m).
 const ARRIVED_M: f64 = 1.5;
 /// Passes at one stand at most (a guard: the planner ends a stand long before).
 const MAX_PASSES_PER_STAND: usize = 200;
 /// Stands in a row without a pass after which the shift ends.
 const MAX_BARREN_STANDS: usize = 12;
-/// Cell of an animation frame [m].
+/// Cell of an animation frame (m).
 const FRAME_CELL_M: f64 = 1.0;
 
 /// Runs a shift of `scenario` with the dig planner's `model_profile` (the
@@ -168,7 +170,7 @@ pub fn run_shift(
         .collect();
     let width = profile.dipper.width_m;
     let reach = profile.search.gx_m[1];
-    let deepest = similarity.length(autoshovel_rope_shovel_dig::terrain::DEEPEST_CUT_M);
+    let deepest = similarity.length(autoshovel_rope_shovel_dig::dig_surface::DEEPEST_CUT_M);
     let density_t = profile.material.density_kg_m3 / 1000.0;
     let capacity = profile.dipper.capacity_m3;
     let nominal_toe = profile

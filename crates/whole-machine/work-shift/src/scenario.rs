@@ -14,7 +14,7 @@ use crate::error::{Result, ShiftError};
 /// the machine's model; a 1.5 km square pit at 0.5 m).
 pub const MAX_CELLS: f64 = 1e7;
 
-/// Highest pile, heap or vehicle [m].
+/// Highest pile, heap or vehicle (m).
 pub const MAX_HEIGHT_M: f64 = 1000.0;
 
 /// The built-in scenario's text.
@@ -27,13 +27,13 @@ pub const BUILTINS: &[(&str, &str)] = &[("bench", BENCH_TOML)];
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct WorldSpec {
-    /// Lower-left corner (x, y) [m].
+    /// Lower-left corner (x, y) (m).
     #[serde(deserialize_with = "config::xy")]
     pub min_m: [f64; 2],
-    /// Upper-right corner [m].
+    /// Upper-right corner (m).
     #[serde(deserialize_with = "config::xy")]
     pub max_m: [f64; 2],
-    /// Edge of a cell of the height grid [m].
+    /// Edge of a cell of the height grid (m).
     pub cell_m: f64,
 }
 
@@ -43,16 +43,16 @@ pub struct WorldSpec {
 pub struct PileSpec {
     /// The face's profile (the generator's shapes, Fig. 7).
     pub shape: PileShape,
-    /// x of the toe line [m].
+    /// x of the toe line (m).
     pub toe_x_m: f64,
-    /// The face runs along y between these [m].
+    /// The face runs along y between these (m).
     #[serde(deserialize_with = "config::xy")]
     pub y_m: [f64; 2],
-    /// Toe to crest [m].
+    /// Toe to crest (m).
     pub face_height_m: f64,
-    /// Mean slope of the face and of the sides [deg].
+    /// Mean slope of the face and of the sides (deg).
     pub repose_deg: f64,
-    /// Flat top behind the crest [m].
+    /// Flat top behind the crest (m).
     pub top_depth_m: f64,
 }
 
@@ -60,12 +60,12 @@ pub struct PileSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct HeapSpec {
-    /// Centre (x, y) [m].
+    /// Centre (x, y) (m).
     #[serde(deserialize_with = "config::xy")]
     pub center_m: [f64; 2],
-    /// Radius at the floor [m].
+    /// Radius at the floor (m).
     pub radius_m: f64,
-    /// Height [m].
+    /// Height (m).
     pub height_m: f64,
 }
 
@@ -75,15 +75,15 @@ pub struct HeapSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ParkedSpec {
-    /// Centre (x, y) [m].
+    /// Centre (x, y) (m).
     #[serde(deserialize_with = "config::xy")]
     pub center_m: [f64; 2],
-    /// Length and width [m].
+    /// Length and width (m).
     #[serde(deserialize_with = "config::xy")]
     pub size_m: [f64; 2],
-    /// Heading of its length [deg from +x].
+    /// Heading of its length (deg from +x).
     pub heading_deg: f64,
-    /// Height [m].
+    /// Height (m).
     pub height_m: f64,
 }
 
@@ -91,7 +91,7 @@ pub struct ParkedSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct MachineSpec {
-    /// The swing axis at the start, on the floor (x, y) [m].
+    /// The swing axis at the start, on the floor (x, y) (m).
     #[serde(deserialize_with = "config::xy")]
     pub start_m: [f64; 2],
     /// Heading at the start [deg from +x, counter-clockwise].
@@ -99,27 +99,27 @@ pub struct MachineSpec {
     /// λ: the dig planner's 1:30 model is scaled this many times
     /// ([`autoshovel_rope_shovel_dig::Similarity`]).
     pub lambda: f64,
-    /// The saddle block O ahead of the swing axis [m].
+    /// The saddle block O ahead of the swing axis (m).
     pub saddle_ahead_m: f64,
-    /// Radius of the crawlers' footprint disc, for walking [m].
+    /// Radius of the crawlers' footprint disc, for walking (m).
     pub footprint_radius_m: f64,
-    /// The LiDAR's height above the floor, on the swing axis [m].
+    /// The LiDAR's height above the floor, on the swing axis (m).
     pub sensor_height_m: f64,
-    /// Largest swing speed [deg/s].
+    /// Largest swing speed (deg/s).
     pub swing_speed_deg_s: f64,
-    /// Swing acceleration and braking [deg/s²].
+    /// Swing acceleration and braking (deg/s²).
     pub swing_accel_deg_s2: f64,
-    /// Inertia of the upper works and boom about the swing axis [kg·m²].
+    /// Inertia of the upper works and boom about the swing axis (kg·m²).
     pub upper_inertia_kg_m2: f64,
-    /// Radius at which the load swings [m].
+    /// Radius at which the load swings (m).
     pub dipper_radius_m: f64,
-    /// Dumping: the door opens and the load falls [s].
+    /// Dumping: the door opens and the load falls (s).
     pub dump_s: f64,
-    /// Mass of the whole machine [t].
+    /// Mass of the whole machine (t).
     pub mass_t: f64,
     /// Propel force over weight on the pit floor.
     pub rolling_resistance: f64,
-    /// Walking speed [m/s].
+    /// Walking speed (m/s).
     pub walk_speed_mps: f64,
 }
 
@@ -127,11 +127,11 @@ pub struct MachineSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct TruckSpec {
-    /// Swing angle at which a truck stands, from the machine's heading [deg].
+    /// Swing angle at which a truck stands, from the machine's heading (deg).
     pub swing_deg: f64,
-    /// Payload [t].
+    /// Payload (t).
     pub capacity_t: f64,
-    /// A full truck leaves and the next is spotted in this time [s].
+    /// A full truck leaves and the next is spotted in this time (s).
     pub exchange_s: f64,
 }
 
@@ -139,15 +139,15 @@ pub struct TruckSpec {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct ShiftSpec {
-    /// Length of the shift [h].
+    /// Length of the shift (h).
     pub hours: f64,
     /// Seed of every random process of the run.
     pub seed: u64,
     /// Points of each scan.
     pub scan_points: usize,
-    /// Swing angles at which the machine may dig from a stand [deg].
+    /// Swing angles at which the machine may dig from a stand (deg).
     pub dig_angles_deg: Vec<f64>,
-    /// A new stand along the face is this far to the side [m].
+    /// A new stand along the face is this far to the side (m).
     pub lateral_step_m: f64,
 }
 

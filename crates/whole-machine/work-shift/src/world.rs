@@ -9,8 +9,8 @@ use rand_chacha::ChaCha8Rng;
 use rand_distr::{Distribution, Normal};
 use rayon::prelude::*;
 
-use autoshovel_point_cloud::PointCloud;
 use autoshovel_core::Pose2;
+use autoshovel_point_cloud::PointCloud;
 use autoshovel_terrain::sensor_from_level;
 
 use crate::grid::{Cut, Layout};
@@ -19,13 +19,13 @@ use crate::scenario::{HeapSpec, ShiftScenario};
 /// The pit: heights above the floor at cell centres, x fastest.
 #[derive(Debug, Clone, PartialEq)]
 pub struct World {
-    /// Lower-left corner of the grid [m].
+    /// Lower-left corner of the grid (m).
     pub origin: [f64; 2],
-    /// Cell edge [m].
+    /// Cell edge (m).
     pub cell_m: f64,
     /// Cells along x and y.
     pub size: [usize; 2],
-    /// Height of each cell's centre above the floor [m].
+    /// Height of each cell's centre above the floor (m).
     pub z: Vec<f64>,
 }
 
@@ -33,15 +33,15 @@ pub struct World {
 /// perception estimates it from the floor), range noise and outliers.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct Lidar {
-    /// Height above the floor, on the swing axis [m].
+    /// Height above the floor, on the swing axis (m).
     pub height_m: f64,
     /// Points a scan.
     pub points: usize,
-    /// Roll and pitch of the mounting [rad].
+    /// Roll and pitch of the mounting (rad).
     pub roll_rad: f64,
     /// (see `roll_rad`)
     pub pitch_rad: f64,
-    /// Range noise, standard deviation [m].
+    /// Range noise, standard deviation (m).
     pub range_noise_m: f64,
     /// Share of returns that are dust or rain: points anywhere in the view.
     pub outlier_share: f64,
@@ -133,7 +133,7 @@ impl World {
     }
 
     /// Height above the floor at (x, y), bilinear between cell centres
-    /// (held at the edges) [m].
+    /// (held at the edges) (m).
     pub fn height(&self, x: f64, y: f64) -> f64 {
         let u = ((x - self.origin[0]) / self.cell_m - 0.5).clamp(0.0, (self.size[0] - 1) as f64);
         let v = ((y - self.origin[1]) / self.cell_m - 0.5).clamp(0.0, (self.size[1] - 1) as f64);
@@ -159,7 +159,7 @@ impl World {
         self.layout().centre(i)
     }
 
-    /// Everything above the floor [m³] (each cell a prism).
+    /// Everything above the floor (m³) (each cell a prism).
     pub fn volume_m3(&self) -> f64 {
         self.layout().volume_m3(&self.z)
     }
@@ -196,7 +196,7 @@ impl World {
     }
 
     /// Takes the material above `cut`'s tooth path within its width out of
-    /// the pit (never below the floor), and returns its volume [m³]: each
+    /// the pit (never below the floor), and returns its volume (m³): each
     /// cell the swept strip covers is lowered to the path, one it covers in
     /// part by that share of its height above the path.
     pub fn cut(&mut self, cut: &Cut) -> f64 {

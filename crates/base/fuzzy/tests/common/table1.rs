@@ -1,6 +1,6 @@
 //! Test / example fixture: the crawler trajectory-tracking fuzzy controller
-//! of the electric-shovel paper's §4.3 — inputs e [m] ∈ [−0.45, 0.45] and
-//! ec ∈ [−30, 30], output u [rpm] ∈ [−2700, 2700], seven evenly spaced
+//! of the electric-shovel paper's §4.3 — inputs e (m) ∈ [−0.45, 0.45] and
+//! ec ∈ [−30, 30], output u (rpm) ∈ [−2700, 2700], seven evenly spaced
 //! triangular terms each, Table 1 (rows ec, columns e). Mamdani inference
 //! (Mamdani & Assilian 1975). The tracking crate owns the real controller;
 //! this copy only exercises the generic machinery (shared with the example

@@ -28,10 +28,10 @@
 
 use super::common::{bad, empty_input, f32_at_most, is_finite};
 use super::exp::exp_in_place;
-use super::grid::Grid;
-use super::kdtree::KdTree;
 use super::normals::{add_lanes, pca_normal, Columns, LANES};
-use super::within::Isa;
+use crate::search::columns::ColumnGrid;
+use crate::search::kdtree::KdTree;
+use crate::simd::Isa;
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
 use serde::{Deserialize, Serialize};
@@ -50,11 +50,11 @@ struct Terms {
 /// Parameters of [`bilateral_normal_smoothing`] ([RS eq. 19]–[RS eq. 20]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct BilateralParams {
-    /// The neighbourhood radius r of N_r(P) [m], inclusive.
+    /// The neighbourhood radius r of N_r(P) (m), inclusive.
     pub radius_m: f64,
-    /// σ_d of the distance weight w_d [m].
+    /// σ_d of the distance weight w_d (m).
     pub sigma_d_m: f64,
-    /// σ_n of the normal-offset weight w_n [m].
+    /// σ_n of the normal-offset weight w_n (m).
     pub sigma_n_m: f64,
     /// Number of smoothing passes.
     pub iterations: usize,
@@ -198,8 +198,8 @@ pub fn bilateral_normal_smoothing(cloud: &[Point], params: &BilateralParams) -> 
             }
         };
         // On a grid of columns as wide as the radius when the cloud suits
-        // one (`grid/`), else on the k-d tree: the same neighbours.
-        points = match Grid::for_radius(current, radius) {
+        // one (`search::columns`), else on the k-d tree: the same neighbours.
+        points = match ColumnGrid::for_radius(current, radius) {
             Some(grid) => grid.map_within(r2, Terms::default, smooth),
             None => {
                 let tree = KdTree::new(current);

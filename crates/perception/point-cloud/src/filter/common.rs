@@ -71,55 +71,9 @@ where
     Ok(kept(&finite)?.into_iter().map(|i| index[i]).collect())
 }
 
-/// A seeded uniform generator on [0, 1) (an LCG, 24 bits) for the tests'
-/// clouds: the same seed gives the same cloud on every machine.
-#[cfg(test)]
-pub(crate) fn uniform(seed: u64) -> impl FnMut() -> f32 {
-    let mut s = seed;
-    move || {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 40) as f32 / (1u64 << 24) as f32
-    }
-}
-
-/// A seeded generator of integers below `m` (the same LCG, its top 31
-/// bits) for the tests: the same seed gives the same draws everywhere.
-#[cfg(test)]
-pub(crate) fn below(seed: u64) -> impl FnMut(u64) -> u64 {
-    let mut s = seed;
-    move |m| {
-        s = s
-            .wrapping_mul(6364136223846793005)
-            .wrapping_add(1442695040888963407);
-        (s >> 33) % m
-    }
-}
-
 /// The points of `cloud` at `indices`, in that order.
 pub(crate) fn gather(cloud: &[Point], indices: &[usize]) -> PointCloud {
     PointCloud::new(indices.iter().map(|&i| cloud[i]).collect())
-}
-
-/// Relative widening of a search box beyond its radius (`grid/`,
-/// `octree.rs`): far above the f32 rounding of a squared distance (below
-/// 4e-7), so no point whose f32 squared distance is within a cap lies
-/// outside a box of the cap's root widened by it.
-pub(crate) const SLACK: f64 = 1e-4;
-
-/// The values within `wide` of `v`, rounded outwards to f32 (so that no
-/// f32 value within them falls outside).
-pub(crate) fn within_f32(v: f32, wide: f64) -> (f32, f32) {
-    let (lo, hi) = (f64::from(v) - wide, f64::from(v) + wide);
-    let (mut lo32, mut hi32) = (lo as f32, hi as f32);
-    if f64::from(lo32) > lo {
-        lo32 = lo32.next_down();
-    }
-    if f64::from(hi32) < hi {
-        hi32 = hi32.next_up();
-    }
-    (lo32, hi32)
 }
 
 #[cfg(test)]

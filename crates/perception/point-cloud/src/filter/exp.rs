@@ -7,7 +7,7 @@
 //! which for a binary that runs on every x86-64 are SSE2's: slower than
 //! libm (6.5 against 5 ns, measured). Here the same steps run on four
 //! (AVX2) or eight (AVX-512) values an instruction, chosen at run time as
-//! in `within.rs`, or one at a time elsewhere: Cody and Waite's reduction
+//! in `search::within`, or one at a time elsewhere: Cody and Waite's reduction
 //! x = k·ln 2 + r (ln 2 in two parts, fdlibm's), e^r by its Taylor series to
 //! r¹³ (|r| ≤ ln 2 / 2: the terms left out are below 10⁻¹⁷), and 2^k as
 //! two powers of two built from their exponent bits (so that e^x below
@@ -16,7 +16,7 @@
 //! every path: the same bits everywhere (the tests hold each path to the
 //! scalar one, and all to libm within 2⁻⁵¹ relative).
 
-use super::within::Isa;
+use crate::simd::{Isa, Path};
 
 /// Rounds to an integer by adding and taking away 1.5 · 2⁵².
 const ROUND: f64 = 6_755_399_441_055_744.0;
@@ -52,24 +52,24 @@ const TAYLOR: [f64; 12] = [
 /// Replaces each of `x` (finite or infinite, not NaN) by e^x.
 pub(super) fn exp_in_place(isa: Isa, x: &mut [f64]) {
     let mut chunks = x.chunks_exact_mut(8);
-    match isa {
-        // SAFETY: `Isa::best` and `Isa::available` give these only where
-        // the machine has the instruction set.
+    match isa.path() {
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => {
+        Path::Avx512(t) => {
             for c in &mut chunks {
-                unsafe { avx512::exp8(c.try_into().expect("8 values")) };
+                // SAFETY: `t` proves AVX-512F, the kernel's one requirement.
+                unsafe { avx512::exp8(t, c.try_into().expect("8 values")) };
             }
         }
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => {
+        Path::Avx2(t) => {
             for c in &mut chunks {
                 for half in c.chunks_exact_mut(4) {
-                    unsafe { avx2::exp4(half.try_into().expect("4 values")) };
+                    // SAFETY: `t` proves AVX2, the kernel's one requirement.
+                    unsafe { avx2::exp4(t, half.try_into().expect("4 values")) };
                 }
             }
         }
-        Isa::Portable => {
+        Path::Portable => {
             for v in chunks.by_ref().flatten() {
                 *v = exp(*v);
             }
@@ -108,7 +108,7 @@ mod avx2 {
     /// # Safety
     /// AVX2.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn exp4(x: &mut [f64; 4]) {
+    pub(super) unsafe fn exp4(_: crate::simd::Avx2, x: &mut [f64; 4]) {
         let s = _mm256_set1_pd;
         // SAFETY: four values.
         let v = unsafe { _mm256_loadu_pd(x.as_ptr()) };
@@ -152,7 +152,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn exp8(x: &mut [f64; 8]) {
+    pub(super) unsafe fn exp8(_: crate::simd::Avx512, x: &mut [f64; 8]) {
         let s = _mm512_set1_pd;
         // SAFETY: eight values.
         let v = unsafe { _mm512_loadu_pd(x.as_ptr()) };

@@ -20,24 +20,20 @@
 //! what to change. Non-finite points are dropped by every filter, as PCL's
 //! tools do. Neighbour searches build one index per call and query it in
 //! parallel with rayon: a grid of height-sorted columns for a dense scan
-//! (`grid/`: statistical and radius removal, smoothing), an octree for the
+//! (`search::columns`: statistical and radius removal, smoothing), an octree for the
 //! statistical filter where the density varies widely across the cloud
-//! (`octree.rs`), a k-d tree for normals and for clouds too sparse for a
-//! grid (`kdtree.rs`, which says why it is not `kiddo`); all find the same
+//! (`search::octree`), a k-d tree for normals and for clouds too sparse for a
+//! grid (`search::kdtree`, which says why it is not `kiddo`); all find the same
 //! neighbours, and results never depend on the number of threads.
 
 mod bilateral;
 mod common;
 mod exp;
-mod grid;
-mod kdtree;
 mod normals;
-mod octree;
 mod pass_through;
 mod radius_outlier;
 mod statistical_outlier;
 mod voxel_grid;
-mod within;
 
 pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
@@ -52,4 +48,3 @@ pub use statistical_outlier::{
     StatisticalOutlierParams,
 };
 pub use voxel_grid::{voxel_grid, VoxelCells, VoxelGridParams};
-pub use within::Isa;

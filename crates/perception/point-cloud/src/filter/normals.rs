@@ -16,7 +16,7 @@
 //! normal: `None` (PCL writes NaN).
 
 use super::common::{bad, empty_input, f32_at_most};
-use super::kdtree::{KdTree, Nearest};
+use crate::search::kdtree::{KdTree, Nearest};
 use crate::{Point, Result};
 
 const FILTER: &str = "normal estimation";
@@ -26,14 +26,14 @@ const FILTER: &str = "normal estimation";
 pub enum Neighbourhood {
     /// The k nearest points, the point itself included (PCL's `setKSearch`).
     Nearest(usize),
-    /// The points within this radius [m], inclusive (PCL's `setRadiusSearch`).
+    /// The points within this radius (m), inclusive (PCL's `setRadiusSearch`).
     Radius(f64),
 }
 
 /// Which way normals point.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub enum Orientation {
-    /// Towards this viewpoint [m], e.g. the sensor: n·(v − p) ≥ 0.
+    /// Towards this viewpoint (m), e.g. the sensor: n·(v − p) ≥ 0.
     Viewpoint([f64; 3]),
     /// Upwards: n_z ≥ 0.
     PositiveZ,
@@ -454,7 +454,7 @@ mod tests {
     /// largest eigenvalue, one with a repeated eigenvalue, then `n`
     /// random B·Bᵀ (seeded).
     fn covariances(seed: u64, n: usize) -> Vec<[[f64; 3]; 3]> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         let mut cases = vec![
             [[4.0, 0.0, 0.0], [0.0, 4.0, 0.0], [0.0, 0.0, 1e-6]],
             [[2.0, 1.0, 0.0], [1.0, 2.0, 0.0], [0.0, 0.0, 3.0]],

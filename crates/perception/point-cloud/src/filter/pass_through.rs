@@ -55,9 +55,9 @@ impl Axis {
 pub struct PassThroughParams {
     /// The axis filtered on.
     pub axis: Axis,
-    /// Lower limit [m], inclusive; may be `-inf`.
+    /// Lower limit (m), inclusive; may be `-inf`.
     pub min_m: f64,
-    /// Upper limit [m], inclusive; may be `+inf`.
+    /// Upper limit (m), inclusive; may be `+inf`.
     pub max_m: f64,
     /// Keep the points inside `[min_m, max_m]` (true) or outside it (false).
     pub keep_inside: bool,
@@ -214,7 +214,7 @@ where
         .zip(points.par_chunks(CHUNK))
         .enumerate()
         .map(|(chunk, (dst, src))| {
-            crate::room::populate(dst);
+            crate::prefault::populate(dst);
             let mut n = 0;
             for (b, block) in src.chunks(BLOCK).enumerate() {
                 if block.len() == BLOCK && !limits.may_pass_any(block.as_flattened(), &on_axis) {

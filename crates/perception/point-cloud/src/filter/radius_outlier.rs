@@ -21,7 +21,7 @@
 //! counting itself (or a duplicate of itself) as the first, has a squared
 //! distance `d` with `(double) d <= radius * radius` (the radius squared in
 //! f64, as PCL does; `d` is FLANN's f32 squared distance, computed here in
-//! the same order, see `kdtree.rs`). Points at exactly the radius count.
+//! the same order, see `search::kdtree`). Points at exactly the radius count.
 //! The non-dense branch (`radiusSearch`, `k <= min_pts_radius_` removed)
 //! counts the same neighbours. Non-finite points are dropped first, as the
 //! PCL tool does. `radius_m` must be positive (PCL refuses 0).
@@ -39,11 +39,11 @@ use autoshovel_core::config::short;
 use rayon::prelude::*;
 
 use super::common::{bad, emptied, empty_input, f32_at_most, gather, is_finite, on_finite_points};
-use super::grid::{radius_side, Grid};
-use super::kdtree::KdTree;
 use super::statistical_outlier::{
     statistical_kept_on, statistical_outlier_removal_indices, StatisticalOutlierParams,
 };
+use crate::search::columns::{radius_side, ColumnGrid};
+use crate::search::kdtree::KdTree;
 use crate::{Point, PointCloud, Result};
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,7 @@ const FILTER: &str = "radius outlier removal";
 /// Parameters of [`radius_outlier_removal`] ([RS eq. 13]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RadiusOutlierParams {
-    /// The search radius K_s [m], inclusive.
+    /// The search radius K_s (m), inclusive.
     pub radius_m: f64,
     /// The least number of other points within the radius for a point to be
     /// kept (PCL's `min_pts_radius_`, `-min_pts`).
@@ -134,7 +134,7 @@ pub struct RadiusKept {
     pub kept: Vec<usize>,
     /// The grid of the kept points (by their indices in the cloud), when
     /// the cloud suited one sized for both searches.
-    grid: Option<Grid>,
+    grid: Option<ColumnGrid>,
 }
 
 /// Radius outlier removal ([RS eq. 13]) that keeps its neighbour index for
@@ -163,7 +163,7 @@ pub fn radius_outlier_removal_then(
     let grid = (params.min_neighbors > 0 && wanted <= cloud.len() && cloud.iter().all(is_finite))
         .then(|| {
             let side = radius_side(f64::from(r2).sqrt());
-            Grid::for_k_nearest_at_least(cloud, mean_k.saturating_add(1), side)
+            ColumnGrid::for_k_nearest_at_least(cloud, mean_k.saturating_add(1), side)
         })
         .flatten();
     let Some(grid) = grid else {
@@ -229,9 +229,9 @@ fn kept_indices(points: &[crate::Point], params: &RadiusOutlierParams) -> Vec<us
     let r2 = f32_at_most(params.radius_m * params.radius_m);
     // The wanted-th nearest is within the radius exactly when at least
     // `wanted` points are: count them, stopping at `wanted` (on a grid of
-    // columns as wide as the radius when the cloud suits one, `grid/`;
+    // columns as wide as the radius when the cloud suits one, `search::columns`;
     // else on the k-d tree: the same counts).
-    match Grid::for_radius(points, f64::from(r2).sqrt()) {
+    match ColumnGrid::for_radius(points, f64::from(r2).sqrt()) {
         Some(grid) => grid.kept_inputs(&grid.map_has_within_in_grid_order(r2, wanted)),
         None => {
             let tree = KdTree::new(points);
@@ -256,7 +256,7 @@ mod tests {
     /// A scan of a wavy surface, 1 cm noise, 2 % of points flung up to
     /// 0.5 m above it.
     fn scan(n: usize, seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         (0..n)
             .map(|i| {
                 let (x, y) = (u() * 20.0, u() * 20.0);

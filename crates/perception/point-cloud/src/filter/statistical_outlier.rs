@@ -48,10 +48,10 @@
 //! sample standard deviation.
 
 use super::common::{bad, emptied, empty_input, gather, on_finite_points};
-use super::grid::Grid;
-use super::kdtree::KdTree;
-use super::octree::Octree;
-use super::within::Isa;
+use crate::search::columns::ColumnGrid;
+use crate::search::kdtree::KdTree;
+use crate::search::octree::Octree;
+use crate::simd::{Isa, Path};
 use crate::{Point, PointCloud, Result};
 use autoshovel_core::config::short;
 use serde::{Deserialize, Serialize};
@@ -168,9 +168,9 @@ pub(crate) fn mean_neighbour_distances(points: &[Point], mean_k: usize) -> Vec<f
 
 /// `f` of every point's k nearest squared distances (the point itself
 /// counted; in any order, the k-th last), in input order: on the octree
-/// (`octree.rs`) when the density varies widely ([`uneven`], probed on
+/// (`search::octree`) when the density varies widely ([`uneven`], probed on
 /// a sample), else on the grid of columns when the cloud suits one
-/// (`grid/`), else on the k-d tree; the same bits every way.
+/// (`search::columns`), else on the k-d tree; the same bits every way.
 fn k_nearest_distances<T, F>(points: &[Point], k: usize, f: F) -> Vec<T>
 where
     T: Send + Sync + Clone + Default,
@@ -178,7 +178,7 @@ where
 {
     // The octree's finest cell (0: as fine as codes go), or none.
     let octree = match Search::chosen() {
-        Search::Grid => None,
+        Search::ColumnGrid => None,
         Search::Octree => Some(0.0),
         Search::Chosen => {
             let kth = probe_k_nearest(points, k);
@@ -192,7 +192,7 @@ where
             return tree.map_k_nearest_distances(k, f);
         }
     }
-    match Grid::for_k_nearest(points, k) {
+    match ColumnGrid::for_k_nearest(points, k) {
         Some(grid) => grid.map_k_nearest_distances(k, f),
         None => KdTree::new(points).map_k_nearest_distances(k, f),
     }
@@ -251,7 +251,7 @@ fn uneven(kth: &[f64]) -> bool {
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Search {
     Chosen,
-    Grid,
+    ColumnGrid,
     Octree,
 }
 
@@ -259,7 +259,7 @@ impl Search {
     fn chosen() -> Self {
         static CHOSEN: std::sync::OnceLock<Search> = std::sync::OnceLock::new();
         *CHOSEN.get_or_init(|| match std::env::var("AUTOSHOVEL_SEARCH").as_deref() {
-            Ok("grid") => Search::Grid,
+            Ok("grid") => Search::ColumnGrid,
             Ok("octree") => Search::Octree,
             _ => Search::Chosen,
         })
@@ -305,7 +305,7 @@ pub fn mean_distances_and_reach_at(
     Ok(queries
         .par_iter()
         .map_init(
-            || super::kdtree::Nearest::new(mean_k + 1),
+            || crate::search::kdtree::Nearest::new(mean_k + 1),
             |knn, q| {
                 tree.nearest(q, knn);
                 let nearest = knn.distances();
@@ -392,14 +392,14 @@ fn root_sum_on(isa: Isa, nearest: &[f32]) -> f64 {
     fn wide(nearest: &[f32]) -> f64 {
         body(nearest)
     }
-    match isa {
-        Isa::Portable => body(nearest),
-        // SAFETY: `Isa::best` and `Isa::available` name AVX2 or AVX-512
-        // only where the machine has them.
+    match isa.path() {
+        Path::Portable => body(nearest),
+        // SAFETY: `_t` proves AVX2, `wide`'s one requirement.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { wide(nearest) },
+        Path::Avx2(_t) => unsafe { wide(nearest) },
+        // SAFETY: `t` proves AVX-512F, the kernel's one requirement.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::root_sum(nearest) },
+        Path::Avx512(t) => unsafe { avx512::root_sum(t, nearest) },
     }
 }
 
@@ -438,7 +438,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn root_sum(nearest: &[f32]) -> f64 {
+    pub(super) unsafe fn root_sum(_: crate::simd::Avx512, nearest: &[f32]) -> f64 {
         let n = nearest.len();
         let mut sum = _mm512_setzero_pd();
         let mut i = 0;
@@ -539,7 +539,7 @@ fn kept_indices(points: &[Point], params: &StatisticalOutlierParams) -> Result<V
 /// which are those at `filed` (ascending, not empty) of some cloud: indices
 /// into `filed`.
 pub(crate) fn statistical_kept_on(
-    grid: &Grid,
+    grid: &ColumnGrid,
     filed: &[usize],
     params: &StatisticalOutlierParams,
 ) -> Result<Vec<usize>> {
@@ -578,7 +578,7 @@ mod tests {
 
     #[test]
     fn the_probe_tells_an_uneven_cloud_from_an_even_one() {
-        let mut u = super::super::common::uniform(4);
+        let mut u = crate::testing::uniform(4);
         // A plane of 200 × 200 points a centimetre apart (jittered).
         let plane = |at: f32, step: f32, u: &mut dyn FnMut() -> f32| -> Vec<Point> {
             (0..40_000)
@@ -609,7 +609,7 @@ mod tests {
     #[test]
     fn the_root_sum_is_the_same_on_every_path() {
         // Four lanes, then (l0 + l1) + (l2 + l3) + the rest, written out.
-        let mut u = super::super::common::uniform(3);
+        let mut u = crate::testing::uniform(3);
         for n in 0..80 {
             let d: Vec<f32> = (0..n)
                 .map(|_| u().abs() * 10f32.powi(n as i32 % 7 - 3))
@@ -625,7 +625,7 @@ mod tests {
             for isa in Isa::available() {
                 let sum = root_sum_on(isa, &d);
                 #[cfg(target_arch = "x86_64")]
-                if isa == Isa::Avx512 {
+                if isa.avx512().is_some() {
                     // Newton's roots and eight lanes: within the bound.
                     let bound = (ROOT_ERROR + 2.0 * n as f64 * f64::EPSILON) * expected;
                     assert!((sum - expected).abs() <= bound, "{n}: {sum} {expected}");
@@ -639,11 +639,11 @@ mod tests {
     #[test]
     #[cfg(target_arch = "x86_64")]
     fn newtons_roots_are_within_their_bound_for_every_mantissa() {
-        if !Isa::available().contains(&Isa::Avx512) {
+        let Some(t) = Isa::best().avx512() else {
             return;
-        }
-        // SAFETY: the machine has AVX-512F (checked above).
-        let root = |d: f32| unsafe { avx512::root_sum(&[d]) };
+        };
+        // SAFETY: `t` proves AVX-512F.
+        let root = |d: f32| unsafe { avx512::root_sum(t, &[d]) };
         // Every f32 in [1, 4) (both parities of the exponent: the estimate
         // of 1/√x is scaled by powers of 4 only), every 7th in a debug build.
         let step = if cfg!(debug_assertions) { 7 } else { 1 };
@@ -656,7 +656,7 @@ mod tests {
         // Measured: within one ulp (2.2e-16 at worst), far inside the bound.
         assert!(worst < ROOT_ERROR / 16.0, "worst relative error {worst:e}");
         // Every scale of f32, subnormals to the largest; 0, +∞ and NaN.
-        let mut u = super::super::common::below(5);
+        let mut u = crate::testing::below(5);
         for _ in 0..200_000 {
             let d = f32::from_bits(u(u64::from(f32::MAX.to_bits()) + 1) as u32);
             let exact = f64::from(d).sqrt();
@@ -670,7 +670,7 @@ mod tests {
         assert_eq!(root(f32::INFINITY), f64::INFINITY);
         assert!(root(f32::NAN).is_nan());
         // SAFETY: as above.
-        assert_eq!(unsafe { avx512::root_sum(&[]) }, 0.0);
+        assert_eq!(unsafe { avx512::root_sum(t, &[]) }, 0.0);
     }
 
     /// PCL's d̄_i: sorted, the first skipped, summed nearest first.

@@ -43,7 +43,7 @@ pub use keys::VoxelCells;
 use radix::{radix_sort_voxels, Voxel};
 
 use super::common::{bad, empty_input, is_finite};
-use super::within::Isa;
+use crate::simd::Isa;
 use crate::{Point, PointCloud, Result};
 use serde::{Deserialize, Serialize};
 
@@ -52,7 +52,7 @@ const FILTER: &str = "voxel grid";
 /// Parameters of [`voxel_grid`] ([RS eq. 17]–[RS eq. 18]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct VoxelGridParams {
-    /// The voxel edge r along x, y and z [m].
+    /// The voxel edge r along x, y and z (m).
     pub leaf_m: [f64; 3],
 }
 
@@ -65,7 +65,7 @@ impl Default for VoxelGridParams {
 }
 
 impl VoxelGridParams {
-    /// Cubic voxels of edge `leaf_m` [m].
+    /// Cubic voxels of edge `leaf_m` (m).
     pub fn cube(leaf_m: f64) -> Self {
         Self {
             leaf_m: [leaf_m; 3],
@@ -221,7 +221,7 @@ fn centroids(
     // The linear index, PCL's order: x fastest, z slowest (the cell is
     // valid: the bounds pass checked every finite point).
     let cells = VoxelCells::with_inverse(inv);
-    let grid = keys::Grid {
+    let grid = keys::Lattice {
         cells,
         lo,
         ex: extent[0] as u64,
@@ -371,7 +371,7 @@ fn bucketed_centroids(points: &[Point], keys: &[u32], voxel_bits: u32) -> Vec<Po
                 start[super_of(k) + 2] += 1;
             }
             let total = counts_to_starts(&mut start);
-            let mut sorted: Vec<Entry> = crate::room::with_room(total);
+            let mut sorted: Vec<Entry> = crate::prefault::with_room(total);
             let room = &mut sorted.spare_capacity_mut()[..total];
             for (&k, p) in keys.iter().zip(ps).filter(|(&k, _)| k != NOT_FINITE) {
                 let slot = &mut start[super_of(k) + 1];
@@ -542,7 +542,7 @@ where
 #[cfg(test)]
 mod tests {
     use super::{centroids, VoxelGridParams, Way};
-    use crate::filter::within::Isa;
+    use crate::simd::Isa;
     use crate::Point;
 
     /// A camera-like scan: rows of points 2 mm apart over a gentle
@@ -550,7 +550,7 @@ mod tests {
     /// neighbours in the input are neighbours in space; points on voxel
     /// faces, non-finite points, and a far corner that widens the box.
     fn scan(rows: usize, columns: usize, seed: u64) -> Vec<Point> {
-        let mut next = super::super::common::below(seed);
+        let mut next = crate::testing::below(seed);
         let mut points = Vec::with_capacity(rows * columns + 8);
         for r in 0..rows {
             for c in 0..columns {
@@ -608,7 +608,7 @@ mod tests {
         // 15 rows, which cut the 10 rows of a voxel's points apart.
         let dense = scan(800, 800, 3);
         let mut blocks: Vec<&[Point]> = dense.chunks(12_000).collect();
-        let mut next = super::super::common::below(4);
+        let mut next = crate::testing::below(4);
         for i in (1..blocks.len()).rev() {
             blocks.swap(i, next(i as u64 + 1) as usize);
         }
@@ -644,7 +644,7 @@ mod tests {
         // voxels: sorted; a scan in rows, with runs
         // of three points a voxel and nine points a voxel at 6 mm (tried,
         // then given up) and fifty at 2 cm (tabled).
-        let mut next = super::super::common::below(5);
+        let mut next = crate::testing::below(5);
         let random: Vec<Point> = (0..100_000)
             .map(|_| [0, 1, 2].map(|_| next(1 << 20) as f32 / (1 << 20) as f32 * 2.0 - 1.0))
             .collect();

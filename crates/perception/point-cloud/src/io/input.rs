@@ -7,7 +7,7 @@ use std::path::Path;
 
 use crate::{CloudError, Point};
 
-/// Progress is reported every this many bytes [bytes].
+/// Progress is reported every this many bytes (bytes).
 const PROGRESS_STEP: u64 = 1 << 20;
 
 /// A buffered source with position, size, progress and the file's name.

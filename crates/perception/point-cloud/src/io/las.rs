@@ -53,9 +53,9 @@ pub const LAZ_MAX_POINTS_PER_BYTE: u64 = 2000;
 /// Fewest bytes a LASzip chunk is assumed to take (a raw first point alone
 /// is 20 or more).
 pub const LAZ_MIN_CHUNK_BYTES: u64 = 8;
-/// Minimum size of a variable-length record header [bytes].
+/// Minimum size of a variable-length record header (bytes).
 const VLR_HEADER: u64 = 54;
-/// Size of an extended VLR header [bytes].
+/// Size of an extended VLR header (bytes).
 const EVLR_HEADER: u64 = 60;
 /// Progress is reported every this many points.
 const PROGRESS_POINTS: u64 = 1 << 16;
@@ -553,13 +553,13 @@ pub struct LasHeader {
     pub format: &'static str,
     /// The point count of the header.
     pub points: u64,
-    /// Scale factor per axis [m per step].
+    /// Scale factor per axis (m per step).
     pub scale: [f64; 3],
-    /// Offset per axis [m].
+    /// Offset per axis (m).
     pub offset: [f64; 3],
-    /// The header's bounds [m].
+    /// The header's bounds (m).
     pub min: [f64; 3],
-    /// The header's bounds [m].
+    /// The header's bounds (m).
     pub max: [f64; 3],
     /// The coordinate system records (`LASF_Projection`: GeoTIFF keys
     /// 34735–34737, WKT 2111–2112), as (record id, bytes), in record-id
@@ -639,7 +639,7 @@ pub enum LasVersion {
     V1_4,
 }
 
-/// Coordinate resolution written [m].
+/// Coordinate resolution written (m).
 pub const LAS_SCALE_M: f64 = 0.001;
 
 /// Scale and offset of one axis: the offset is the middle of the data

@@ -22,13 +22,13 @@ use std::io::BufRead;
 
 use super::input::Input;
 
-/// Largest back-reference distance [bytes].
+/// Largest back-reference distance (bytes).
 const MAX_DISTANCE: usize = 1 << 13;
-/// Longest literal run [bytes].
+/// Longest literal run (bytes).
 const MAX_LITERAL: usize = 32;
-/// Longest back-reference [bytes].
+/// Longest back-reference (bytes).
 const MAX_MATCH: usize = 264;
-/// Output is handed to the sink in blocks of about this size [bytes].
+/// Output is handed to the sink in blocks of about this size (bytes).
 const BLOCK: usize = 1 << 16;
 /// The most one compressed byte can expand to: a 3-byte back-reference
 /// yields at most 264 bytes.

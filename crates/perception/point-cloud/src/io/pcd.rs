@@ -19,14 +19,14 @@ use super::scalar::Scalar;
 use super::Encoding;
 use crate::Point;
 
-/// Longest header or ASCII data line accepted [bytes].
+/// Longest header or ASCII data line accepted (bytes).
 const MAX_LINE: usize = 1 << 20;
-/// Largest point record accepted [bytes]: far above any real layout
+/// Largest point record accepted (bytes): far above any real layout
 /// (PCL's largest descriptors are ~1.3 kB) and small enough to buffer.
 const MAX_POINT_STEP: usize = 1 << 20;
-/// Binary data is read in chunks of about this size [bytes].
+/// Binary data is read in chunks of about this size (bytes).
 const CHUNK: usize = 1 << 20;
-/// Zero bytes accepted after binary data [bytes]. PCL 1.13 sizes its
+/// Zero bytes accepted after binary data (bytes). PCL 1.13 sizes its
 /// binary files for memory mapping and leaves up to a page of zeros after
 /// the data (its own 7-point test file is 4208 bytes); 64 KiB covers the
 /// largest page size in use. Anything else after the data is an error.
@@ -498,15 +498,8 @@ fn read_binary<R: BufRead>(
 
 /// The bytes of `points`, as a little-endian file lays out x y z as f32.
 fn points_as_bytes(points: &mut [Point]) -> &mut [u8] {
-    // SAFETY: `[f32; 3]` has no padding and every bit pattern is an f32,
-    // so its memory is 12 initialised bytes a point and any bytes written
-    // there make valid points; the length is the slice's size in bytes.
-    unsafe {
-        std::slice::from_raw_parts_mut(
-            points.as_mut_ptr().cast::<u8>(),
-            std::mem::size_of_val(points),
-        )
-    }
+    // `[f32; 3]` is plain data: no padding, every bit pattern an f32.
+    bytemuck::cast_slice_mut(points)
 }
 
 #[inline]

@@ -20,9 +20,9 @@ use super::text;
 use super::Encoding;
 use crate::Point;
 
-/// Longest header or ASCII data line accepted [bytes].
+/// Longest header or ASCII data line accepted (bytes).
 const MAX_LINE: usize = 1 << 20;
-/// Binary vertex data is read in chunks of about this size [bytes].
+/// Binary vertex data is read in chunks of about this size (bytes).
 const CHUNK: usize = 1 << 20;
 
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]

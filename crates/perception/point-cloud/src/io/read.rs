@@ -11,7 +11,7 @@ use super::las::{self, LasHeader};
 use super::{pcd, ply, xyz, Format};
 use crate::{CloudError, PointCloud};
 
-/// Buffer size of file readers [bytes].
+/// Buffer size of file readers (bytes).
 const BUFFER: usize = 1 << 20;
 
 /// What [`read`] found.

@@ -11,7 +11,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use super::{las, pcd, ply, xyz, Encoding, Format, LasVersion};
 use crate::{CloudError, PointCloud};
 
-/// Buffer size of file writers [bytes].
+/// Buffer size of file writers (bytes).
 const BUFFER: usize = 1 << 20;
 
 /// Options of [`write_with`].
@@ -40,7 +40,7 @@ pub fn write(path: &Path, cloud: &PointCloud, encoding: Encoding) -> crate::Resu
     )
 }
 
-/// [`write`] with every option.
+/// [`write()`] with every option.
 pub fn write_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -> crate::Result<()> {
     let format = Format::from_path(path)?;
     let encoding = options

@@ -11,7 +11,7 @@ use super::input::{line_str, Input, Points};
 use super::text;
 use crate::Point;
 
-/// Longest line accepted [bytes].
+/// Longest line accepted (bytes).
 const MAX_LINE: usize = 1 << 16;
 /// Lines sampled before the point vector is sized from the bytes per line.
 const SAMPLE_LINES: usize = 4096;

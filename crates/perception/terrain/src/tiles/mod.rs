@@ -84,7 +84,7 @@ use autoshovel_point_cloud::{CloudError, Point, PointCloud};
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use store::{dist_path, f32_at, Filing, Grid, RawSpill, Rec, Stage, DIST_RECORD};
+use store::{dist_path, f32_at, Filing, RawSpill, Rec, StageFiles, TileLayout, DIST_RECORD};
 use task::{filter_err, Step};
 pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
@@ -100,7 +100,7 @@ use crate::perceive::{
 /// Working memory a point of a tile needs through the heaviest stage
 /// (measured with `/usr/bin/time -v` on 4 M-point tiles: the point and its
 /// index twice over, the k-d tree's copy, the neighbour distances, the
-/// voxel keys), used to check a tile against the memory limit [bytes].
+/// voxel keys), used to check a tile against the memory limit (bytes).
 pub const BYTES_PER_POINT: u64 = 160;
 
 /// Most tiles a survey may be cut into (every tile's list is open at once
@@ -117,16 +117,16 @@ const LOOKAHEAD: usize = 8 << 20;
 /// How the survey is cut and held.
 #[derive(Debug, Clone, PartialEq)]
 pub struct TileOptions {
-    /// Side of a square tile in the levelled (x, y) plane [m]; `None`:
+    /// Side of a square tile in the levelled (x, y) plane (m); `None`:
     /// chosen so that a tile takes about a million points (less if a
     /// quarter of the memory limit holds fewer).
     pub tile_m: Option<f64>,
-    /// Most working memory a tile may take [bytes]; in [`InProcess`], the
+    /// Most working memory a tile may take (bytes); in [`InProcess`], the
     /// tiles running at once together.
     pub memory_limit: u64,
     /// Points of the sample for the floor and the tilt, and of the fit.
     pub sample_points: usize,
-    /// Cell of the survey's height model [m].
+    /// Cell of the survey's height model (m).
     pub model_cell_m: f64,
     /// Where the working folder is made (removed at the end).
     pub work_dir: PathBuf,
@@ -232,7 +232,7 @@ impl Survey {
         Ok(Self { files, headers })
     }
 
-    /// The origin the survey is read relative to [m], per axis: zero where
+    /// The origin the survey is read relative to (m), per axis: zero where
     /// every coordinate the headers bound lies within 10 km of zero (f32
     /// keeps a millimetre there); otherwise the headers' smallest value
     /// rounded down to a kilometre, so that UTM coordinates keep their
@@ -289,7 +289,7 @@ fn crs_words(crs: &[(u16, Vec<u8>)]) -> String {
 pub struct TileOutput {
     /// Column and row of the tile.
     pub tile: [usize; 2],
-    /// The tile's box in the levelled (x, y) plane: min x, min y, max x, max y [m].
+    /// The tile's box in the levelled (x, y) plane: min x, min y, max x, max y (m).
     pub bounds: [f64; 4],
     /// The cleaned points whose first point lies in the tile (levelled frame), in survey order.
     pub cloud: PointCloud,
@@ -314,23 +314,23 @@ pub struct TiledPerceived {
     pub format: &'static str,
     /// Points of the sample the floor and tilt came from.
     pub sample_points: usize,
-    /// Roll α [rad] and pitch β [rad] of [RS eq. 11].
+    /// Roll α (rad) and pitch β (rad) of [RS eq. 11].
     pub roll_rad: f64,
-    /// Pitch β [rad].
+    /// Pitch β (rad).
     pub pitch_rad: f64,
     /// The floor found in the levelled sample.
     pub floor: TiltEstimate,
     /// Length scale.
     pub scale: f64,
-    /// Point spacing [m].
+    /// Point spacing (m).
     pub spacing_m: f64,
-    /// Tile side [m].
+    /// Tile side (m).
     pub tile_m: f64,
     /// Tiles along x and y.
     pub grid: [usize; 2],
     /// Tiles that held points.
     pub tiles_used: usize,
-    /// Halo width [m].
+    /// Halo width (m).
     pub halo_m: f64,
     /// Most points a tile held with its halo.
     pub largest_tile_points: u64,
@@ -352,14 +352,14 @@ pub struct TiledPerceived {
     pub fit_note: Option<String>,
     /// Mean height of the cleaned points per cell.
     pub model: HeightModel,
-    /// Peak resident memory of the process [bytes], where the system tells.
+    /// Peak resident memory of the process (bytes), where the system tells.
     pub peak_memory: Option<u64>,
-    /// The origin subtracted from the files' coordinates ([`Survey::origin`]) [m].
+    /// The origin subtracted from the files' coordinates ([`Survey::origin`]) (m).
     pub origin_m: [f64; 3],
 }
 
 impl TiledPerceived {
-    /// Total time of the stages [ms].
+    /// Total time of the stages (ms).
     pub fn total_ms(&self) -> f64 {
         self.stages.iter().map(|s| s.ms).sum()
     }
@@ -389,11 +389,11 @@ pub struct TiledSummary {
     pub stage_points: BTreeMap<&'static str, usize>,
     /// Every stage, in order.
     pub stages: Vec<StageRecord>,
-    /// Roll α used to level [deg].
+    /// Roll α used to level (deg).
     pub roll_deg: f64,
-    /// Pitch β used to level [deg].
+    /// Pitch β used to level (deg).
     pub pitch_deg: f64,
-    /// Floor height, levelled frame [m].
+    /// Floor height, levelled frame (m).
     pub floor_height_m: f64,
     /// Sample points on the floor plane.
     pub floor_points: usize,
@@ -401,43 +401,43 @@ pub struct TiledSummary {
     pub floor_share: f64,
     /// Sample points more than the below margin under the floor.
     pub points_below_floor: usize,
-    /// RMS distance of the floor points from the plane [m].
+    /// RMS distance of the floor points from the plane (m).
     pub floor_rms_m: f64,
     /// Points of the sample the floor and tilt came from.
     pub sample_points: usize,
     /// Length scale used.
     pub scale: f64,
-    /// Point spacing used [m].
+    /// Point spacing used (m).
     pub spacing_m: f64,
     /// R² of the fit on the grid samples.
     pub r2: f64,
-    /// Wall time of each stage [ms].
+    /// Wall time of each stage (ms).
     pub timings_ms: BTreeMap<&'static str, f64>,
-    /// Wall time of all stages [ms].
+    /// Wall time of all stages (ms).
     pub total_ms: f64,
     /// Points read per second of the whole run.
     pub points_per_s: f64,
-    /// Tile side [m].
+    /// Tile side (m).
     pub tile_m: f64,
     /// Tiles along x and y.
     pub grid: [usize; 2],
     /// Tiles that held points.
     pub tiles_used: usize,
-    /// Halo width [m].
+    /// Halo width (m).
     pub halo_m: f64,
     /// Most points a tile held with its halo.
     pub largest_tile_points: u64,
     /// Statistical-filter points searched again past the halo.
     pub statistical_researched: u64,
     /// The origin subtracted from the files' coordinates before levelling
-    /// (zero near the origin; a kilometre corner for UTM) [m]: the cleaned
+    /// (zero near the origin; a kilometre corner for UTM) (m): the cleaned
     /// tiles and the height model are relative to it.
     pub origin_m: [f64; 3],
-    /// The memory limit of a tile [bytes].
+    /// The memory limit of a tile (bytes).
     pub memory_limit_bytes: u64,
-    /// Peak resident memory of the process [bytes] (null where unknown).
+    /// Peak resident memory of the process (bytes) (null where unknown).
     pub peak_memory_bytes: Option<u64>,
-    /// Height model cell [m] and cells along x and y.
+    /// Height model cell (m) and cells along x and y.
     pub model_cell_m: f64,
     /// Cells of the height model along x and y.
     pub model_size: [usize; 2],
@@ -518,7 +518,7 @@ impl Drop for WorkDir {
     }
 }
 
-/// The process's peak resident memory [bytes] (Linux: VmHWM).
+/// The process's peak resident memory (bytes) (Linux: VmHWM).
 pub fn peak_memory() -> Option<u64> {
     let status = fs::read_to_string("/proc/self/status").ok()?;
     let line = status.lines().find(|l| l.starts_with("VmHWM:"))?;
@@ -699,7 +699,7 @@ pub fn perceive_tiled_with(
     let t1 = Instant::now();
     let threshold = floor.floor_height_m + p.ground.margin_m * scale;
     let ground = PassThroughParams::ground_removal(threshold);
-    let mut lists = Filing::new(Stage::create(&work.0, 0, grid.tiles())?);
+    let mut lists = Filing::new(StageFiles::create(&work.0, 0, grid.tiles())?);
     let mut id = 0u64;
     let mut by_tile: Vec<Vec<Rec>> = vec![Vec::new(); grid.tiles()];
     let mut level_ms = 0.0;
@@ -936,7 +936,7 @@ pub fn perceive_tiled_with(
     })
 }
 
-fn record(stage: &'static str, lists: &Stage, t: Instant) -> StageRecord {
+fn record(stage: &'static str, lists: &StageFiles, t: Instant) -> StageRecord {
     StageRecord {
         stage,
         points: lists.total() as usize,
@@ -968,7 +968,7 @@ fn grid_over(
     hi: [f32; 3],
     n: u64,
     options: &TileOptions,
-) -> Result<Grid> {
+) -> Result<TileLayout> {
     let mut blo = [f64::INFINITY; 2];
     let mut bhi = [f64::NEG_INFINITY; 2];
     for c in 0..8 {
@@ -1006,12 +1006,12 @@ fn grid_over(
     }
     // Centre the grid on the box.
     let origin = [0, 1].map(|a| blo[a] - (size[a] as f64 * side - extent[a]) / 2.0);
-    Ok(Grid { origin, side, size })
+    Ok(TileLayout { origin, side, size })
 }
 
 /// The stages of one run, each a round of tasks handed to the executor.
 struct Driver<'a> {
-    grid: Grid,
+    grid: TileLayout,
     halo: f64,
     limit: u64,
     run: PathBuf,
@@ -1023,7 +1023,7 @@ struct Driver<'a> {
 
 impl Driver<'_> {
     /// A task of `step` for every tile of `input` that holds points.
-    fn tasks(&self, input: &Stage, output: &Path, step: &Step) -> Vec<TileTask> {
+    fn tasks(&self, input: &StageFiles, output: &Path, step: &Step) -> Vec<TileTask> {
         (0..self.grid.tiles())
             .filter(|&t| input.own[t] > 0)
             .map(|t| TileTask {
@@ -1081,11 +1081,11 @@ impl Driver<'_> {
     /// One stage: `step` on every tile of `input`, filed as the next stage.
     fn pass(
         &mut self,
-        input: Stage,
+        input: StageFiles,
         step: Step,
         progress: &mut dyn FnMut(&str, u64, u64),
-    ) -> Result<Stage> {
-        let mut output = Stage::create(&self.run, self.next, self.grid.tiles())?;
+    ) -> Result<StageFiles> {
+        let mut output = StageFiles::create(&self.run, self.next, self.grid.tiles())?;
         self.next += 1;
         let tasks = self.tasks(&input, &output.dir, &step);
         for r in self.execute(step.stage(), tasks, progress)? {
@@ -1104,10 +1104,10 @@ impl Driver<'_> {
     /// here, then the cut on every tile.
     fn statistical(
         &mut self,
-        input: Stage,
+        input: StageFiles,
         params: StatisticalOutlierParams,
         progress: &mut dyn FnMut(&str, u64, u64),
-    ) -> Result<Stage> {
+    ) -> Result<StageFiles> {
         let k = params.mean_k;
         let total = input.total();
         if k as u64 >= total {
@@ -1152,7 +1152,7 @@ impl Driver<'_> {
 
 /// [RS eq. 14]: the sums of every tile's d̄_i in survey order, merging the
 /// tiles' `dist-{t}` files (each in survey order) by point index.
-fn distance_sums(stage: &Stage) -> Result<DistanceSums> {
+fn distance_sums(stage: &StageFiles) -> Result<DistanceSums> {
     let mut sums = DistanceSums::default();
     // Each tile's file and its next (id, d̄_i).
     type Head = (BufReader<File>, Option<(u64, f32)>, PathBuf);

@@ -143,13 +143,13 @@ pub(super) struct Rec {
 
 /// The tile grid in the levelled (x, y) plane.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
-pub(super) struct Grid {
+pub(super) struct TileLayout {
     pub origin: [f64; 2],
     pub side: f64,
     pub size: [usize; 2],
 }
 
-impl Grid {
+impl TileLayout {
     pub fn tiles(&self) -> usize {
         self.size[0] * self.size[1]
     }
@@ -252,7 +252,7 @@ pub(super) type Writer = Option<usize>;
 
 /// One stage's files (module docs) and the points each holds.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
-pub(super) struct Stage {
+pub(super) struct StageFiles {
     /// The stage's folder.
     pub dir: PathBuf,
     /// Points of each tile's own file.
@@ -261,7 +261,7 @@ pub(super) struct Stage {
     pub halo: Vec<Vec<(Writer, u64)>>,
 }
 
-impl Stage {
+impl StageFiles {
     /// An empty stage `s{n}` of `tiles` tiles under `run`, its folder made.
     pub fn create(run: &Path, n: usize, tiles: usize) -> Result<Self> {
         let dir = run.join(format!("s{n}"));
@@ -403,7 +403,7 @@ pub(super) fn read_checked(path: &Path, expect: u64) -> Result<Vec<Rec>> {
 /// the pieces' tiles and points.
 pub(super) fn file_tile(
     dir: &Path,
-    grid: &Grid,
+    grid: &TileLayout,
     t: usize,
     recs: &[Rec],
     halo_m: f64,
@@ -421,13 +421,13 @@ pub(super) fn file_tile(
 /// survey order a chunk at a time, and each tile's own points and halo are
 /// appended to its files through buffers.
 pub(super) struct Filing {
-    stage: Stage,
+    stage: StageFiles,
     own: Vec<Vec<Rec>>,
     halo: Vec<Vec<Rec>>,
 }
 
 impl Filing {
-    pub fn new(stage: Stage) -> Self {
+    pub fn new(stage: StageFiles) -> Self {
         let tiles = stage.own.len();
         Self {
             stage,
@@ -438,7 +438,7 @@ impl Filing {
 
     /// Files `recs` (in survey order) under tile `t`, with a copy of each
     /// in the halo of every other tile within `halo_m`.
-    pub fn put(&mut self, grid: &Grid, t: usize, recs: &[Rec], halo_m: f64) -> Result<()> {
+    pub fn put(&mut self, grid: &TileLayout, t: usize, recs: &[Rec], halo_m: f64) -> Result<()> {
         self.own[t].extend_from_slice(recs);
         self.stage.own[t] += recs.len() as u64;
         if self.own[t].len() >= FLUSH_POINTS {
@@ -483,7 +483,7 @@ impl Filing {
     }
 
     /// Writes every buffer out: the stage as filed.
-    pub fn finish(mut self) -> Result<Stage> {
+    pub fn finish(mut self) -> Result<StageFiles> {
         for t in 0..self.own.len() {
             self.flush_one(t, false)?;
             self.flush_one(t, true)?;

@@ -9,18 +9,18 @@
 use std::path::PathBuf;
 use std::sync::{mpsc, Condvar, Mutex};
 
+use autoshovel_core::config;
 use autoshovel_point_cloud::filter::{
     bilateral_normal_smoothing, mean_distances_and_reach, mean_distances_and_reach_at,
     radius_outlier_removal_indices, voxel_grid, BilateralParams, DistanceSums, RadiusOutlierParams,
     StatisticalOutlierParams, VoxelCells, VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, Point, PointCloud};
-use autoshovel_core::config;
 use serde::{Deserialize, Serialize};
 
 use super::store::{
     dist_path, f32_at, file_tile, halo_path, own_path, read_bytes_checked, read_checked,
-    write_whole, Grid, Loaded, Rec, Writer, DIST_RECORD,
+    write_whole, Loaded, Rec, TileLayout, Writer, DIST_RECORD,
 };
 use super::BYTES_PER_POINT;
 use crate::error::{Result, SurfaceError};
@@ -69,7 +69,7 @@ pub struct TileTask {
     pub(super) input: PathBuf,
     /// The stage folder written (unused by `Distances`).
     pub(super) output: PathBuf,
-    pub(super) grid: Grid,
+    pub(super) grid: TileLayout,
     pub(super) halo_m: f64,
     pub(super) memory_limit: u64,
     /// Points of every tile's own file in `input` (the statistical filter
@@ -95,7 +95,7 @@ impl TileTask {
         self.own[self.tile] + self.halo.iter().map(|h| h.1).sum::<u64>()
     }
 
-    /// Working memory the task needs [bytes] (its points at
+    /// Working memory the task needs (bytes) (its points at
     /// [`BYTES_PER_POINT`]).
     pub fn need(&self) -> u64 {
         self.points().saturating_mul(BYTES_PER_POINT)

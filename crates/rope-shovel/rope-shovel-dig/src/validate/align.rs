@@ -29,7 +29,7 @@ use crate::validate::record::ForceRecord;
 /// How to search the alignment.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct AlignParams {
-    /// Offsets searched either side of the record's first sample [s];
+    /// Offsets searched either side of the record's first sample (s);
     /// `None`: half the planned dig time.
     pub max_lag_s: Option<f64>,
     /// Largest relative deviation of the time scale s from 1 searched
@@ -94,25 +94,25 @@ const MAX_GRID: usize = 400;
 /// The clock that maps plan time onto the measured record.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct Alignment {
-    /// τ: the time on the measured clock at which the plan's t = 0 falls [s].
+    /// τ: the time on the measured clock at which the plan's t = 0 falls (s).
     pub offset_s: f64,
     /// τ minus the record's first time: how long after the record starts
-    /// the dig starts (negative: the record starts after the dig) [s].
+    /// the dig starts (negative: the record starts after the dig) (s).
     pub delay_s: f64,
     /// s: measured time per planned time (1: as fast as planned).
     pub time_scale: f64,
     /// The mean of the hoist and crowd correlations at the alignment.
     pub correlation: f64,
-    /// Offsets searched either side of the record's start [s].
+    /// Offsets searched either side of the record's start (s).
     pub max_lag_s: f64,
-    /// Step of the offset grid before refinement [s].
+    /// Step of the offset grid before refinement (s).
     pub lag_step_s: f64,
     /// Largest deviation of s from 1 searched.
     pub max_stretch: f64,
 }
 
 impl Alignment {
-    /// The measured-clock time of plan time `t_plan_s` [s].
+    /// The measured-clock time of plan time `t_plan_s` (s).
     pub fn measured_time(&self, t_plan_s: f64) -> f64 {
         self.offset_s + self.time_scale * t_plan_s
     }
@@ -136,7 +136,7 @@ pub fn interpolate(t: &[f64], v: &[f64], x: f64) -> f64 {
 }
 
 /// The plan on the search grid: times and both forces.
-struct Grid {
+struct Resampled {
     t: Vec<f64>,
     hoist: Vec<f64>,
     crowd: Vec<f64>,
@@ -155,7 +155,7 @@ fn pearson(n: f64, [sa, sb, saa, sbb, sab]: [f64; 5]) -> f64 {
 
 /// The search: the plan's grid and the measurement.
 struct Search<'a> {
-    grid: Grid,
+    grid: Resampled,
     measured: &'a ForceRecord,
     min_points: usize,
 }
@@ -226,7 +226,7 @@ pub fn align(
     let step_g = h.max(td_s / MAX_GRID as f64);
     let n_g = (td_s / step_g).round().max(2.0) as usize;
     let t: Vec<f64> = (0..=n_g).map(|i| td_s * i as f64 / n_g as f64).collect();
-    let grid = Grid {
+    let grid = Resampled {
         hoist: t
             .iter()
             .map(|&x| interpolate(&planned.t_s, &planned.hoist_force_n, x))

@@ -1,5 +1,5 @@
 //! Planned against measured ([RS §5], [RS Table 6], [RS Fig. 20]): the
-//! measured record aligned with the plan ([`crate::validate::align`]) and
+//! measured record aligned with the plan ([`crate::validate::align()`]) and
 //! resampled at the plan's sample times, then per force the peaks, the RMS
 //! difference, Pearson's r, R² and a fitted gain, and the rows of Table 6
 //! (dug mass and dig time, planned and measured, relative deviation).
@@ -35,7 +35,7 @@ pub struct Deviation {
     pub measured: f64,
     /// measured − planned.
     pub difference: f64,
-    /// |planned − measured| / measured [%], Table 6's "relative deviation".
+    /// |planned − measured| / measured (%), Table 6's "relative deviation".
     pub relative_deviation_pct: f64,
 }
 
@@ -54,15 +54,15 @@ impl Deviation {
 /// One force planned and measured on the aligned samples ([RS Fig. 20]).
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct ForceComparison {
-    /// Largest planned force on the compared samples [N].
+    /// Largest planned force on the compared samples (N).
     pub peak_planned_n: f64,
-    /// Largest measured force on them [N].
+    /// Largest measured force on them (N).
     pub peak_measured_n: f64,
-    /// Measured minus planned peak [N].
+    /// Measured minus planned peak (N).
     pub peak_difference_n: f64,
-    /// Root mean square of measured − planned [N].
+    /// Root mean square of measured − planned (N).
     pub rms_difference_n: f64,
-    /// Mean of measured − planned [N].
+    /// Mean of measured − planned (N).
     pub mean_difference_n: f64,
     /// Pearson's correlation r.
     pub pearson_r: f64,
@@ -116,13 +116,13 @@ impl ForceComparison {
 /// The rope length or the handle extension planned and measured.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct TravelComparison {
-    /// Root mean square of measured − planned [m].
+    /// Root mean square of measured − planned (m).
     pub rms_difference_m: f64,
-    /// Mean of measured − planned: an encoder's zero offset [m].
+    /// Mean of measured − planned: an encoder's zero offset (m).
     pub mean_difference_m: f64,
-    /// Root mean square of measured − planned after removing the mean [m].
+    /// Root mean square of measured − planned after removing the mean (m).
     pub rms_difference_zeroed_m: f64,
-    /// Largest |measured − planned| [m].
+    /// Largest |measured − planned| (m).
     pub max_abs_difference_m: f64,
 }
 
@@ -158,14 +158,14 @@ pub struct ValidateSummary {
     pub measured_samples: usize,
     /// Plan samples inside the measured record after alignment (compared).
     pub compared_samples: usize,
-    /// The measured record's first and last time [s].
+    /// The measured record's first and last time (s).
     pub record_span_s: [f64; 2],
     /// The clock that maps the plan onto the record.
     pub alignment: Alignment,
-    /// Dug mass [kg], when the record has `mass_kg` ([RS Table 6]).
+    /// Dug mass (kg), when the record has `mass_kg` ([RS Table 6]).
     #[serde(skip_serializing_if = "Option::is_none")]
     pub mass_kg: Option<Deviation>,
-    /// Dig time [s]: t_d against s · t_d ([RS Table 6]).
+    /// Dig time (s): t_d against s · t_d ([RS Table 6]).
     pub dig_time_s: Deviation,
     /// Hoist force ([RS Fig. 20], [RS Table 6]).
     pub hoist_force: ForceComparison,
@@ -191,17 +191,17 @@ pub struct Paired {
 /// The compared samples: the plan's times inside the aligned record.
 #[derive(Debug, Clone, PartialEq)]
 pub struct AlignedSeries {
-    /// Plan time [s].
+    /// Plan time (s).
     pub t_plan_s: Vec<f64>,
-    /// The same instants on the measured clock [s].
+    /// The same instants on the measured clock (s).
     pub t_measured_s: Vec<f64>,
-    /// Hoist force [N].
+    /// Hoist force (N).
     pub hoist_force_n: Paired,
-    /// Crowd force [N].
+    /// Crowd force (N).
     pub crowd_force_n: Paired,
-    /// Rope length [m], when both sides have it.
+    /// Rope length (m), when both sides have it.
     pub rope_length_m: Option<Paired>,
-    /// Handle extension [m], when both sides have it.
+    /// Handle extension (m), when both sides have it.
     pub handle_extension_m: Option<Paired>,
 }
 

@@ -1,7 +1,7 @@
 //! Planned against measured: the rope-shovel paper's testbed validation
 //! ([RS §5], [RS Table 6], [RS Fig. 20]) as a job, `validate-dig`. A plan's
 //! folder and a measured record ([`record`]), aligned in time by
-//! cross-correlation of the forces ([`align`]), compared force by force and
+//! cross-correlation of the forces ([`align()`]), compared force by force and
 //! in dug mass and dig time ([`compare`], [`ValidateSummary`]); and a
 //! measurement simulated from a plan with known errors ([`simulate`]).
 

@@ -41,20 +41,20 @@ pub const MIN_SAMPLES: usize = 10;
 /// `t_s` strictly increases and every series is as long as it.
 #[derive(Debug, Clone, PartialEq)]
 pub struct ForceRecord {
-    /// Time [s].
+    /// Time (s).
     pub t_s: Vec<f64>,
-    /// Hoist rope force F_h [N].
+    /// Hoist rope force F_h (N).
     pub hoist_force_n: Vec<f64>,
-    /// Crowd force F_c [N].
+    /// Crowd force F_c (N).
     pub crowd_force_n: Vec<f64>,
-    /// Free hoist rope length, bail pin to the boom-point sheave [m].
+    /// Free hoist rope length, bail pin to the boom-point sheave (m).
     pub rope_length_m: Option<Vec<f64>>,
-    /// Handle extension d₂ [m].
+    /// Handle extension d₂ (m).
     pub handle_extension_m: Option<Vec<f64>>,
 }
 
 impl ForceRecord {
-    /// Time of the first and the last sample [s].
+    /// Time of the first and the last sample (s).
     pub fn span_s(&self) -> (f64, f64) {
         (
             self.t_s.first().copied().unwrap_or(0.0),
@@ -62,7 +62,7 @@ impl ForceRecord {
         )
     }
 
-    /// The median time step [s].
+    /// The median time step (s).
     pub fn median_step_s(&self) -> f64 {
         let mut d: Vec<f64> = self.t_s.windows(2).map(|w| w[1] - w[0]).collect();
         if d.is_empty() {
@@ -80,7 +80,7 @@ pub struct MeasuredRecord {
     pub source: PathBuf,
     /// The forces (and rope and handle, if recorded).
     pub forces: ForceRecord,
-    /// The dug mass, weighed after the dig [kg].
+    /// The dug mass, weighed after the dig (kg).
     pub mass_kg: Option<f64>,
 }
 
@@ -166,9 +166,9 @@ pub struct PlannedRecord {
     pub source: String,
     /// The pile's name.
     pub surface: String,
-    /// Planned dug mass m_dig [kg].
+    /// Planned dug mass m_dig (kg).
     pub m_dig_kg: f64,
-    /// Planned dig time t_d [s].
+    /// Planned dig time t_d (s).
     pub td_s: f64,
     /// Planned forces, rope length and handle extension over [0, t_d].
     pub forces: ForceRecord,

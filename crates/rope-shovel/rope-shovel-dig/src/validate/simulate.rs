@@ -17,9 +17,9 @@ use crate::validate::record::{ForceRecord, MeasuredRecord, PlannedRecord};
 /// The errors of a simulated measurement.
 #[derive(Debug, Clone, Copy, PartialEq)]
 pub struct MeasurementModel {
-    /// Standard deviation of the noise on each force [N].
+    /// Standard deviation of the noise on each force (N).
     pub noise_n: f64,
-    /// Time from the logger's start (t = 0) to the dig's start [s].
+    /// Time from the logger's start (t = 0) to the dig's start (s).
     pub delay_s: f64,
     /// Measured dig time per planned dig time.
     pub time_scale: f64,
@@ -27,11 +27,11 @@ pub struct MeasurementModel {
     pub gain_hoist: f64,
     /// Gain of the crowd force sensor (1: exact).
     pub gain_crowd: f64,
-    /// Weighed minus planned mass [kg].
+    /// Weighed minus planned mass (kg).
     pub mass_offset_kg: f64,
-    /// Logger sample period [s].
+    /// Logger sample period (s).
     pub sample_period_s: f64,
-    /// Recording after the dig ends [s].
+    /// Recording after the dig ends (s).
     pub tail_s: f64,
     /// Seed of the noise.
     pub seed: u64,

@@ -5,10 +5,12 @@
 //! product, a floor and three i64 conversions, each checked) was a sixth
 //! of the grid's time, and the tables' owners read it once each.
 
+use std::mem::MaybeUninit;
+
 use rayon::prelude::*;
 
 use crate::filter::common::is_finite;
-use crate::filter::within::Isa;
+use crate::simd::{Isa, Path};
 use crate::Point;
 
 /// ⌊v⌋ of a finite `v` with |v| < 4e18, as `v.floor() as i64` gives it.
@@ -63,9 +65,9 @@ const SAMPLE_EVERY: usize = 4;
 /// PCL's RGB-D scans, 14.5 ns a visit against 1.9 ns a point).
 const VISIT: usize = 8;
 
-/// The grid of one call of [`super::voxel_grid`].
+/// The lattice of voxels of one call of [`super::voxel_grid`].
 #[derive(Debug, Clone, Copy)]
-pub(super) struct Grid {
+pub(super) struct Lattice {
     /// A point's cell (PCL's f32 product with the inverse leaf, floored).
     pub cells: VoxelCells,
     /// The least occupied cell per axis.
@@ -74,7 +76,7 @@ pub(super) struct Grid {
     pub ex: u64,
     pub exy: u64,
     /// Bits of the largest key (the keys are 32 bits for a box of fewer
-    /// than 2³² voxels, which [`Grid::keys`] is for).
+    /// than 2³² voxels, which [`Lattice::keys`] is for).
     pub bits: u32,
     /// Every finite point's cells lie within i32 (−2³¹ ≤ ⌊v⌋ < 2³¹), so
     /// the vector path may compute them in 32 bits.
@@ -96,16 +98,23 @@ pub(super) struct Keys {
     pub visits: usize,
 }
 
-impl Grid {
-    /// The key of each point of `ps` into `out` (as long).
-    fn keys_into(&self, isa: Isa, ps: &[Point], out: &mut [u32]) {
-        match isa {
-            // SAFETY: `Isa::best` gives AVX-512 only where the machine has
-            // it; the cells of every finite point fit i32.
+impl Lattice {
+    /// The key of each point of `ps` written into `out` (as long), which
+    /// it returns initialised.
+    fn keys_into<'o>(&self, isa: Isa, ps: &[Point], out: &'o mut [MaybeUninit<u32>]) -> &'o [u32] {
+        assert_eq!(ps.len(), out.len(), "a key a point");
+        match isa.path() {
+            // SAFETY: `t` proves AVX-512F; the cells of every finite point
+            // fit i32; `out` is as long as `ps`.
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx512 if self.cells_fit_i32 => unsafe { avx512::keys(self, ps, out) },
+            Path::Avx512(t) if self.cells_fit_i32 => unsafe { avx512::keys(t, self, ps, out) },
             _ => self.keys_portable(ps, out),
         }
+        // SAFETY: both paths write every element of `out` (the vector
+        // loop the whole steps of 16, `keys_portable` the rest), and
+        // `MaybeUninit<u32>` has `u32`'s layout (the standard library's
+        // `assume_init_ref` on slices, stable only from Rust 1.93).
+        unsafe { &*(out as *const [MaybeUninit<u32>] as *const [u32]) }
     }
 
     /// The linear index of the voxel of a finite point of the box (x
@@ -117,13 +126,13 @@ impl Grid {
         c[0] + c[1] * self.ex + c[2] * self.exy
     }
 
-    fn keys_portable(&self, ps: &[Point], out: &mut [u32]) {
+    fn keys_portable(&self, ps: &[Point], out: &mut [MaybeUninit<u32>]) {
         for (p, key) in ps.iter().zip(out) {
-            *key = if is_finite(p) {
+            key.write(if is_finite(p) {
                 self.linear(p) as u32
             } else {
                 NOT_FINITE
-            };
+            });
         }
     }
 
@@ -131,7 +140,7 @@ impl Grid {
     pub(super) fn keys(&self, points: &[Point], isa: Isa) -> Keys {
         const CHUNK: usize = 1 << 14;
         let shift = self.bits.saturating_sub(HISTOGRAM_BITS);
-        let mut keys: Vec<u32> = crate::room::with_room(points.len());
+        let mut keys: Vec<u32> = crate::prefault::with_room(points.len());
         let room = &mut keys.spare_capacity_mut()[..points.len()];
         let bins = 1 << HISTOGRAM_BITS;
         let none = || (vec![0usize; bins], 0, 0);
@@ -139,10 +148,7 @@ impl Grid {
             .par_chunks_mut(CHUNK)
             .zip(points.par_chunks(CHUNK))
             .map(|(room, ps)| {
-                // SAFETY: u32 has no invalid bit patterns, and every key
-                // is written below before it is read.
-                let out = unsafe { &mut *(room as *mut [_] as *mut [u32]) };
-                self.keys_into(isa, ps, out);
+                let out = self.keys_into(isa, ps, room);
                 let (mut histogram, mut sampled, mut visits) = none();
                 for run in out.chunks(SAMPLE).step_by(SAMPLE_EVERY) {
                     let mut last = NOT_FINITE;
@@ -175,7 +181,7 @@ impl Grid {
 mod avx512 {
     use std::arch::x86_64::*;
 
-    use super::{Grid, NOT_FINITE};
+    use super::{Lattice, NOT_FINITE};
     use crate::Point;
 
     /// Lane l of axis a of 16 points (48 interleaved floats in three
@@ -211,12 +217,17 @@ mod avx512 {
     const FIRST_TWO: [[i32; 16]; 3] = [first_two(0), first_two(1), first_two(2)];
     const THIRD: [([i32; 16], u16); 3] = [third(0), third(1), third(2)];
 
-    /// [`Grid::keys_portable`], 16 points a step.
+    /// [`Lattice::keys_portable`], 16 points a step.
     ///
     /// # Safety
-    /// AVX-512F; every finite point's cells fit i32.
+    /// AVX-512F (the proof); every finite point's cells fit i32.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn keys(grid: &Grid, ps: &[Point], out: &mut [u32]) {
+    pub(super) unsafe fn keys(
+        _: crate::simd::Avx512,
+        grid: &Lattice,
+        ps: &[Point],
+        out: &mut [std::mem::MaybeUninit<u32>],
+    ) {
         assert_eq!(ps.len(), out.len());
         let whole = ps.len() / 16 * 16;
         let flat = ps.as_flattened();

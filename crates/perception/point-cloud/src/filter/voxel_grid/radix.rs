@@ -74,7 +74,7 @@ mod tests {
 
     #[test]
     fn radix_sort_orders_voxels_and_keeps_each_voxels_entries_in_order() {
-        let mut next = crate::filter::common::below(9);
+        let mut next = crate::testing::below(9);
         for trial in 0..2_000 {
             let bits = 1 + (trial % 31) as u32;
             let n = next(300) as usize;

@@ -34,7 +34,7 @@ use rayon::prelude::*;
 
 use super::keys::{Keys, HISTOGRAM_BITS};
 use super::radix::{radix_sort_voxels, Voxel};
-use crate::filter::within::Isa;
+use crate::simd::{Isa, Path};
 use crate::Point;
 
 /// Fewest points a voxel a thread's table must hold on average, judged
@@ -230,10 +230,11 @@ impl Table {
     /// Adds the points `ps[i]` at the positions `own` (ascending) to
     /// their voxels (keys `block[i]`), each voxel's in input order.
     fn add(&mut self, isa: Isa, block: &[u32], ps: &[Point], own: &[u32]) {
-        match isa {
-            // SAFETY: `Isa::best` gives these only where the machine has AVX2.
+        match isa.avx2() {
+            // SAFETY: `t` proves AVX2; `own` indexes `block` and `ps` (the
+            // caller's positions of its own keys).
             #[cfg(target_arch = "x86_64")]
-            Isa::Avx2 | Isa::Avx512 => unsafe { avx2::add(self, block, ps, own) },
+            Some(t) => unsafe { avx2::add(t, self, block, ps, own) },
             _ => self.add_portable(block, ps, own),
         }
     }
@@ -374,10 +375,11 @@ pub(super) fn centroids(points: &[Point], keys: &Keys, bits: u32, isa: Isa) -> O
 /// u32 arithmetic: `from + span` ≤ 2³² − 1, so [`NOT_FINITE`] is never
 /// one), written to the front of `own`; returns how many.
 fn owned(isa: Isa, block: &[u32], (from, span): (u32, u32), own: &mut [u32; BLOCK]) -> usize {
-    match isa {
-        // SAFETY: `Isa::best` gives AVX-512 only where the machine has it.
+    match isa.path() {
+        // SAFETY: `t` proves AVX-512F; `block` holds at most `BLOCK` keys
+        // (asserted in the kernel).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::owned(block, from, span, own) },
+        Path::Avx512(t) => unsafe { avx512::owned(t, block, from, span, own) },
         _ => {
             // Without a branch, which mispredicted where the threads'
             // voxels interleave.
@@ -402,7 +404,7 @@ mod tests {
         // finite): where the tables could pay (v up to a twelfth of the
         // points and beyond), the estimate is near v, and the finite
         // points near their count.
-        let mut next = crate::filter::common::below(8);
+        let mut next = crate::testing::below(8);
         for v in [1_000u64, 20_000, 150_000, 500_000] {
             let keys: Vec<u32> = (0..2_000_000)
                 .map(|_| {
@@ -435,6 +437,7 @@ mod avx512 {
     /// AVX-512F; `block` at most [`BLOCK`] keys.
     #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn owned(
+        _: crate::simd::Avx512,
         block: &[u32],
         from: u32,
         span: u32,
@@ -487,7 +490,13 @@ mod avx2 {
     /// # Safety
     /// AVX2; `own` indexes `block` and `ps`.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn add(table: &mut Table, block: &[u32], ps: &[Point], own: &[u32]) {
+    pub(super) unsafe fn add(
+        _: crate::simd::Avx2,
+        table: &mut Table,
+        block: &[u32],
+        ps: &[Point],
+        own: &[u32],
+    ) {
         // `Table::slot`'s probe, with the table's fields in registers (the
         // stores below could alias them), read again after a voxel is
         // taken: calling `Table::slot` here was 6–16 % slower (`kinect5`

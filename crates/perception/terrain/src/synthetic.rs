@@ -271,44 +271,44 @@ pub struct PileParams {
     pub points: usize,
     /// Length scale: 1 for a mine face, 1/30 for the paper's model. Default 1.
     pub scale: f64,
-    /// Face height H, toe to crest [m]. Default 10 m.
+    /// Face height H, toe to crest (m). Default 10 m.
     pub face_height_m: f64,
-    /// Repose angle φ: the mean slope of the face [rad]. Default 40°.
+    /// Repose angle φ: the mean slope of the face (rad). Default 40°.
     pub repose_angle_rad: f64,
-    /// Scan width W across the dig direction [m]. Default 20 m.
+    /// Scan width W across the dig direction (m). Default 20 m.
     pub width_m: f64,
-    /// Horizontal distance D from the sensor to the toe at the sides [m]. Default 15 m.
+    /// Horizontal distance D from the sensor to the toe at the sides (m). Default 15 m.
     pub toe_distance_m: f64,
-    /// Bow A of the toe line towards the sensor at the centre [m]. Default 0.5 m.
+    /// Bow A of the toe line towards the sensor at the centre (m). Default 0.5 m.
     pub toe_bow_m: f64,
-    /// Nearest floor in the scan, from the sensor [m]. Default 5 m.
+    /// Nearest floor in the scan, from the sensor (m). Default 5 m.
     pub near_distance_m: f64,
-    /// Depth of the flat top scanned behind the crest [m]. Default 8 m.
+    /// Depth of the flat top scanned behind the crest (m). Default 8 m.
     pub top_depth_m: f64,
-    /// Sensor height h_s above the floor [m]. Default 12 m (high on the
+    /// Sensor height h_s above the floor (m). Default 12 m (high on the
     /// machine, above the crest, so the top is seen).
     pub sensor_height_m: f64,
-    /// Standard deviation of the range noise along the ray [m]. Default 0.02 m.
+    /// Standard deviation of the range noise along the ray (m). Default 0.02 m.
     pub range_noise_m: f64,
     /// Share of outlier points, in [0, 0.5]. Default 0.01.
     pub outlier_fraction: f64,
     /// Share of the outliers that are isolated points far from the surface
     /// (the rest hover above it), in [0, 1]. Default 0.2.
     pub isolated_share: f64,
-    /// Sensor roll α of [RS eq. 11] [rad]. Default 3°.
+    /// Sensor roll α of [RS eq. 11] (rad). Default 3°.
     pub roll_rad: f64,
-    /// Sensor pitch β of [RS eq. 11] [rad]. Default −2°.
+    /// Sensor pitch β of [RS eq. 11] (rad). Default −2°.
     pub pitch_rad: f64,
     /// How the surface points are spread. Default [`ScanPattern::Area`].
     pub pattern: ScanPattern,
     /// Full angle of the circular field of view of [`ScanPattern::Rosette`],
-    /// centred on the middle of the scan window [rad]. Default 70.4° (a
+    /// centred on the middle of the scan window (rad). Default 70.4° (a
     /// Livox Avia's circular pattern).
     pub fov_rad: f64,
     /// Seed of the ChaCha8 generator. Default 1.
     pub seed: u64,
     /// Shift of the whole scene, sensor included, in the level frame's
-    /// (x, y) [m], before the tilt: the scans of a survey of many piles
+    /// (x, y) (m), before the tilt: the scans of a survey of many piles
     /// share one frame this way ([`PileParams::survey_step_m`]). Default 0.
     pub offset_m: [f64; 2],
 }
@@ -447,12 +447,12 @@ impl PileParams {
         Ok(())
     }
 
-    /// Face run L = H / tan φ, scaled [m].
+    /// Face run L = H / tan φ, scaled (m).
     pub fn face_run_m(&self) -> f64 {
         self.scale * self.face_height_m / self.repose_angle_rad.tan()
     }
 
-    /// Toe line x_toe(y) in the level frame, scaled [m].
+    /// Toe line x_toe(y) in the level frame, scaled (m).
     pub fn toe_x_m(&self, y: f64) -> f64 {
         let w = self.scale * self.width_m;
         self.scale * (self.toe_distance_m - self.toe_bow_m * (PI * y / w).cos())
@@ -477,7 +477,7 @@ impl PileParams {
         }
     }
 
-    /// The shift from one scan of a survey to the next along x and y [m]:
+    /// The shift from one scan of a survey to the next along x and y (m):
     /// the scan window's extent less 5 %, so that neighbouring scans
     /// overlap a little, as a survey's passes do.
     pub fn survey_step_m(&self) -> [f64; 2] {
@@ -485,7 +485,7 @@ impl PileParams {
         [0.95 * (x1 - x0), 0.95 * (y1 - y0)]
     }
 
-    /// The x range `[near, far]` and the y range `[−W/2, W/2]` scanned, scaled [m].
+    /// The x range `[near, far]` and the y range `[−W/2, W/2]` scanned, scaled (m).
     pub fn window_m(&self) -> ([f64; 2], [f64; 2]) {
         let l = self.face_run_m();
         let far = self.scale * self.toe_distance_m
@@ -495,7 +495,7 @@ impl PileParams {
         ([self.scale * self.near_distance_m, far], [-half, half])
     }
 
-    /// The noiseless surface z(x, y) in the level, sensor-centred frame [m]
+    /// The noiseless surface z(x, y) in the level, sensor-centred frame (m)
     /// (the floor is at `−scale · sensor_height_m`).
     pub fn height_at(&self, x: f64, y: f64) -> f64 {
         let s = (x - self.toe_x_m(y)) / self.face_run_m();
@@ -989,11 +989,11 @@ pub struct GeneratePileSummary {
     pub points: usize,
     /// How the points are spread (`area` or `rosette`).
     pub pattern: &'static str,
-    /// Sensor height above the floor [m].
+    /// Sensor height above the floor (m).
     pub sensor_height_m: f64,
-    /// Sensor roll α [deg].
+    /// Sensor roll α (deg).
     pub roll_deg: f64,
-    /// Sensor pitch β [deg].
+    /// Sensor pitch β (deg).
     pub pitch_deg: f64,
     /// Length scale (1 = a 10 m face).
     pub scale: f64,
@@ -1008,9 +1008,9 @@ pub struct GeneratePileSummary {
     pub last_file: String,
     /// Its encoding.
     pub encoding: &'static str,
-    /// Time to generate [ms].
+    /// Time to generate (ms).
     pub generate_ms: f64,
-    /// Time to write [ms].
+    /// Time to write (ms).
     pub write_ms: f64,
     /// Always true (a failed run is an error).
     pub success: bool,

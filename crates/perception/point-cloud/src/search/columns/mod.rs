@@ -14,7 +14,7 @@
 //! block's columns, numbered in a run, as one run where their heights lie
 //! within the box's, as on a surface; else each column by two look-ups in
 //! its slabs), and one vector pass over those contiguous runs
-//! (`within.rs`) gives their squared distances and keeps those within r.
+//! (`search::within`) gives their squared distances and keeps those within r.
 //! If k of them lie within r, they hold the k nearest (kept by a sorting
 //! network, `within::smallest`); otherwise r grows
 //! (by the count found, as on a surface) and the query is repeated. The
@@ -28,7 +28,7 @@
 //! columns searched nearest box first, and a block's columns nearest
 //! first (a k-d tree built for them at 2 M points and more answered them
 //! more slowly since, and took 0.8 GB more at 20 M). A grid searched once
-//! may be searched again with some points dropped (`Grid::retain`: the
+//! may be searched again with some points dropped (`ColumnGrid::retain`: the
 //! statistical filter on what the radius filter kept, on columns sized for
 //! both). In place of the
 //! tree's walk with a branch a node, a query costs a few look-ups and
@@ -39,7 +39,7 @@
 //! kilometres apart) is declined and the caller uses the k-d tree; both
 //! give the same distances, bit for bit.
 //!
-//! Arithmetic as in `kdtree.rs`: squared distances in f32 in FLANN's order,
+//! Arithmetic as in `search::kdtree`: squared distances in f32 in FLANN's order,
 //! so that the sums agree with PCL's; the box is the radius widened by a
 //! relative 1e-4, far above the f32 rounding of a squared distance, so no
 //! point within r is left out of it.
@@ -51,8 +51,9 @@ use rayon::prelude::*;
 mod far;
 mod near;
 
-use super::common::{within_f32 as heights_within, SLACK};
-use super::within::{self, Isa, Run};
+use super::bounds::{within_f32 as heights_within, SLACK};
+use super::within::{self, Run};
+use crate::simd::Isa;
 use near::Near;
 
 use crate::Point;
@@ -60,7 +61,7 @@ use crate::Point;
 /// Columns allowed per point before the grid is declined.
 const COLUMNS_PER_POINT: usize = 8;
 
-/// A column's span widened by this share of its side (see `Grid::off_columns`).
+/// A column's span widened by this share of its side (see `ColumnGrid::off_columns`).
 const MARGIN: f64 = 1e-6;
 
 /// The distance from `v` to the span `lo..=hi` (0 within).
@@ -92,7 +93,7 @@ fn smaller<T: PartialOrd>(a: T, b: T) -> T {
 }
 
 /// Points filed by column (numbered in blocks, see `block_index`), each column by height.
-pub(crate) struct Grid {
+pub(crate) struct ColumnGrid {
     /// Corner of the grid (the cloud's minimum) and cell side.
     origin: [f64; 3],
     h: f64,
@@ -117,13 +118,13 @@ pub(crate) struct Grid {
     /// Input index of each sorted position.
     ids: Vec<u32>,
     /// Input indices run below this: the points filed, and after
-    /// [`Grid::retain`] those it dropped.
+    /// [`ColumnGrid::retain`] those it dropped.
     inputs: usize,
     /// The search loop's instruction set.
     isa: Isa,
 }
 
-impl Grid {
+impl ColumnGrid {
     /// Files `points` (finite, more than `k`) on columns whose side suits
     /// their k-th neighbour distance, or `None` when the cloud is too
     /// sparse for a grid (see the module docs).
@@ -131,7 +132,7 @@ impl Grid {
         Self::for_k_nearest_at_least(points, k, 0.0)
     }
 
-    /// [`Grid::for_k_nearest`] with columns at least `min_side` wide (so
+    /// [`ColumnGrid::for_k_nearest`] with columns at least `min_side` wide (so
     /// that the same grid serves searches within a radius below it), or
     /// `None` also when that is more than [`WIDER`] times the side the k
     /// nearest want.
@@ -204,7 +205,7 @@ impl Grid {
     }
 
     /// The grid of the points that `keep` marks by sorted position (as
-    /// [`Grid::map_has_within_in_grid_order`] gives it), which keep their
+    /// [`ColumnGrid::map_has_within_in_grid_order`] gives it), which keep their
     /// input indices: the same columns, each still by height, the others
     /// dropped in place, with no sort and no new memory but a copy of the
     /// column starts (a filter's output
@@ -335,7 +336,7 @@ impl Grid {
         // them by index from the cloud and the columns was a read from
         // anywhere in 200 MB a point, most of the filing of a 14 M-point
         // scan).
-        let mut dealt: Vec<Dealt> = crate::room::with_room(n);
+        let mut dealt: Vec<Dealt> = crate::prefault::with_room(n);
         let mut row_first = Vec::with_capacity(rows + 1);
         let mut pieces: Vec<Vec<&mut [MaybeUninit<Dealt>]>> =
             tallies.iter().map(|_| Vec::new()).collect();
@@ -633,7 +634,7 @@ impl Grid {
 
     /// Whether each point has at least `wanted` points (itself counted)
     /// within squared distance `r2`, by sorted position (radius outlier
-    /// removal, [RS eq. 13]; [`Grid::kept_inputs`] gives the survivors'
+    /// removal, [RS eq. 13]; [`ColumnGrid::kept_inputs`] gives the survivors'
     /// input indices).
     pub(crate) fn map_has_within_in_grid_order(&self, r2: f32, wanted: usize) -> Vec<bool> {
         self.map_runs(Near::default, |near, p| {
@@ -680,7 +681,7 @@ impl Grid {
         self.runs_in_input_order(self.map_runs(init, f), |v| v)
     }
 
-    /// The values of [`Grid::map_runs`]' runs put in input order through
+    /// The values of [`ColumnGrid::map_runs`]' runs put in input order through
     /// `value` (the places of inputs not filed left at the default).
     fn runs_in_input_order<V, T, G>(&self, runs: Vec<Vec<V>>, value: G) -> Vec<T>
     where
@@ -804,7 +805,7 @@ impl Grid {
                 // more. Not past the columns round its own, though: a
                 // point off a thick layer (its k-th far) is followed by
                 // one in it, which a radius past a column's side would
-                // send through `Grid::runs` (at 20 M points on the bench
+                // send through `ColumnGrid::runs` (at 20 M points on the bench
                 // pile, 11 % of the searches; 6 % so).
                 *guess = (f64::from(kth).sqrt() * GUESS)
                     .min(GUESS_REACH * self.near_width())
@@ -868,7 +869,7 @@ fn set_bits(bits: &[u64]) -> Vec<usize> {
         .map(|part| part.iter().map(|w| w.count_ones() as usize).sum())
         .collect();
     let total = counts.iter().sum();
-    let mut out: Vec<usize> = crate::room::with_room(total);
+    let mut out: Vec<usize> = crate::prefault::with_room(total);
     let mut pieces = Vec::with_capacity(counts.len());
     let mut rest = &mut out.spare_capacity_mut()[..total];
     for &count in &counts {
@@ -932,7 +933,7 @@ fn block_index(cx: usize, cy: usize, nx: usize) -> usize {
     ((cy / BLOCK) * blocks_x + cx / BLOCK) * BLOCK * BLOCK + (cy % BLOCK) * BLOCK + cx % BLOCK
 }
 
-/// Columns a parallel task of `Grid::retain` compacts.
+/// Columns a parallel task of `ColumnGrid::retain` compacts.
 const RETAIN_COLUMNS: usize = 256;
 
 /// Points whose k-th distance checks a grid's side.
@@ -941,7 +942,7 @@ const PROBES: usize = 256;
 /// Points filed round a radius query's own that it counts first.
 const FIRST: usize = 16;
 
-/// Parts the points are dealt to at most, by `Grid::new` (rows of blocks
+/// Parts the points are dealt to at most, by `ColumnGrid::new` (rows of blocks
 /// next to each other taken together past it): a chunk of the input
 /// writes to each part in turn, and past a hundred or so places written
 /// at once the writes slow down (at 20 M points, 129 rows: dealing 12.1–13.1
@@ -955,7 +956,7 @@ const RUN: usize = 4096;
 /// The next query's radius: this times the k-th distance of the last ...
 const GUESS: f64 = 1.1;
 
-/// ... at most this share of [`Grid::near_width`]: within the reach of the
+/// ... at most this share of [`ColumnGrid::near_width`]: within the reach of the
 /// columns round a query's own (`near.rs`).
 const GUESS_REACH: f64 = 0.99;
 
@@ -967,7 +968,7 @@ pub(crate) fn radius_side(radius: f64) -> f64 {
 }
 
 /// A k-nearest grid is not made this many times wider than the k nearest
-/// want for a radius search to share it (`Grid::for_k_nearest_at_least`).
+/// want for a radius search to share it (`ColumnGrid::for_k_nearest_at_least`).
 const WIDER: f64 = 2.0;
 
 /// Columns this many times as wide as the typical k-th distance: runs
@@ -1082,7 +1083,7 @@ fn slab_index_of(start: &[u32], z: &[f32], h: f64) -> (Vec<Slabs>, Vec<u32>) {
     (slabs, slab_start)
 }
 
-/// A point dealt to its row of blocks by `Grid::new`: its column, input
+/// A point dealt to its row of blocks by `ColumnGrid::new`: its column, input
 /// index and coordinates (20 bytes).
 #[derive(Clone, Copy)]
 struct Dealt {
@@ -1200,7 +1201,7 @@ mod tests {
     fn the_slab_index_by_runs_of_columns_is_the_index_in_one_run() {
         // 5000 columns (five runs), some empty, some tall, heights sorted
         // within each.
-        let mut u = super::super::common::uniform(3);
+        let mut u = crate::testing::uniform(3);
         let (mut start, mut z) = (vec![0u32], Vec::new());
         for c in 0..5000 {
             let n = match c % 7 {
@@ -1223,7 +1224,7 @@ mod tests {
 
     #[test]
     fn a_column_sorts_by_height_then_index_on_every_path() {
-        let mut u = super::super::common::uniform(5);
+        let mut u = crate::testing::uniform(5);
         for trial in 0..3_000 {
             let n = trial % 140;
             // Distinct heights mostly, ties (a few values) now and then.
@@ -1242,7 +1243,7 @@ mod tests {
     }
 
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         // A rough surface with noise, a few outliers high above it and
         // duplicated points.
         let mut points: Vec<Point> = (0..n)
@@ -1269,7 +1270,7 @@ mod tests {
     }
 
     fn both(points: &[Point], k: usize) -> (Vec<Vec<u32>>, Vec<Vec<u32>>) {
-        let grid = Grid::for_k_nearest(points, k).expect("a grid");
+        let grid = ColumnGrid::for_k_nearest(points, k).expect("a grid");
         let tree = KdTree::new(points);
         (
             grid.map_k_nearest_distances(k, bits),
@@ -1292,7 +1293,7 @@ mod tests {
         // A scan on a 35° slope with 3 % of its points moved far off it
         // (above, below, beside it, past its end, into an empty corner of
         // the box): answered nearest box first, as `far_k_nearest`.
-        let mut u = super::super::common::uniform(11);
+        let mut u = crate::testing::uniform(11);
         let mut points: Vec<Point> = (0..30_000)
             .map(|_| {
                 let (x, y) = (u() * 30.0, u() * 12.0);
@@ -1328,7 +1329,7 @@ mod tests {
         }
         for points in [flat, line, far] {
             let tree = KdTree::new(&points).map_k_nearest_distances(11, bits);
-            if let Some(grid) = Grid::for_k_nearest(&points, 11) {
+            if let Some(grid) = ColumnGrid::for_k_nearest(&points, 11) {
                 assert_eq!(grid.map_k_nearest_distances(11, bits), tree);
             }
         }
@@ -1340,7 +1341,7 @@ mod tests {
         // tall column whole when it holds few points, else cuts it by its
         // slabs), dense on one side and sparse on the other, so that the
         // tall columns come in both kinds.
-        let mut u = super::super::common::uniform(12);
+        let mut u = crate::testing::uniform(12);
         let points: Vec<Point> = (0..24_000)
             .map(|i| {
                 let x = if i < 20_000 {
@@ -1351,7 +1352,7 @@ mod tests {
                 [x, u() * 5.0, 2.0 * u()]
             })
             .collect();
-        let grid = Grid::for_k_nearest(&points, 21).expect("a grid");
+        let grid = ColumnGrid::for_k_nearest(&points, 21).expect("a grid");
         let tall: Vec<u32> = (0..grid.slabs.len())
             .filter(|&c| f64::from(grid.slabs[c].top - grid.slabs[c].base) > near::WHOLE * grid.h)
             .map(|c| grid.start[c + 1] - grid.start[c])
@@ -1365,12 +1366,12 @@ mod tests {
     #[test]
     fn a_long_cloud_dealt_in_parts_of_several_rows_agrees_too() {
         // A strip of scan 2 km long: more rows of blocks than `DEAL_ROWS`,
-        // so that `Grid::new` deals them to parts of several rows.
-        let mut u = super::super::common::uniform(13);
+        // so that `ColumnGrid::new` deals them to parts of several rows.
+        let mut u = crate::testing::uniform(13);
         let points: Vec<Point> = (0..20_000)
             .map(|_| [u() * 0.5, u() * 2_000.0, 0.05 * u()])
             .collect();
-        let grid = Grid::for_k_nearest(&points, 11).expect("a grid");
+        let grid = ColumnGrid::for_k_nearest(&points, 11).expect("a grid");
         assert!(grid.ny.div_ceil(BLOCK) > DEAL_ROWS, "{} rows", grid.ny);
         let tree = KdTree::new(&points).map_k_nearest_distances(11, bits);
         assert_eq!(grid.map_k_nearest_distances(11, bits), tree);
@@ -1416,7 +1417,7 @@ mod tests {
             let r2 = r * r;
             let tree = KdTree::new(&points);
             let by_tree = tree.map_points(|| (), |_, _, p| tree.has_within(p, r2, wanted));
-            let grid = Grid::for_radius(&points, f64::from(r)).expect("a grid");
+            let grid = ColumnGrid::for_radius(&points, f64::from(r)).expect("a grid");
             let by_tree: Vec<usize> = (0..n).filter(|&i| by_tree[i]).collect();
             let by_grid = grid.kept_inputs(&grid.map_has_within_in_grid_order(r2, wanted));
             assert_eq!(by_grid, by_tree, "n {n}, r {r}");
@@ -1435,7 +1436,7 @@ mod tests {
             ids.sort_unstable();
             ids
         });
-        let grid = Grid::for_radius(&points, 0.25).expect("a grid");
+        let grid = ColumnGrid::for_radius(&points, 0.25).expect("a grid");
         let by_grid = grid.map_within(
             r2,
             || (),

@@ -26,26 +26,26 @@ const GL5: [(f64, f64); 5] = [
     (0.906_179_845_938_664, 0.236_926_885_056_189_1),
 ];
 
-/// Grid step of the tabulated profile [m].
+/// Grid step of the tabulated profile (m).
 const DX: f64 = 0.001;
 
 /// A pile profile in the dig frame, width-averaged (module docs).
 #[derive(Debug, Clone, PartialEq)]
 pub struct DigSurface {
-    /// x of the first sample [m].
+    /// x of the first sample (m).
     x0: f64,
-    /// Heights f̄ at x0 + i·DX [m].
+    /// Heights f̄ at x0 + i·DX (m).
     heights: Vec<f64>,
     /// Where it came from, for reports.
     pub source: String,
     /// A cut thicker than this is taken as "everything" (the normal never
-    /// leaves the material) [m]: 4 m, a hundred times the scale model's
+    /// leaves the material) (m): 4 m, a hundred times the scale model's
     /// deepest cut; [`DigSurface::with_deepest_cut`] sets it for a larger
     /// machine.
     deepest_cut_m: f64,
 }
 
-/// The default of [`DigSurface::with_deepest_cut`] [m].
+/// The default of [`DigSurface::with_deepest_cut`] (m).
 pub const DEEPEST_CUT_M: f64 = 4.0;
 
 impl DigSurface {
@@ -228,12 +228,12 @@ impl DigSurface {
         }, x_toe))
     }
 
-    /// The x range tabulated [m].
+    /// The x range tabulated (m).
     pub fn x_range(&self) -> (f64, f64) {
         (self.x0, self.x0 + (self.heights.len() - 1) as f64 * DX)
     }
 
-    /// Highest point of the profile [m].
+    /// Highest point of the profile (m).
     pub fn top(&self) -> f64 {
         self.heights
             .iter()
@@ -241,7 +241,7 @@ impl DigSurface {
             .fold(f64::NEG_INFINITY, f64::max)
     }
 
-    /// f̄(x), linear between samples, held at the ends [m].
+    /// f̄(x), linear between samples, held at the ends (m).
     #[inline]
     pub fn height(&self, x: f64) -> f64 {
         let u = (x - self.x0) / DX;

@@ -48,21 +48,21 @@ use crate::volume::{counted_volume, strip};
 pub struct ContactReport {
     /// Index of the boulder in the scenario.
     pub obstacle: usize,
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
-    /// Contact point [m].
+    /// Contact point (m).
     pub point_m: [f64; 2],
-    /// V_c, tip velocity at the contact [m/s].
+    /// V_c, tip velocity at the contact (m/s).
     pub velocity_m_s: [f64; 2],
-    /// F_f, the boulder's push on the tooth, in the simulator [N].
+    /// F_f, the boulder's push on the tooth, in the simulator (N).
     pub force_n: [f64; 2],
-    /// F̂, the force the planner estimated from the measured torque jump [N].
+    /// F̂, the force the planner estimated from the measured torque jump (N).
     pub measured_force_n: [f64; 2],
     /// n̂, the rock's normal the planner estimated from F̂.
     pub estimated_normal: [f64; 2],
     /// The envelope's true outward normal there (simulator).
     pub true_normal: [f64; 2],
-    /// γ from V_c to F̂ as the planner reads it (see [`crate::preimage`]) [deg].
+    /// γ from V_c to F̂ as the planner reads it (see [`crate::preimage`]) (deg).
     pub gamma_deg: f64,
     /// The preimage rule's choice.
     pub decision: AvoidSide,
@@ -75,27 +75,27 @@ pub struct ContactReport {
 /// One executed sample.
 #[derive(Debug, Clone, Serialize)]
 pub struct Sample {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
-    /// Tooth tip [m].
+    /// Tooth tip (m).
     pub tip_m: [f64; 2],
-    /// θ₁, θ₂, θ₃ [rad].
+    /// θ₁, θ₂, θ₃ (rad).
     pub joints_rad: [f64; 3],
-    /// Joint rates [rad/s].
+    /// Joint rates (rad/s).
     pub joint_rates_rad_s: [f64; 3],
-    /// φ = θ₁ + θ₂ + θ₃ [rad].
+    /// φ = θ₁ + θ₂ + θ₃ (rad).
     pub attitude_rad: f64,
-    /// Joint torques from the Lagrange dynamics [N·m].
+    /// Joint torques from the Lagrange dynamics (N·m).
     pub torques_nm: [f64; 3],
-    /// The same as the machine measures them, with the sensor's noise [N·m].
+    /// The same as the machine measures them, with the sensor's noise (N·m).
     pub measured_torques_nm: [f64; 3],
-    /// Digging resistance on the tooth (soil, plus the boulder at a contact) [N].
+    /// Digging resistance on the tooth (soil, plus the boulder at a contact) (N).
     pub digging_force_n: [f64; 2],
-    /// Its magnitude [N].
+    /// Its magnitude (N).
     pub digging_force_magnitude_n: f64,
-    /// Soil carried in the bucket [kg].
+    /// Soil carried in the bucket (kg).
     pub load_kg: f64,
-    /// [HE eq. 2] volume swept so far (soil and any boulder inside it) [m³].
+    /// [HE eq. 2] volume swept so far (soil and any boulder inside it) (m³).
     pub swept_volume_m3: f64,
     /// Index into [`Excavation::segments`].
     pub segment: usize,
@@ -110,17 +110,17 @@ pub struct Sample {
 pub struct SegmentReport {
     /// Its role.
     pub kind: SegmentKind,
-    /// Start [s].
+    /// Start (s).
     pub t_start_s: f64,
-    /// End, or the contact that cut it short [s].
+    /// End, or the contact that cut it short (s).
     pub t_end_s: f64,
-    /// Planned duration [s].
+    /// Planned duration (s).
     pub planned_duration_s: f64,
-    /// Start point [m].
+    /// Start point (m).
     pub from_m: [f64; 2],
-    /// Planned end point [m].
+    /// Planned end point (m).
     pub to_m: [f64; 2],
-    /// Volume planned for it ([HE eq. 2]; none for a detour) [m³].
+    /// Volume planned for it ([HE eq. 2]; none for a detour) (m³).
     pub planned_volume_m3: Option<f64>,
     /// n of the step search that placed its end (none for a detour).
     pub steps: Option<usize>,
@@ -135,50 +135,50 @@ pub struct DetourReport {
     pub contact: usize,
     /// The side passed.
     pub side: AvoidSide,
-    /// The goal line x [m].
+    /// The goal line x (m).
     pub goal_x_m: f64,
     /// The forward search's grid path and its P/Q counts.
     pub search: SearchPath,
-    /// The smoothed detour, densely sampled [m].
+    /// The smoothed detour, densely sampled (m).
     pub smoothed_m: Vec<[f64; 2]>,
     /// Least distance of the executed detour from the boulder really met
     /// (simulator), past its first tenth (it starts on the rim), the
-    /// contact that may cut it short excluded [m].
+    /// contact that may cut it short excluded (m).
     pub clearance_m: f64,
-    /// The same from the envelope the planner estimated [m].
+    /// The same from the envelope the planner estimated (m).
     pub planned_clearance_m: f64,
     /// The envelope the planner went round.
     pub estimate: Envelope,
-    /// Volume counted when it was planned (swept so far and boulders) [m³].
+    /// Volume counted when it was planned (swept so far and boulders) (m³).
     pub volume_before_replan_m3: f64,
-    /// The re-planned path after the detour, sampled in time [m].
+    /// The re-planned path after the detour, sampled in time (m).
     pub replanned_m: Vec<[f64; 2]>,
 }
 
 /// The level-1 plan made before any contact.
 #[derive(Debug, Clone, Serialize)]
 pub struct Level1Report {
-    /// (x_begin, ground) [m].
+    /// (x_begin, ground) (m).
     pub start_m: [f64; 2],
-    /// (x_mid, −h) [m].
+    /// (x_mid, −h) (m).
     pub mid_m: [f64; 2],
-    /// (x_end, ground) [m].
+    /// (x_end, ground) (m).
     pub end_m: [f64; 2],
-    /// Volume of the first half [m³].
+    /// Volume of the first half (m³).
     pub first_half_m3: f64,
-    /// Volume of the second half [m³].
+    /// Volume of the second half (m³).
     pub second_half_m3: f64,
     /// n of the midpoint.
     pub mid_steps: usize,
     /// n of the end point.
     pub end_steps: usize,
-    /// Volume the midpoint's last step changed [m³].
+    /// Volume the midpoint's last step changed (m³).
     pub first_step_volume_m3: f64,
-    /// Volume the end point's last step changed [m³].
+    /// Volume the end point's last step changed (m³).
     pub second_step_volume_m3: f64,
-    /// Durations of descent and rise [s].
+    /// Durations of descent and rise (s).
     pub durations_s: [f64; 2],
-    /// The planned tip path, sampled in time [m] (for plots and CSV; not
+    /// The planned tip path, sampled in time (m) (for plots and CSV; not
     /// in summaries).
     #[serde(skip_serializing)]
     pub path_m: Vec<[f64; 2]>,
@@ -195,18 +195,18 @@ pub struct Excavation {
     pub obstacles: Vec<Envelope>,
     /// The boulders as the planner estimated them, with their touches.
     pub estimates: Vec<BoulderEstimate>,
-    /// The radius the planner assumed at a first touch [m].
+    /// The radius the planner assumed at a first touch (m).
     pub prior_radius_m: f64,
-    /// V [m³].
+    /// V (m³).
     pub target_volume_m3: f64,
-    /// Dug, soil and boulders (module docs) [m³].
+    /// Dug, soil and boulders (module docs) (m³).
     pub achieved_volume_m3: f64,
-    /// Soil alone [m³].
+    /// Soil alone (m³).
     pub soil_volume_m3: f64,
-    /// Boulders counted as dug [m³].
+    /// Boulders counted as dug (m³).
     pub obstacle_volume_m3: f64,
     /// What the planner believes it dug: the same count with its estimated
-    /// boulders instead of the real ones [m³].
+    /// boulders instead of the real ones (m³).
     pub believed_volume_m3: f64,
     /// The side chosen at the first contact, if any.
     pub avoid_direction: Option<AvoidSide>,
@@ -220,19 +220,19 @@ pub struct Excavation {
     pub detours: Vec<DetourReport>,
     /// The executed motion.
     pub samples: Vec<Sample>,
-    /// Length of the dig [s].
+    /// Length of the dig (s).
     pub duration_s: f64,
     /// Least signed distance of the executed tip from any envelope (0 when
-    /// touching at a contact; never negative) [m]; none without boulders.
+    /// touching at a contact; never negative) (m); none without boulders.
     pub min_envelope_distance_m: Option<f64>,
     /// max over consecutive samples and joints of |Δθ| / (θ̇_max·Δt): at most 1
     /// means no jump beyond the speed limits.
     pub max_joint_step_ratio: f64,
-    /// Peak |τ| per joint, the stall at a contact included [N·m].
+    /// Peak |τ| per joint, the stall at a contact included (N·m).
     pub peak_torques_nm: [f64; 3],
-    /// Peak soil resistance (contacts excluded) [N].
+    /// Peak soil resistance (contacts excluded) (N).
     pub peak_soil_force_n: f64,
-    /// Wall time of planning and simulation [ms].
+    /// Wall time of planning and simulation (ms).
     pub plan_time_ms: f64,
 }
 
@@ -241,15 +241,15 @@ pub struct Excavation {
 pub struct Summary {
     /// Scenario name.
     pub scenario: String,
-    /// V [m³].
+    /// V (m³).
     pub target_volume_m3: f64,
-    /// Dug [m³].
+    /// Dug (m³).
     pub achieved_volume_m3: f64,
     /// (achieved − target)/target.
     pub volume_error: f64,
-    /// Soil alone [m³].
+    /// Soil alone (m³).
     pub soil_volume_m3: f64,
-    /// Boulders counted [m³].
+    /// Boulders counted (m³).
     pub obstacle_volume_m3: f64,
     /// See [`Excavation::believed_volume_m3`].
     pub believed_volume_m3: f64,
@@ -261,23 +261,23 @@ pub struct Summary {
     pub contacts: Vec<ContactReport>,
     /// First contact's side (`over`, `under`), or none.
     pub avoid_direction: Option<AvoidSide>,
-    /// Dig duration [s].
+    /// Dig duration (s).
     pub duration_s: f64,
-    /// Midpoint and end point of the first plan [m].
+    /// Midpoint and end point of the first plan (m).
     pub level1_mid_m: [f64; 2],
-    /// End point of the first plan [m].
+    /// End point of the first plan (m).
     pub level1_end_m: [f64; 2],
-    /// Where the dig actually ended [m].
+    /// Where the dig actually ended (m).
     pub final_tip_m: [f64; 2],
     /// See [`Excavation::min_envelope_distance_m`].
     pub min_envelope_distance_m: Option<f64>,
     /// See [`Excavation::max_joint_step_ratio`].
     pub max_joint_step_ratio: f64,
-    /// Peak |τ| per joint, the stall at a contact included [N·m].
+    /// Peak |τ| per joint, the stall at a contact included (N·m).
     pub peak_torques_nm: [f64; 3],
-    /// Peak soil resistance [N].
+    /// Peak soil resistance (N).
     pub peak_soil_force_n: f64,
-    /// Wall time [ms].
+    /// Wall time (ms).
     pub plan_time_ms: f64,
 }
 
@@ -324,12 +324,12 @@ impl Excavation {
         (self.achieved_volume_m3 - self.target_volume_m3) / self.target_volume_m3
     }
 
-    /// The executed tip path [m].
+    /// The executed tip path (m).
     pub fn executed_path(&self) -> Vec<[f64; 2]> {
         self.samples.iter().map(|s| s.tip_m).collect()
     }
 
-    /// The first (level-1) plan's tip path, before any contact [m].
+    /// The first (level-1) plan's tip path, before any contact (m).
     pub fn planned_path(&self) -> &[[f64; 2]] {
         &self.level1.path_m
     }
@@ -342,7 +342,7 @@ impl Excavation {
             .min_by(|a, b| (a.t_s - c.t_s).abs().total_cmp(&(b.t_s - c.t_s).abs()))
     }
 
-    /// Peak |F| on the tooth over the dig, contacts included (0 without samples) [N].
+    /// Peak |F| on the tooth over the dig, contacts included (0 without samples) (N).
     pub fn peak_digging_force_n(&self) -> f64 {
         self.samples
             .iter()

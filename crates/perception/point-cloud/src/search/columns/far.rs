@@ -1,11 +1,11 @@
 //! The k nearest distances of a point far from the scan (an outlier high
-//! above it), for `Grid::map_k_nearest_distances`: blocks of columns and
+//! above it), for `ColumnGrid::map_k_nearest_distances`: blocks of columns and
 //! columns searched nearest box first.
 
 use super::within;
-use super::{gap, Grid, Scratch, BLOCK, MARGIN, SLACK};
+use super::{gap, ColumnGrid, Scratch, BLOCK, MARGIN, SLACK};
 
-impl Grid {
+impl ColumnGrid {
     /// The k nearest squared distances of a point far from the rest, as
     /// `k_nearest`: blocks of columns are opened nearest first by the
     /// distance from q to their boxes (their span of x and y, their

@@ -633,7 +633,7 @@ mod tests {
     use super::*;
 
     fn cloud(n: usize, seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         // A thin slab with duplicates, to stress ties and flat cells.
         let mut pts: Vec<Point> = (0..n).map(|_| [u(), u() * 2.0, u() * 0.01]).collect();
         for i in 0..n / 10 {

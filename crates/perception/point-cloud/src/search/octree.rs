@@ -2,7 +2,7 @@
 //! of neighbouring points at a time: the statistical filter's search
 //! ([RS eq. 14]) for scans whose density changes widely from place to place.
 //!
-//! Why beside the grid of columns (`grid/`): the grid files every point on
+//! Why beside the grid of columns (`search::columns`): the grid files every point on
 //! columns of one side, sized for the median k-th distance. Where the
 //! density changes tenfold across one cloud (PCL's five RGB-D scans side by
 //! side, `kinect5`: k-th distances from 4 mm on the close-up scans to 4 cm
@@ -32,7 +32,7 @@
 //! it. Each [`PART`] points of the group (a patch next in Morton order)
 //! cut that buffer to their own box widened by R (one vector pass,
 //! `within::keep_inside`), and each point then takes one vector pass over
-//! its part's cut (`within.rs`) keeping the distances within r (the k-th
+//! its part's cut (`search::within`) keeping the distances within r (the k-th
 //! distance of the point before, times [`GUESS`], at most R), and when k
 //! are within r they hold its k nearest. The k are picked by splitting
 //! the distances at a little below the point before's k-th
@@ -60,8 +60,8 @@
 //! the rosette scan), a group's gather reads a box round the group, and
 //! the grid is up to twice as fast: `statistical_outlier.rs` chooses.
 //!
-//! Arithmetic as in `grid/` and `kdtree.rs`: squared distances in f32 in
-//! FLANN's order (`within.rs`), so the distances are PCL's bit for bit;
+//! Arithmetic as in `search::columns` and `search::kdtree`: squared distances in f32 in
+//! FLANN's order (`search::within`), so the distances are PCL's bit for bit;
 //! every box is widened by a relative [`SLACK`], far above the f32 rounding
 //! of a squared distance, and rounded outwards to f32, so no point within r
 //! is left out of it. The results never depend on the grouping, the reach
@@ -69,8 +69,9 @@
 
 use rayon::prelude::*;
 
-use super::common::{within_f32, SLACK};
-use super::within::{self, Isa, Run};
+use super::bounds::{within_f32, SLACK};
+use super::within::{self, Run};
+use crate::simd::Isa;
 use crate::Point;
 
 /// Most points a leaf holds.
@@ -917,7 +918,7 @@ mod tests {
     /// Two camera-like scans of very different density side by side, with
     /// strays above them and duplicated points.
     fn uneven(n: usize, seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         let mut points: Vec<Point> = (0..n)
             .map(|i| {
                 let (scale, at) = if i % 3 == 0 { (0.2, 0.0) } else { (4.0, 10.0) };
@@ -988,7 +989,7 @@ mod tests {
 
     #[test]
     fn a_thick_layer_a_line_and_far_clusters_agree_too() {
-        let mut u = super::super::common::uniform(7);
+        let mut u = crate::testing::uniform(7);
         // A block of noise, as thick as it is wide.
         let block: Vec<Point> = (0..20_000).map(|_| [u(), u(), u()]).collect();
         agree(&block, 51);
@@ -1009,7 +1010,7 @@ mod tests {
     /// in a box of 20 m: many groups with points whose k nearest lie past
     /// the group's reach, some searched alone.
     fn clusters(seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         let mut points = Vec::new();
         for _ in 0..60 {
             let centre = [u() * 20.0, u() * 20.0, u() * 2.0];
@@ -1027,7 +1028,7 @@ mod tests {
     /// A plane in tiles of 1 m alternately dense (1 cm) and sparse (6 cm),
     /// jittered: groups at the tiles' edges hold points of both.
     fn checkerboard(seed: u64) -> Vec<Point> {
-        let mut u = super::super::common::uniform(seed);
+        let mut u = crate::testing::uniform(seed);
         let mut points = Vec::new();
         for tx in 0..6 {
             for ty in 0..6 {
@@ -1093,7 +1094,7 @@ mod tests {
         // Fewer strays than k, spread over a few metres far above a scan:
         // a group of them finds its k nearest on no gather of its own, and
         // they are searched one after another, each alone.
-        let mut u = super::super::common::uniform(11);
+        let mut u = crate::testing::uniform(11);
         let mut points: Vec<Point> = (0..20_000)
             .map(|_| [u() * 20.0, u() * 20.0, 0.01 * u()])
             .collect();

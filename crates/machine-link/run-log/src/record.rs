@@ -18,7 +18,7 @@ use autoshovel_core::Pose2;
 use autoshovel_walk_tracker::RefLeg;
 use serde::{Deserialize, Serialize};
 
-use crate::error::LinkError;
+use crate::error::RunLogError;
 
 /// The topics.
 pub mod topic {
@@ -43,11 +43,11 @@ pub mod topic {
 /// A pose in a message.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct PoseMsg {
-    /// East [m].
+    /// East (m).
     pub x: f64,
-    /// North [m].
+    /// North (m).
     pub y: f64,
-    /// θ from east, counter-clockwise [rad].
+    /// θ from east, counter-clockwise (rad).
     pub theta: f64,
 }
 
@@ -71,10 +71,10 @@ impl From<PoseMsg> for Pose2 {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct LegMsg {
     /// `forward` or `reverse`.
-    pub direction: autoshovel_walk_planner::Direction,
-    /// Points [[x, y]] [m].
+    pub direction: autoshovel_core::Direction,
+    /// Points [[x, y]] (m).
     pub points: Vec<[f64; 2]>,
-    /// Heading required at the end [rad].
+    /// Heading required at the end (rad).
     pub end_heading_rad: f64,
 }
 
@@ -99,7 +99,7 @@ pub struct PathMsg {
 /// One decision of the workstation.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct TickMsg {
-    /// Time on the PLC's clock since the run started [s].
+    /// Time on the PLC's clock since the run started (s).
     pub t_s: f64,
     /// Leg index.
     pub leg: usize,
@@ -107,32 +107,32 @@ pub struct TickMsg {
     pub measured: PoseMsg,
     /// The simulator's truth (None on a real machine).
     pub truth: Option<PoseMsg>,
-    /// Distance travelled (truth, or along the fixes) [m].
+    /// Distance travelled (truth, or along the fixes) (m).
     pub travelled_m: f64,
-    /// Preview deviation d [m].
+    /// Preview deviation d (m).
     pub d_m: f64,
-    /// Centroid deviation d0 [m].
+    /// Centroid deviation d0 (m).
     pub d0_m: f64,
-    /// Reference speed [m/s].
+    /// Reference speed (m/s).
     pub speed_ref_mps: f64,
-    /// Steering n_r − n_l [rpm].
+    /// Steering n_r − n_l (rpm).
     pub steer_rpm: f64,
-    /// Left setpoint [rpm].
+    /// Left setpoint (rpm).
     pub left_rpm: f64,
-    /// Right setpoint [rpm].
+    /// Right setpoint (rpm).
     pub right_rpm: f64,
 }
 
 /// An RTK fix.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct RtkMsg {
-    /// The receiver's time since the run started [s].
+    /// The receiver's time since the run started (s).
     pub t_s: f64,
-    /// East [m].
+    /// East (m).
     pub east_m: f64,
-    /// North [m].
+    /// North (m).
     pub north_m: f64,
-    /// Heading from north, clockwise [deg].
+    /// Heading from north, clockwise (deg).
     pub heading_deg: f64,
     /// NMEA fix quality.
     pub quality: u8,
@@ -141,9 +141,9 @@ pub struct RtkMsg {
 /// Inverter readings of both motors.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize, Deserialize)]
 pub struct MotorsMsg {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
-    /// Left: speed [rpm], frequency [Hz], current [A], voltage [V].
+    /// Left: speed (rpm), frequency (Hz), current (A), voltage (V).
     pub left: [f64; 4],
     /// Right: the same.
     pub right: [f64; 4],
@@ -152,11 +152,11 @@ pub struct MotorsMsg {
 /// The end of a drive: where the machine stopped, and the metrics.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct EndMsg {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
     /// Final pose (truth on a simulator, else the last fix).
     pub end: PoseMsg,
-    /// Distance travelled [m].
+    /// Distance travelled (m).
     pub travelled_m: f64,
     /// Whether the path was completed.
     pub completed: bool,
@@ -167,7 +167,7 @@ pub struct EndMsg {
 /// An event.
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 pub struct EventMsg {
-    /// Time [s] (machine time, or wall time for link events).
+    /// Time (s) (machine time, or wall time for link events).
     pub t_s: f64,
     /// Who: `workstation`, `link`, `plc`.
     pub source: String,
@@ -183,14 +183,14 @@ pub struct RunLog {
     channels: BTreeMap<&'static str, u16>,
     seq: u32,
     path: PathBuf,
-    /// Unix time of the run's t = 0 [ns].
+    /// Unix time of the run's t = 0 (ns).
     pub origin_ns: u64,
 }
 
-fn log_err(path: &Path, e: impl std::fmt::Display) -> LinkError {
-    LinkError::Log {
+fn write_err(path: &Path, source: mcap::McapError) -> RunLogError {
+    RunLogError::McapWrite {
         path: path.to_path_buf(),
-        why: e.to_string(),
+        source,
     }
 }
 
@@ -204,17 +204,18 @@ impl RunLog {
         path: &Path,
         metadata: &[(&str, String)],
         overwrite: bool,
-    ) -> Result<RunLog, LinkError> {
+    ) -> Result<RunLog, RunLogError> {
         let f = if overwrite {
             File::create(path)
         } else {
             File::options().write(true).create_new(true).open(path)
         }
-        .map_err(|e| {
-            if e.kind() == std::io::ErrorKind::AlreadyExists {
-                log_err(path, "exists; choose another --log or pass --force")
+        .map_err(|source| {
+            let path = path.to_path_buf();
+            if source.kind() == std::io::ErrorKind::AlreadyExists {
+                RunLogError::Exists { path }
             } else {
-                log_err(path, e)
+                RunLogError::Io { path, source }
             }
         })?;
         let opts = mcap::WriteOptions::new()
@@ -223,7 +224,7 @@ impl RunLog {
             .library(format!("autoshovel {}", env!("CARGO_PKG_VERSION")));
         let mut w = opts
             .create(BufWriter::new(f))
-            .map_err(|e| log_err(path, e))?;
+            .map_err(|e| write_err(path, e))?;
         let meta = mcap::records::Metadata {
             name: "autoshovel".into(),
             metadata: metadata
@@ -231,7 +232,7 @@ impl RunLog {
                 .map(|(k, v)| (k.to_string(), v.clone()))
                 .collect(),
         };
-        w.write_metadata(&meta).map_err(|e| log_err(path, e))?;
+        w.write_metadata(&meta).map_err(|e| write_err(path, e))?;
         Ok(RunLog {
             w,
             channels: BTreeMap::new(),
@@ -246,7 +247,7 @@ impl RunLog {
         self.origin_ns = ((ticks - UNIX_EPOCH_TICKS).max(0) as u64).saturating_mul(100);
     }
 
-    fn channel(&mut self, topic: &'static str) -> Result<u16, LinkError> {
+    fn channel(&mut self, topic: &'static str) -> Result<u16, RunLogError> {
         if let Some(id) = self.channels.get(topic) {
             return Ok(*id);
         }
@@ -254,11 +255,11 @@ impl RunLog {
         let sid = self
             .w
             .add_schema(topic, "jsonschema", schema.as_bytes())
-            .map_err(|e| log_err(&self.path, e))?;
+            .map_err(|e| write_err(&self.path, e))?;
         let id = self
             .w
             .add_channel(sid, topic, "json", &BTreeMap::new())
-            .map_err(|e| log_err(&self.path, e))?;
+            .map_err(|e| write_err(&self.path, e))?;
         self.channels.insert(topic, id);
         Ok(id)
     }
@@ -269,9 +270,12 @@ impl RunLog {
         topic: &'static str,
         t_s: f64,
         msg: &T,
-    ) -> Result<(), LinkError> {
+    ) -> Result<(), RunLogError> {
         let id = self.channel(topic)?;
-        let data = serde_json::to_vec(msg).map_err(|e| log_err(&self.path, e))?;
+        let data = serde_json::to_vec(msg).map_err(|source| RunLogError::Encode {
+            path: self.path.clone(),
+            source,
+        })?;
         let t = self
             .origin_ns
             .saturating_add((t_s.max(0.0) * 1e9).round() as u64);
@@ -286,12 +290,12 @@ impl RunLog {
                 },
                 &data,
             )
-            .map_err(|e| log_err(&self.path, e))
+            .map_err(|e| write_err(&self.path, e))
     }
 
     /// Writes the summary and index and closes the file.
-    pub fn finish(mut self) -> Result<PathBuf, LinkError> {
-        self.w.finish().map_err(|e| log_err(&self.path, e))?;
+    pub fn finish(mut self) -> Result<PathBuf, RunLogError> {
+        self.w.finish().map_err(|e| write_err(&self.path, e))?;
         Ok(self.path)
     }
 }

@@ -12,8 +12,8 @@ use autoshovel_walk_tracker::workstation::Decision;
 use autoshovel_walk_tracker::{deviations, RefLeg, RtkFix, TrackCommand};
 use serde::Serialize;
 
-use crate::error::LinkError;
-use crate::log::{topic, EventMsg, PathMsg, PoseMsg, TickMsg};
+use crate::error::RunLogError;
+use crate::record::{topic, EventMsg, PathMsg, PoseMsg, TickMsg};
 
 /// The part of the end message replay needs.
 #[derive(serde::Deserialize)]
@@ -37,15 +37,22 @@ pub struct Replay {
     pub source: String,
 }
 
-fn err(path: &Path, why: impl Into<String>) -> LinkError {
-    LinkError::Log {
+fn err(path: &Path, why: impl Into<String>) -> RunLogError {
+    RunLogError::Content {
         path: path.to_path_buf(),
         why: why.into(),
     }
 }
 
+fn io_err(path: &Path, source: std::io::Error) -> RunLogError {
+    RunLogError::Io {
+        path: path.to_path_buf(),
+        source,
+    }
+}
+
 /// The legs of a path message.
-pub fn legs_of(msg: &PathMsg, path: &Path) -> Result<Vec<RefLeg>, LinkError> {
+pub fn legs_of(msg: &PathMsg, path: &Path) -> Result<Vec<RefLeg>, RunLogError> {
     msg.legs
         .iter()
         .enumerate()
@@ -75,19 +82,29 @@ fn setup_with(legs: Vec<RefLeg>, start: Pose2) -> Setup {
 }
 
 /// Replays a `drive` MCAP log.
-pub fn replay_mcap(path: &Path) -> Result<Replay, LinkError> {
-    let bytes = std::fs::read(path).map_err(|e| err(path, e.to_string()))?;
-    let stream = mcap::MessageStream::new(&bytes)
-        .map_err(|e| err(path, format!("not an MCAP file: {e}")))?;
+pub fn replay_mcap(path: &Path) -> Result<Replay, RunLogError> {
+    let bytes = std::fs::read(path).map_err(|source| io_err(path, source))?;
+    let stream = mcap::MessageStream::new(&bytes).map_err(|source| RunLogError::McapRead {
+        path: path.to_path_buf(),
+        what: "not an MCAP file",
+        source,
+    })?;
     let mut path_msg: Option<PathMsg> = None;
     let mut ticks: Vec<TickMsg> = Vec::new();
     let mut events: Vec<Event> = Vec::new();
     let mut end_msg: Option<(f64, PoseMsg, f64, bool)> = None;
     for m in stream {
-        let m = m.map_err(|e| err(path, format!("damaged MCAP: {e}")))?;
+        let m = m.map_err(|source| RunLogError::McapRead {
+            path: path.to_path_buf(),
+            what: "damaged MCAP",
+            source,
+        })?;
         let topic_name = m.channel.topic.as_str();
-        let bad = |e: serde_json::Error| {
-            err(path, format!("message {} on {topic_name}: {e}", m.sequence))
+        let bad = |source: serde_json::Error| RunLogError::Message {
+            path: path.to_path_buf(),
+            topic: topic_name.to_string(),
+            sequence: m.sequence,
+            source,
         };
         match topic_name {
             topic::PATH => path_msg = Some(serde_json::from_slice(&m.data).map_err(bad)?),
@@ -199,7 +216,7 @@ fn intern(kind: &str) -> &'static str {
 /// One row of a real machine's RTK track.
 #[derive(Debug, Clone, Copy, PartialEq, Serialize)]
 pub struct TrackRow {
-    /// Time [s].
+    /// Time (s).
     pub t_s: f64,
     /// The fix.
     pub fix: RtkFix,
@@ -208,8 +225,8 @@ pub struct TrackRow {
 /// Reads a CSV of RTK fixes: a header naming `t_s` (or `time_s`),
 /// `east_m`, `north_m` and `heading_deg` (north, clockwise, the
 /// receiver's), in any order; other columns are ignored.
-pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, LinkError> {
-    let text = std::fs::read_to_string(path).map_err(|e| err(path, e.to_string()))?;
+pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, RunLogError> {
+    let text = std::fs::read_to_string(path).map_err(|source| io_err(path, source))?;
     let mut lines = text
         .lines()
         .enumerate()
@@ -247,7 +264,7 @@ pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, LinkError> {
     let mut rows = Vec::new();
     for (i, line) in lines {
         let cells: Vec<&str> = line.split(',').map(str::trim).collect();
-        let num = |c: usize, name: &str| -> Result<f64, LinkError> {
+        let num = |c: usize, name: &str| -> Result<f64, RunLogError> {
             cells
                 .get(c)
                 .and_then(|s| s.parse::<f64>().ok())
@@ -291,7 +308,7 @@ pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, LinkError> {
     Ok(rows)
 }
 
-/// A run is complete when its last fix is within this of the path's end [m].
+/// A run is complete when its last fix is within this of the path's end (m).
 pub const COMPLETE_WITHIN_M: f64 = 0.5;
 
 /// Replays a real machine's RTK track (`read_rtk_csv`) against `legs`: each

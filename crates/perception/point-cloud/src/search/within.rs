@@ -1,4 +1,4 @@
-//! The inner loop of every grid search (`grid/`): the squared distances
+//! The inner loop of every grid search (`search::columns`): the squared distances
 //! from a query to a run of points, and which of them lie within a cap —
 //! kept (the distances themselves, or a payload such as the points'
 //! indices) or counted.
@@ -17,10 +17,10 @@
 //! holds a run to a narrower path (BENCHMARKS.md compares them).
 //!
 //! Every path computes `dx·dx + dy·dy + dz·dz` in f32, in that order, with
-//! no fused multiply-add (FLANN's arithmetic, as `kdtree.rs`), so each
+//! no fused multiply-add (FLANN's arithmetic, as `search::kdtree`), so each
 //! gives the same bits as the portable loop; the tests hold them to it.
 
-use std::sync::OnceLock;
+use crate::simd::{Isa, Path};
 
 /// A run of points by axis (equal lengths).
 #[derive(Debug, Clone, Copy)]
@@ -38,60 +38,6 @@ impl Run<'_> {
             y: &self.y[i..],
             z: &self.z[i..],
         }
-    }
-}
-
-/// The instruction sets with a path of their own (the filters' and the
-/// floor search's): every path gives the same bits.
-#[derive(Debug, Clone, Copy, PartialEq, Eq)]
-pub enum Isa {
-    /// The target's baseline (SSE2 on x86-64).
-    Portable,
-    /// AVX2 (with POPCNT).
-    #[cfg(target_arch = "x86_64")]
-    Avx2,
-    /// AVX-512F (with AVX2).
-    #[cfg(target_arch = "x86_64")]
-    Avx512,
-}
-
-impl Isa {
-    /// The widest this machine runs (found once), or a narrower one named
-    /// by the environment variable `AUTOSHOVEL_ISA` (`portable`, `avx2`):
-    /// to measure the paths side by side, or to rule one out.
-    pub fn best() -> Self {
-        static BEST: OnceLock<Isa> = OnceLock::new();
-        *BEST.get_or_init(|| {
-            let all = Self::available();
-            let widest = *all.last().expect("the portable path");
-            match std::env::var("AUTOSHOVEL_ISA").as_deref() {
-                Ok("portable") => Isa::Portable,
-                #[cfg(target_arch = "x86_64")]
-                Ok("avx2") if all.contains(&Isa::Avx2) => Isa::Avx2,
-                _ => widest,
-            }
-        })
-    }
-
-    /// Every path this machine runs, the portable one first.
-    pub fn available() -> Vec<Self> {
-        let mut all = vec![Isa::Portable];
-        #[cfg(target_arch = "x86_64")]
-        {
-            // (every machine with AVX2 has POPCNT, which counts the kept
-            // lanes: without it a count is a dozen dependent instructions
-            // on the search loop's critical path; checked all the same)
-            let avx2 = std::arch::is_x86_feature_detected!("avx2")
-                && std::arch::is_x86_feature_detected!("popcnt");
-            if avx2 {
-                all.push(Isa::Avx2);
-            }
-            // (every AVX-512 machine has AVX2; the other paths rely on it)
-            if std::arch::is_x86_feature_detected!("avx512f") && avx2 {
-                all.push(Isa::Avx512);
-            }
-        }
-        all
     }
 }
 
@@ -132,10 +78,11 @@ pub(super) fn keep_inside(isa: Isa, run: Run, lo: [f32; 3], hi: [f32; 3], out: [
         ox.len() == oy.len() && ox.len() == oz.len(),
         "the output's axes differ in length"
     );
-    match isa {
-        // SAFETY: as in `count`; the output's axes are equally long.
+    match isa.path() {
+        // SAFETY: `t` proves AVX-512; `check` made the run's axes equally
+        // long, and the output's axes are equally long (asserted above).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::keep_inside(run, lo, hi, [ox, oy, oz]) },
+        Path::Avx512(t) => unsafe { avx512::keep_inside(t, run, lo, hi, [ox, oy, oz]) },
         _ => portable::keep_inside(run, lo, hi, [ox, oy, oz]),
     }
 }
@@ -145,14 +92,14 @@ pub(super) fn keep_inside(isa: Isa, run: Run, lo: [f32; 3], hi: [f32; 3], out: [
 #[inline]
 pub(super) fn count(isa: Isa, q: [f32; 3], run: Run, cap: f32) -> usize {
     check(run);
-    match isa {
-        Isa::Portable => portable::count(q, run, cap),
-        // SAFETY: `Isa::best` and `Isa::available` give these only where
-        // the machine has the instruction set; `check` made the lengths equal.
+    match isa.path() {
+        Path::Portable => portable::count(q, run, cap),
+        // SAFETY: `t` proves the instruction set; `check` made the lengths equal.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { avx2::count(q, run, cap) },
+        Path::Avx2(t) => unsafe { avx2::count(t, q, run, cap) },
+        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::count(q, run, cap) },
+        Path::Avx512(t) => unsafe { avx512::count(t, q, run, cap) },
     }
 }
 
@@ -179,11 +126,10 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
         "k = {k} of {} distances",
         bits.len()
     );
-    let sorted = match isa {
-        Isa::Portable => false,
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 | Isa::Avx512 => sort_by_network(isa, bits),
-    };
+    #[cfg(target_arch = "x86_64")]
+    let sorted = sort_by_network(isa, bits);
+    #[cfg(not(target_arch = "x86_64"))]
+    let sorted = false;
     if !sorted {
         bits.select_nth_unstable(k - 1);
     }
@@ -206,10 +152,10 @@ pub(super) fn smallest_near(isa: Isa, bits: &mut [u32], k: usize, pivot: u32) {
         return smallest(isa, bits, k);
     }
     assert!((1..=n).contains(&k), "k = {k} of {n} distances");
-    let a = match isa {
-        // SAFETY: `Isa::Avx512` only where the machine has AVX-512F; n ≤ 128.
+    let a = match isa.path() {
+        // SAFETY: `t` proves AVX-512F; n ≤ 128 (above).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::split(bits, pivot) },
+        Path::Avx512(t) => unsafe { avx512::split(t, bits, pivot) },
         _ => return smallest(isa, bits, k),
     };
     if a > k {
@@ -233,18 +179,17 @@ pub(super) fn smallest_near(isa: Isa, bits: &mut [u32], k: usize, pivot: u32) {
 #[cfg(target_arch = "x86_64")]
 fn sort_by_network(isa: Isa, values: &mut [u32]) -> bool {
     let n = values.len();
-    // SAFETY: `Isa::best` and `Isa::available` give these only where the
-    // machine has the instruction set; the lengths as `sort` requires.
+    // SAFETY: `t` proves the instruction set; the lengths as `sort` requires.
     unsafe {
-        match (isa, n) {
-            (Isa::Avx512, 0..=16) => avx512::sort::<1>(values),
-            (Isa::Avx512, 17..=32) => avx512::sort::<2>(values),
-            (Isa::Avx512, 33..=64) => avx512::sort::<4>(values),
-            (Isa::Avx512, 65..=128) => avx512::sort::<8>(values),
-            (Isa::Avx2, 0..=8) => avx2::sort::<1>(values),
-            (Isa::Avx2, 9..=16) => avx2::sort::<2>(values),
-            (Isa::Avx2, 17..=32) => avx2::sort::<4>(values),
-            (Isa::Avx2, 33..=64) => avx2::sort::<8>(values),
+        match (isa.path(), n) {
+            (Path::Avx512(t), 0..=16) => avx512::sort::<1>(t, values),
+            (Path::Avx512(t), 17..=32) => avx512::sort::<2>(t, values),
+            (Path::Avx512(t), 33..=64) => avx512::sort::<4>(t, values),
+            (Path::Avx512(t), 65..=128) => avx512::sort::<8>(t, values),
+            (Path::Avx2(t), 0..=8) => avx2::sort::<1>(t, values),
+            (Path::Avx2(t), 9..=16) => avx2::sort::<2>(t, values),
+            (Path::Avx2(t), 17..=32) => avx2::sort::<4>(t, values),
+            (Path::Avx2(t), 33..=64) => avx2::sort::<8>(t, values),
             _ => return false,
         }
     }
@@ -255,16 +200,15 @@ fn sort_by_network(isa: Isa, values: &mut [u32]) -> bool {
 /// 128 of them, on AVX-512); `false`, with them untouched, elsewhere.
 pub(super) fn sort_wide(isa: Isa, values: &mut [u64]) -> bool {
     #[cfg(target_arch = "x86_64")]
-    if isa == Isa::Avx512 {
-        // SAFETY: `Isa::best` and `Isa::available` give `Isa::Avx512` only
-        // where the machine has AVX-512F; the lengths as `sort_wide` requires.
+    if let Some(t) = isa.avx512() {
+        // SAFETY: `t` proves AVX-512F; the lengths as `sort_wide` requires.
         unsafe {
             match values.len() {
-                0..=8 => avx512::sort_wide::<1>(values),
-                9..=16 => avx512::sort_wide::<2>(values),
-                17..=32 => avx512::sort_wide::<4>(values),
-                33..=64 => avx512::sort_wide::<8>(values),
-                65..=128 => avx512::sort_wide::<16>(values),
+                0..=8 => avx512::sort_wide::<1>(t, values),
+                9..=16 => avx512::sort_wide::<2>(t, values),
+                17..=32 => avx512::sort_wide::<4>(t, values),
+                33..=64 => avx512::sort_wide::<8>(t, values),
+                65..=128 => avx512::sort_wide::<16>(t, values),
                 _ => return false,
             }
         }
@@ -284,20 +228,20 @@ pub(super) const MOST_RANKED: usize = 64;
 /// [`MOST_RANKED`] values, and on the portable path.
 pub(super) fn ranks(isa: Isa, values: &[u32], ranks: &mut [u32; MOST_RANKED]) -> bool {
     let n = values.len();
-    let ranked = match isa {
-        Isa::Portable => false,
-        _ if n < 2 => {
+    let ranked = match isa.avx2() {
+        None => false,
+        Some(_) if n < 2 => {
             ranks[..n].fill(0);
             true
         }
-        // SAFETY: `Isa::best` and `Isa::available` give these only where
-        // the machine has AVX2 (AVX-512 only with it); the lengths as required.
+        // SAFETY: `t` proves AVX2 (AVX-512 machines have it too); the
+        // lengths as `ranks` requires.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 | Isa::Avx512 if n <= 32 => unsafe { avx2::ranks::<4>(values, ranks) },
+        Some(t) if n <= 32 => unsafe { avx2::ranks::<4>(t, values, ranks) },
+        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 | Isa::Avx512 if n <= 64 => unsafe { avx2::ranks::<8>(values, ranks) },
-        #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 | Isa::Avx512 => false,
+        Some(t) if n <= 64 => unsafe { avx2::ranks::<8>(t, values, ranks) },
+        Some(_) => false,
     };
     // Distinct values have ranks 0..n, whose sum is n(n − 1)/2; with ties
     // every rank is at most the distinct case's and some below it.
@@ -345,14 +289,15 @@ fn keep<const PAYLOAD: bool>(
     out: &mut Vec<u32>,
 ) {
     check(run);
-    match isa {
-        Isa::Portable => portable::keep::<PAYLOAD>(q, run, payload, cap, out),
+    match isa.path() {
+        Path::Portable => portable::keep::<PAYLOAD>(q, run, payload, cap, out),
         // SAFETY: as in `count`; `payload` is as long as the run when
         // `PAYLOAD` (asserted by `keep_payload`).
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx2 => unsafe { avx2::keep::<PAYLOAD>(q, run, payload, cap, out) },
+        Path::Avx2(t) => unsafe { avx2::keep::<PAYLOAD>(t, q, run, payload, cap, out) },
+        // SAFETY: as above.
         #[cfg(target_arch = "x86_64")]
-        Isa::Avx512 => unsafe { avx512::keep::<PAYLOAD>(q, run, payload, cap, out) },
+        Path::Avx512(t) => unsafe { avx512::keep::<PAYLOAD>(t, q, run, payload, cap, out) },
     }
 }
 
@@ -542,6 +487,7 @@ mod avx2 {
     use std::arch::x86_64::*;
 
     use super::{portable, Run};
+    use crate::simd::Avx2;
 
     /// For each 8-bit mask, the lanes it selects, first to last, then
     /// zeros: the permutation that packs the selected lanes to the front.
@@ -602,6 +548,7 @@ mod avx2 {
     /// AVX2; equal axes; `payload` as long as the run when `PAYLOAD`.
     #[target_feature(enable = "avx2,popcnt")]
     pub(super) unsafe fn keep<const PAYLOAD: bool>(
+        _: Avx2,
         q: [f32; 3],
         run: Run,
         payload: &[u32],
@@ -641,7 +588,7 @@ mod avx2 {
     /// # Safety
     /// AVX2; equal axes.
     #[target_feature(enable = "avx2,popcnt")]
-    pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
+    pub(super) unsafe fn count(_: Avx2, q: [f32; 3], run: Run, cap: f32) -> usize {
         let n = run.x.len();
         let (qv, capv) = (splat(q), _mm256_set1_ps(cap));
         let (mut found, mut i) = (0, 0);
@@ -706,7 +653,7 @@ mod avx2 {
     /// # Safety
     /// AVX2; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
+    pub(super) unsafe fn sort<const V: usize>(_: Avx2, values: &mut [u32]) {
         let n = values.len();
         debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 8);
         let mut filled = [u32::MAX; 64];
@@ -729,7 +676,11 @@ mod avx2 {
     /// # Safety
     /// AVX2; `values.len() ≤ 8 · V ≤ 64`.
     #[target_feature(enable = "avx2")]
-    pub(super) unsafe fn ranks<const V: usize>(values: &[u32], ranks: &mut [u32; 64]) -> bool {
+    pub(super) unsafe fn ranks<const V: usize>(
+        _: Avx2,
+        values: &[u32],
+        ranks: &mut [u32; 64],
+    ) -> bool {
         let n = values.len();
         debug_assert!(n <= 8 * V && 8 * V <= 64);
         // AVX2 compares signed integers only: the sign bit flipped, they
@@ -763,6 +714,7 @@ mod avx512 {
     use std::arch::x86_64::*;
 
     use super::Run;
+    use crate::simd::Avx512;
 
     /// Squared distances of the points from position `i` that `lanes`
     /// selects (the others read as zero).
@@ -814,6 +766,7 @@ mod avx512 {
     /// AVX-512F; equal axes; `payload` as long as the run when `PAYLOAD`.
     #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn keep<const PAYLOAD: bool>(
+        _: Avx512,
         q: [f32; 3],
         run: Run,
         payload: &[u32],
@@ -853,6 +806,7 @@ mod avx512 {
     /// AVX-512F; equal axes, in the run and in the output.
     #[target_feature(enable = "avx512f,popcnt")]
     pub(super) unsafe fn keep_inside(
+        _: Avx512,
         run: Run,
         lo: [f32; 3],
         hi: [f32; 3],
@@ -899,7 +853,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F; equal axes.
     #[target_feature(enable = "avx512f,popcnt")]
-    pub(super) unsafe fn count(q: [f32; 3], run: Run, cap: f32) -> usize {
+    pub(super) unsafe fn count(_: Avx512, q: [f32; 3], run: Run, cap: f32) -> usize {
         let n = run.x.len();
         let (qv, capv) = (splat(q), _mm512_set1_ps(cap));
         let (mut found, mut i) = (0, 0);
@@ -964,7 +918,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F; `values.len() ≤ 128`.
     #[target_feature(enable = "avx512f,popcnt")]
-    pub(super) unsafe fn split(values: &mut [u32], pivot: u32) -> usize {
+    pub(super) unsafe fn split(_: Avx512, values: &mut [u32], pivot: u32) -> usize {
         let n = values.len();
         debug_assert!(n <= 128);
         let mut low = [std::mem::MaybeUninit::<u32>::uninit(); 144];
@@ -1010,7 +964,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F; `values.len() ≤ 16 · V`, `V` one of 1, 2, 4, 8.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn sort<const V: usize>(values: &mut [u32]) {
+    pub(super) unsafe fn sort<const V: usize>(_: Avx512, values: &mut [u32]) {
         let n = values.len();
         debug_assert!(n <= 16 * V && V.is_power_of_two() && V <= 8);
         let present: [__mmask16; V] = std::array::from_fn(|c| lanes((16 * c).min(n), n));
@@ -1036,7 +990,7 @@ mod avx512 {
     /// # Safety
     /// AVX-512F; `values.len() ≤ 8 · V`, `V` one of 1, 2, 4, 8, 16.
     #[target_feature(enable = "avx512f")]
-    pub(super) unsafe fn sort_wide<const V: usize>(values: &mut [u64]) {
+    pub(super) unsafe fn sort_wide<const V: usize>(_: Avx512, values: &mut [u64]) {
         let n = values.len();
         debug_assert!(n <= 8 * V && V.is_power_of_two() && V <= 16);
         let present: [__mmask8; V] = std::array::from_fn(|c| {
@@ -1169,7 +1123,7 @@ mod tests {
 
     #[test]
     fn every_path_leaves_the_k_smallest_with_the_kth_last() {
-        let mut next = super::super::common::below(3);
+        let mut next = crate::testing::below(3);
         for trial in 0..20_000 {
             let n = 1 + trial % 140;
             // Distances of every spread, ties (duplicates, zeros) among them
@@ -1222,7 +1176,7 @@ mod tests {
 
     #[test]
     fn every_path_sorts_ids() {
-        let mut next = super::super::common::below(5);
+        let mut next = crate::testing::below(5);
         for trial in 0..20_000 {
             let n = trial % 140;
             // Distinct mostly, ties now and then, values up to u32::MAX
@@ -1249,7 +1203,7 @@ mod tests {
 
     #[test]
     fn every_path_sorts_wide_keys_or_declines() {
-        let mut next = super::super::common::below(11);
+        let mut next = crate::testing::below(11);
         for trial in 0..20_000 {
             let n = trial % 140;
             // Keys of every spread up to u64::MAX, ties now and then.

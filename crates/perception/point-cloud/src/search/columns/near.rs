@@ -3,7 +3,7 @@
 //!
 //! Queries come in sorted order, a column's points one after another (27
 //! of them at k = 21), and each asks for the same few columns round its
-//! own. `Grid::runs` works them out afresh for every query: the box's
+//! own. `ColumnGrid::runs` works them out afresh for every query: the box's
 //! columns by division, a pass over each row of a block for its heights,
 //! the slabs of each column that may hold the box's heights. Here the 3 × 3
 //! columns round a query's column are described once, when the queries
@@ -16,10 +16,10 @@
 //! more than [`WHOLE`] sides (a wall, or an outlier high above the scan)
 //! and that holds more than [`WHOLE_POINTS`] points is still cut to the
 //! box's heights by its slabs. A larger radius (a sparse
-//! spot, a far point) goes to `Grid::runs`. Either way every point within
+//! spot, a far point) goes to `ColumnGrid::runs`. Either way every point within
 //! the radius is in some run, so the results are the same, bit for bit.
 
-use super::{block_index, gap, heights_within, Grid, BLOCK, MARGIN, SLACK};
+use super::{block_index, gap, heights_within, ColumnGrid, BLOCK, MARGIN, SLACK};
 
 /// A column is read whole when its heights span at most this many
 /// sides, else cut by its slabs ...
@@ -65,7 +65,7 @@ struct Cell {
     whole: bool,
 }
 
-impl Grid {
+impl ColumnGrid {
     /// The column (numbered by [`block_index`]) and its x and y indices of
     /// sorted position `p`.
     fn column_of(&self, p: usize) -> (usize, usize, usize) {
@@ -123,7 +123,7 @@ impl Grid {
         self.h * (1.0 - 4.0 * MARGIN)
     }
 
-    /// As [`Grid::runs`], for the grid's own point at sorted position `p`
+    /// As [`ColumnGrid::runs`], for the grid's own point at sorted position `p`
     /// (`q` its coordinates), with the columns round it kept in `near`.
     pub(super) fn runs_near(
         &self,
