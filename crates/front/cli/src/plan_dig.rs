@@ -94,7 +94,7 @@ pub struct Args {
     pub init: InitArg,
     /// After the Grey Wolf Optimizer, polish its best plan by CMA-ES with this
     /// many more evaluations; 0 is the paper's search, GWO alone. The default
-    /// lands within 1 % of a long search on every pile (docs/dig.md).
+    /// lands within 1 % of a long search on every pile (docs/rope-shovel-dig.md).
     #[arg(long, default_value_t = autoshovel_rope_shovel_dig::plan::DEFAULT_POLISH_EVALUATIONS)]
     pub polish: usize,
     /// Start from the final pack of an earlier plan (its `pack.csv`), as the

@@ -144,3 +144,57 @@ fn every_member_keeps_the_workspace_lints_and_the_doc_link_lint() {
         }
     }
 }
+
+/// The dependencies a member's Cargo.toml names (normal ones, by package).
+fn dependencies(member: &str) -> (String, Vec<String>) {
+    let own: toml::Value = toml::from_str(&read(&root().join(member).join("Cargo.toml"))).unwrap();
+    let name = own["package"]["name"].as_str().unwrap().to_string();
+    let deps = own
+        .get("dependencies")
+        .and_then(toml::Value::as_table)
+        .map(|t| t.keys().cloned().collect())
+        .unwrap_or_default();
+    (name, deps)
+}
+
+#[test]
+fn the_figures_reach_no_opc_ua_stack() {
+    // The workspace's graph from the members' manifests; the figures'
+    // closure over it, and every dependency that closure names.
+    let graph: std::collections::BTreeMap<String, Vec<String>> =
+        members().iter().map(|m| dependencies(m)).collect();
+    let mut seen = BTreeSet::new();
+    let mut stack = vec!["autoshovel-figures".to_string()];
+    while let Some(name) = stack.pop() {
+        if !seen.insert(name.clone()) {
+            continue;
+        }
+        if let Some(deps) = graph.get(&name) {
+            stack.extend(deps.iter().cloned());
+        }
+    }
+    for banned in ["autoshovel-plc-link", "async-opcua", "tokio"] {
+        assert!(
+            !seen.contains(banned),
+            "autoshovel-figures reaches {banned}: {seen:?}"
+        );
+    }
+    // The run log it writes the shift's record with is in reach.
+    assert!(seen.contains("autoshovel-run-log"));
+}
+
+#[test]
+fn benchmarks_is_one_page_that_opens_on_the_side_by_side_table() {
+    let text = read(&root().join("BENCHMARKS.md"));
+    let lines = text.lines().count();
+    assert!(
+        lines <= 400,
+        "BENCHMARKS.md has {lines} lines; the history goes to docs/benchmarks-log.md"
+    );
+    let first_table = text.lines().find(|l| l.starts_with('|')).expect("a table");
+    assert!(
+        first_table.contains("ours") && first_table.contains("peers"),
+        "the first table is ours beside the peers: {first_table}"
+    );
+    assert!(root().join("docs/benchmarks-log.md").is_file());
+}

@@ -82,7 +82,7 @@ fn pair(v: &Value) -> [f64; 2] {
     ]
 }
 
-/// γ as the paper defines it in our mirrored frame (docs/excavate.md):
+/// γ as the paper defines it in our mirrored frame (docs/excavator-dig.md):
 /// clockwise from V_c to F_f, atan2(−(V × F), V·F) mod 360° (deg).
 fn gamma_deg(v: [f64; 2], f: [f64; 2]) -> f64 {
     let cross = v[0] * f[1] - v[1] * f[0];

@@ -511,7 +511,7 @@ fn base64(bytes: &[u8]) -> String {
 }
 
 /// The shift as an MCAP run log (the machine link's format and topics,
-/// docs/link.md; Foxglove replays it): the machine's true pose at each
+/// docs/machine-link.md; Foxglove replays it): the machine's true pose at each
 /// pass and along every walk, every event, every pass's record, the
 /// summary at the end. Times are the shift's.
 pub fn run_log(

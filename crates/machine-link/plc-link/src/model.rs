@@ -9,7 +9,7 @@
 //!
 //! Node ids are strings in the namespace (`ns=<index of NAMESPACE_URI>;
 //! s=Shovel.Rtk.East`); the table [`VARIABLES`] is the one source of the
-//! server's address space, the client's checks and `docs/link.md`.
+//! server's address space, the client's checks and `docs/machine-link.md`.
 
 use std::fmt;
 
@@ -255,7 +255,7 @@ pub fn leaf(id: &str) -> &str {
 }
 
 /// The model as a Markdown table (node id, type, unit, writer, meaning),
-/// as `docs/link.md` shows it.
+/// as `docs/machine-link.md` shows it.
 pub fn markdown_table() -> String {
     let mut s = String::from(
         "| node id (`ns=…;s=`) | type | unit | written by | meaning |\n|---|---|---|---|---|\n",
@@ -285,10 +285,10 @@ mod tests {
 
     #[test]
     fn the_docs_show_the_model_as_it_is() {
-        let doc = include_str!("../../../../docs/link.md");
+        let doc = include_str!("../../../../docs/machine-link.md");
         assert!(
             doc.contains(&markdown_table()),
-            "docs/link.md's table differs from model::VARIABLES; paste:\n{}",
+            "docs/machine-link.md's table differs from model::VARIABLES; paste:\n{}",
             markdown_table()
         );
     }

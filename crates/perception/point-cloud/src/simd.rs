@@ -200,4 +200,40 @@ mod tests {
         }
         assert!(all.contains(&Isa::best()));
     }
+
+    /// Prints the path `Isa::best` chose in this process (run alone by
+    /// the test below, with `AUTOSHOVEL_ISA` set).
+    #[test]
+    fn report_the_chosen_path() {
+        println!("chosen path: {}", Isa::best().name());
+    }
+
+    #[test]
+    fn the_variable_holds_a_run_to_a_narrower_path() {
+        let chosen = |value: &str| {
+            let out = std::process::Command::new(std::env::current_exe().unwrap())
+                .args([
+                    "--exact",
+                    "simd::tests::report_the_chosen_path",
+                    "--nocapture",
+                ])
+                .env(ISA_VARIABLE, value)
+                .output()
+                .unwrap();
+            let text = String::from_utf8_lossy(&out.stdout).into_owned();
+            let at = text.find("chosen path: ").expect("the child's report") + 13;
+            text[at..].split_whitespace().next().unwrap().to_string()
+        };
+        let all = Isa::available();
+        let widest = all.last().unwrap().name();
+        assert_eq!(chosen("portable"), "portable");
+        let avx2 = if all.iter().any(|i| i.level() == Level::Avx2) {
+            "avx2"
+        } else {
+            widest
+        };
+        assert_eq!(chosen("avx2"), avx2);
+        assert_eq!(chosen("no-such-path"), widest);
+        assert_eq!(chosen(""), widest);
+    }
 }

@@ -690,7 +690,7 @@ pub const DEFAULT_POLISH_EVALUATIONS: usize = 20_000;
 /// of its best wolf. The best plans sit where several constraints meet
 /// (t_d, c16, c5, c9); GWO alone stops short of that corner, by up to a few
 /// per cent, and GWO alone with the same 25 050 evaluations does too
-/// (docs/dig.md, "Does the planner find its own optimum?"). With
+/// (docs/rope-shovel-dig.md, "Does the planner find its own optimum?"). With
 /// `polish_evaluations = 0` it is the paper's search.
 pub fn search_preset() -> DigSearch {
     DigSearch {

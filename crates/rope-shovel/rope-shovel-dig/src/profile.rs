@@ -9,7 +9,7 @@
 //! maximum, a search box outside the dig-time limits) are refused with the
 //! file, the line and the key.
 //!
-//! # Reading of Table 1 (Fig. 2 is missing from the paper; see docs/dig.md)
+//! # Reading of Table 1 (Fig. 2 is missing from the paper; see docs/rope-shovel-dig.md)
 //! O is the saddle block (shipper shaft) centre, A the boom foot, B the boom
 //! point sheave centre, C the bail pin where the hoist rope meets the dipper,
 //! D the tooth tip. With the handle retracted (d₂ = 0), D lies `l_OD` from O
@@ -58,7 +58,7 @@ pub struct GeometrySpec {
     /// β: boom angle to the horizontal (deg).
     pub boom_angle_deg: f64,
     /// δ1: tilt of the tooth back face from the normal to the tooth line OD
-    /// (deg) (so δ1 + δ2 from the handle normal; docs/dig.md).
+    /// (deg) (so δ1 + δ2 from the handle normal; docs/rope-shovel-dig.md).
     pub dipper_pitch_deg: f64,
     /// δ2: angle at O between the handle axis and OD (deg).
     pub tip_angle_deg: f64,
@@ -487,7 +487,7 @@ pub struct Geometry {
     pub dipper_pitch: f64,
     /// Tilt of the tooth back face from the handle normal, δ1 + δ2: δ1 is
     /// read from the tooth line OD, which is δ2 from the handle axis
-    /// (docs/dig.md, "Our reading of Table 1").
+    /// (docs/rope-shovel-dig.md, "Our reading of Table 1").
     pub back_face_tilt: f64,
     /// L_dg of c17: the handle length, greatest extension d = d₂ + d₂₀.
     pub handle_length: f64,

@@ -8,7 +8,7 @@
 //!   polish of 20 000 (25 050).
 //!
 //! Seeds 10–19 were not used to choose anything. It prints the table of
-//! docs/dig.md and checks the budgets, that every plan is feasible, and the
+//! docs/rope-shovel-dig.md and checks the budgets, that every plan is feasible, and the
 //! aim: the default within 1 % of the long search on every pile and seed.
 //!
 //! Slow (a few minutes in release): `cargo test --release -p

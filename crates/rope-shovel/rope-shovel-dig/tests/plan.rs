@@ -70,7 +70,7 @@ fn the_rebuilt_piles_give_table_4_its_fills_and_our_reading_accepts_its_paths() 
         heights.push(pile.face_height_m);
     }
     // The typical, convex and convex–concave piles stand within 1 cm of
-    // each other; the concave one is lower (docs/dig.md).
+    // each other; the concave one is lower (docs/rope-shovel-dig.md).
     assert!((heights[0] - heights[2]).abs() < 0.01 && (heights[0] - heights[3]).abs() < 0.01);
     assert!(heights[1] < heights[0]);
 }

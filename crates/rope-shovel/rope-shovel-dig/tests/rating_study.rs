@@ -9,7 +9,7 @@
 //! the same rating: a rating that explains the dig times must let all four
 //! of them run.
 //!
-//! It prints the table of docs/dig.md and checks its finding: every
+//! It prints the table of docs/rope-shovel-dig.md and checks its finding: every
 //! rating calibrated this way is below what one of the paper's plans
 //! needs, so no single rating explains the four dig times on our model.
 //!

@@ -132,7 +132,7 @@ impl Default for FuzzyParams {
     fn default() -> Self {
         // Tuned by a seeded random search on fig9a/b (noise off) and the
         // straight / curve / V-shape runs with RTK noise (seeds 11–13; the tests
-        // check seeds 1–6); see docs/track.md.
+        // check seeds 1–6); see docs/walk-tracker.md.
         Self {
             alpha: 0.30,
             k1: 2.42,

@@ -1,5 +1,5 @@
 """A shovel PLC nobody here wrote: a small python asyncua server on the
-model of docs/link.md, for `autoshovel drive` to run against.
+model of docs/machine-link.md, for `autoshovel drive` to run against.
 
 Usage: ua_plc.py PORT PKI_ROOT PASSWORD X Y THETA [--wrong-type NODE] [--nan NODE]
 

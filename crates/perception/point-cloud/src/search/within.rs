@@ -126,8 +126,9 @@ pub(super) fn smallest(isa: Isa, bits: &mut [u32], k: usize) {
         "k = {k} of {} distances",
         bits.len()
     );
+    // (the portable path asks no network: no call on its queries)
     #[cfg(target_arch = "x86_64")]
-    let sorted = sort_by_network(isa, bits);
+    let sorted = isa.avx2().is_some() && sort_by_network(isa, bits);
     #[cfg(not(target_arch = "x86_64"))]
     let sorted = false;
     if !sorted {

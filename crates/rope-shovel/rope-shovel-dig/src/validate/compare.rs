@@ -4,7 +4,7 @@
 //! difference, Pearson's r, R² and a fitted gain, and the rows of Table 6
 //! (dug mass and dig time, planned and measured, relative deviation).
 //!
-//! Definitions (docs/dig.md, "Planned against measured"):
+//! Definitions (docs/rope-shovel-dig.md, "Planned against measured"):
 //!
 //! - R² is the coefficient of determination of the measurement by the plan,
 //!   1 − Σ(m − p)² / Σ(m − m̄)², with the plan as the prediction as it
