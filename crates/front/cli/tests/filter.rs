@@ -116,16 +116,63 @@ fn bad_stages_and_outputs_are_refused_by_name_with_nothing_written() {
     let input = scan(&dir);
     let before = std::fs::read(&input).unwrap();
     let output = dir.path().join("out.pcd");
-    let cases: [(&[&str], &str); 5] = [
+    // Issue 46: errors speak in the flag's terms (never the library's
+    // `leaf_m[0]`, `std_mul`), work past the ceiling is refused with the
+    // estimate before any is done, numbers print short, and an encoding
+    // the output's format lacks is refused, not written as another.
+    let cases: [(&[&str], &str); 12] = [
         (&["--pass", "w:0:1"], "--pass w:0:1: axis 'w'"),
         (&["--statistical", "50"], "--statistical 50: 1 parts"),
-        (&["--voxel", "0"], "voxel"),
+        (&["--voxel", "0"], "--voxel 0: LEAF must be positive"),
+        (
+            &["--voxel", "0.1,0,0.1"],
+            "--voxel 0.1,0,0.1: LY must be positive",
+        ),
+        (
+            &["--statistical", "0,1"],
+            "--statistical 0,1: K must be at least 1",
+        ),
+        (
+            &["--pass", "z:5:1e308"],
+            "--pass z:5:1e308: removed every point (40000 in, 0 out): widen MIN:MAX",
+        ),
+        (
+            &["--statistical", "999999,1"],
+            "--statistical 999999,1 asks too much: 40000 nearest neighbours a point",
+        ),
+        (
+            &["--radius", "100,500000"],
+            "--radius 100,500000 asks too much",
+        ),
+        (
+            &["--voxel", "0.1", "--encoding", "ascii", "--as", "x.las"],
+            "--encoding ascii is not an encoding of",
+        ),
+        (
+            &[
+                "--voxel",
+                "0.1",
+                "--encoding",
+                "binary-compressed",
+                "--as",
+                "x.xyz",
+            ],
+            "(xyz: its one encoding is ascii)",
+        ),
         (&[], "no stage given"),
         (&["--voxel", "0.1", "--same"], "is the input"),
     ];
     for (extra, needle) in cases {
         let same = extra.contains(&"--same");
-        let target = if same { input.clone() } else { output.clone() };
+        let named = extra
+            .iter()
+            .position(|a| *a == "--as")
+            .map(|i| dir.path().join(extra[i + 1]));
+        let target = match (same, &named) {
+            (true, _) => input.clone(),
+            (_, Some(n)) => n.clone(),
+            _ => output.clone(),
+        };
         let mut args: Vec<String> = vec![
             "filter".into(),
             "--input".into(),
@@ -133,19 +180,44 @@ fn bad_stages_and_outputs_are_refused_by_name_with_nothing_written() {
             "--output".into(),
             target.display().to_string(),
         ];
-        args.extend(
-            extra
-                .iter()
-                .filter(|a| **a != "--same")
-                .map(|a| a.to_string()),
-        );
+        let mut skip = false;
+        for a in extra {
+            if std::mem::take(&mut skip) || *a == "--same" {
+                continue;
+            }
+            skip = *a == "--as";
+            if !skip {
+                args.push(a.to_string());
+            }
+        }
         let r = run(&args).fails();
         assert!(
             r.error_message().contains(needle),
             "{extra:?}: {}",
             r.error_message()
         );
+        assert!(r.error_message().len() < 400, "{}", r.error_message());
         assert!(!output.exists(), "{extra:?} wrote {}", output.display());
+        if let Some(n) = named {
+            assert!(!n.exists(), "{extra:?} wrote {}", n.display());
+        }
     }
     assert_eq!(std::fs::read(&input).unwrap(), before);
+    // A write that fails names the user's target, never a temporary name.
+    let blocked = input.join("x.pcd");
+    let r = run(&[
+        "filter",
+        "--input",
+        input.to_str().unwrap(),
+        "--output",
+        blocked.to_str().unwrap(),
+        "--voxel",
+        "0.1",
+    ])
+    .fails();
+    let m = r.error_message();
+    assert!(
+        m.contains(&format!("cannot write {}", blocked.display())) && !m.contains(".autoshovel"),
+        "{m}"
+    );
 }

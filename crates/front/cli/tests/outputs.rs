@@ -90,6 +90,36 @@ fn no_job_writes_onto_its_input_even_forced() {
             "the scan is untouched"
         );
     }
+    // Issue 46: links planted in the output folder under every staging
+    // name an earlier autoshovel used (`.autoshovel-staging-PID-N`, for the
+    // next pids) and pointing at the input's folder steer no write: the
+    // staging folder is made new under a random name.
+    let atk = tmp.path().join("atk");
+    std::fs::create_dir_all(&atk).unwrap();
+    let next = std::fs::read_to_string("/proc/sys/kernel/ns_last_pid")
+        .ok()
+        .and_then(|t| t.trim().parse::<u64>().ok())
+        .unwrap_or(1);
+    for pid in next..next + 200 {
+        for n in 0..2 {
+            let link = atk.join(format!(".autoshovel-staging-{pid}-{n}"));
+            std::os::unix::fs::symlink(tmp.path(), link).unwrap();
+        }
+    }
+    let a = atk.to_str().unwrap();
+    run(&args(&["perceive", "--input", s, "--out", a])).ok();
+    assert_eq!(
+        std::fs::read(&scan).unwrap(),
+        before,
+        "the input is byte-identical"
+    );
+    assert!(atk.join("summary.json").is_file());
+    let links = std::fs::read_dir(&atk)
+        .unwrap()
+        .flatten()
+        .filter(|e| e.file_type().unwrap().is_symlink())
+        .count();
+    assert_eq!(links, 400, "the planted links are left as they were");
     // A warm-start pack read from the folder it would be written to.
     let out = tmp.path().join("dig");
     let o = out.to_str().unwrap();

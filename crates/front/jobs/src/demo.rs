@@ -373,12 +373,12 @@ fn perception(p: &mut Place, r: &mut Report) -> Result<()> {
             &scan,
             &[],
             (&p.ours, p.force),
-            |p| {
-                autoshovel_point_cloud::io::write(
-                    p,
-                    &cloud,
-                    autoshovel_point_cloud::io::Encoding::Binary,
-                )?;
+            |scratch, target| {
+                let options = autoshovel_point_cloud::io::WriteOptions {
+                    encoding: Some(autoshovel_point_cloud::io::Encoding::Binary),
+                    ..Default::default()
+                };
+                autoshovel_point_cloud::io::write_named(scratch, target, &cloud, &options)?;
                 Ok(())
             },
         )?;

@@ -5,7 +5,7 @@
 
 use std::path::{Path, PathBuf};
 
-use autoshovel_point_cloud::io::{read, write, Encoding};
+use autoshovel_point_cloud::io::{read, write_named, Encoding, WriteOptions};
 use autoshovel_point_cloud::PointCloud;
 use autoshovel_terrain::chain::{run_chain, FilterSummary, Stage};
 
@@ -27,12 +27,49 @@ pub fn write_cloud(
         path,
         inputs,
         (&Default::default(), force),
-        |p| {
-            write(p, cloud, encoding)?;
+        |scratch, target| {
+            let options = WriteOptions {
+                encoding: Some(encoding),
+                ..WriteOptions::default()
+            };
+            write_named(scratch, target, cloud, &options)?;
             Ok(())
         },
     )?;
     Ok(encoding)
+}
+
+/// Refuses, before any work, an `--encoding` the output's format does not
+/// have (a text file is ascii, LAS/LAZ binary): a writer reports only
+/// what it wrote.
+fn check_encoding(output: &Path, encoding: Option<Encoding>) -> Result<()> {
+    let Some(e) = encoding else { return Ok(()) };
+    let format = autoshovel_point_cloud::io::Format::from_path(output)?;
+    let has = format.encodings();
+    let fixed = match format {
+        autoshovel_point_cloud::io::Format::Las | autoshovel_point_cloud::io::Format::Laz => {
+            Encoding::Binary
+        }
+        _ => Encoding::Ascii,
+    };
+    if has.contains(&e) || (has.is_empty() && e == fixed) {
+        return Ok(());
+    }
+    let choices = if has.is_empty() {
+        format!("its one encoding is {fixed}")
+    } else {
+        let names: Vec<_> = has.iter().map(|e| e.name()).collect();
+        format!("use {}", names.join(", "))
+    };
+    Err(JobError::setting(
+        "--encoding",
+        e,
+        format!(
+            "is not an encoding of {} ({}: {choices})",
+            output.display(),
+            format.extension()
+        ),
+    ))
 }
 
 /// `filter`: `stages` in order on the cloud of `input`, the result written
@@ -57,6 +94,7 @@ pub fn filter(
             "is the input: write the filtered cloud elsewhere",
         ));
     }
+    check_encoding(output, encoding)?;
     let bar = progress_bar(progress, "reading [{bar:40}] {bytes}/{total_bytes} ({eta})");
     let t0 = std::time::Instant::now();
     let got = read(input, &mut |done, total| {

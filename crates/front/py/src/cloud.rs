@@ -62,7 +62,15 @@ fn write_cloud(
             &path,
             &[],
             (&Default::default(), overwrite),
-            |p| Ok(autoshovel_point_cloud::io::write(p, &cloud, encoding)?),
+            |scratch, target| {
+                let options = autoshovel_point_cloud::io::WriteOptions {
+                    encoding: Some(encoding),
+                    ..Default::default()
+                };
+                Ok(autoshovel_point_cloud::io::write_named(
+                    scratch, target, &cloud, &options,
+                )?)
+            },
         )
     })
     .map_err(|e| match e {

@@ -53,7 +53,8 @@ pub use crate::layout::{
 pub use crate::panels::{finite_range, markdown_table, rating_line, time_panel, Line};
 pub use crate::render::{write_figure, write_panels, MAX_MARKER_PX, MAX_STROKE_PX};
 pub use crate::staging::{
-    files_written_before, refusal, remove_unfinished, write_file_atomically, OutDir, Staging,
+    files_written_before, private_dir, refusal, remove_unfinished, without_path,
+    write_file_atomically, OutDir, Staging,
 };
 pub use crate::style::{viridis, Rgb, Stroke};
 pub use crate::written::{summary_value, write_job_summary, WithFiles, Written};

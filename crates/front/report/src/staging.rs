@@ -9,10 +9,15 @@
 //! through), or when it exists and autoshovel did not write it: the files
 //! autoshovel wrote are those the folder's previous `summary.json` lists.
 //! `force` lifts the second refusal, never the first.
+//!
+//! Staging folders are made by [`private_dir`]: `mkdir` under a random
+//! name, which fails on any existing entry (a planted link included)
+//! rather than going through it, so nothing can steer a job's writes
+//! into another folder. Errors name the user's target, never a staging
+//! path.
 
 use std::collections::HashSet;
 use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
 
 use crate::error::ReportError;
 use crate::json::SUMMARY_FILE;
@@ -103,7 +108,34 @@ pub struct Staging {
     tmp: PathBuf,
 }
 
-static STAGED: AtomicU64 = AtomicU64::new(0);
+/// Random characters in a staging folder's name (62 symbols each: 71
+/// bits, beyond guessing).
+const RANDOM_CHARS: usize = 12;
+
+/// Creates a new folder `.autoshovel-TAG-RANDOM` inside `dir`, readable by
+/// its owner only. Made by one `mkdir`, which refuses an existing entry of
+/// that name (a file, a folder or a link planted there) instead of going
+/// through it, under a name nobody can predict; tempfile retries on a
+/// clash. By hand it would be the same loop over `create_dir` and a
+/// random source, which tempfile already is.
+pub fn private_dir(dir: &Path, tag: &str) -> std::io::Result<PathBuf> {
+    let prefix = format!(".autoshovel-{tag}-");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).rand_bytes(RANDOM_CHARS);
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o700));
+    let made = builder.tempdir_in(dir).map_err(without_path)?;
+    Ok(made.keep())
+}
+
+/// The operating system's error without the path tempfile appends (the
+/// caller names the user's target, never the temporary name).
+pub fn without_path(e: std::io::Error) -> std::io::Error {
+    match e.raw_os_error() {
+        Some(code) => std::io::Error::from_raw_os_error(code),
+        None => std::io::Error::from(e.kind()),
+    }
+}
 
 /// Staging folders and temporary files not yet committed or removed, for
 /// [`remove_unfinished`].
@@ -149,12 +181,8 @@ impl OutDir {
             });
         }
         std::fs::create_dir_all(&self.dir).map_err(|e| ReportError::io(&self.dir, e))?;
-        let n = STAGED.fetch_add(1, Ordering::Relaxed);
-        let tmp = self
-            .dir
-            .join(format!(".autoshovel-staging-{}-{n}", std::process::id()));
+        let tmp = private_dir(&self.dir, "staging").map_err(|e| ReportError::io(&self.dir, e))?;
         unfinished().push(tmp.clone());
-        std::fs::create_dir_all(&tmp).map_err(|e| ReportError::io(&tmp, e))?;
         Ok(Staging {
             out: self.clone(),
             tmp,
@@ -203,15 +231,17 @@ impl Drop for Staging {
     }
 }
 
-/// Writes one file at `target` through a temporary file beside it (the
-/// same extension, so format-by-extension writers work) and a rename,
-/// after checking `target` against the rule (module docs); `ours` are the
-/// files autoshovel wrote before and may replace.
+/// Writes one file at `target` through a private folder beside it
+/// ([`private_dir`]) and a rename, after checking `target` against the rule
+/// (module docs); `ours` are the files autoshovel wrote before and may
+/// replace. `write(scratch, target)` writes the file at `scratch` (the
+/// target's name, so format-by-extension writers work) and names `target`
+/// in its errors; every error names `target`, never the scratch path.
 pub fn write_file_atomically<E: From<ReportError>>(
     target: &Path,
     inputs: &[PathBuf],
     (ours, force): (&HashSet<PathBuf>, bool),
-    write: impl FnOnce(&Path) -> Result<(), E>,
+    write: impl FnOnce(&Path, &Path) -> Result<(), E>,
 ) -> Result<(), E> {
     if let Some(why) = refusal(target, inputs, ours, force) {
         return Err(ReportError::Refused {
@@ -220,29 +250,19 @@ pub fn write_file_atomically<E: From<ReportError>>(
         }
         .into());
     }
-    // A missing folder is the target's error, not the temporary file's.
-    if let Some(parent) = target.parent().filter(|p| !p.as_os_str().is_empty()) {
-        if let Err(e) = std::fs::metadata(parent) {
-            return Err(ReportError::io(target, e).into());
-        }
-    }
-    let name = target
-        .file_name()
-        .map(|n| n.to_string_lossy().into_owned())
-        .unwrap_or_default();
-    let tmp = target.with_file_name(format!(".autoshovel-{}-{name}", std::process::id()));
-    unfinished().push(tmp.clone());
-    let result = write(&tmp);
-    if result.is_ok() {
-        if let Err(e) = std::fs::rename(&tmp, target) {
-            let _ = std::fs::remove_file(&tmp);
-            finished(&tmp);
-            return Err(ReportError::io(target, e).into());
-        }
-    } else {
-        let _ = std::fs::remove_file(&tmp);
-    }
-    finished(&tmp);
+    let parent = match target.parent() {
+        Some(p) if !p.as_os_str().is_empty() => p,
+        _ => Path::new("."),
+    };
+    // A missing or unwritable folder is the target's error.
+    let scratch = private_dir(parent, "write").map_err(|e| ReportError::io(target, e))?;
+    unfinished().push(scratch.clone());
+    let name = target.file_name().unwrap_or(target.as_os_str());
+    let result = write(&scratch.join(name), target).and_then(|()| {
+        std::fs::rename(scratch.join(name), target).map_err(|e| ReportError::io(target, e).into())
+    });
+    let _ = std::fs::remove_dir_all(&scratch);
+    finished(&scratch);
     result
 }
 
@@ -317,20 +337,63 @@ mod tests {
     }
 
     #[test]
+    fn staging_folders_are_new_private_folders_under_random_names() {
+        let d = tmpdir("private");
+        let out = OutDir::new(&d);
+        let (a, b) = (out.stage().unwrap(), out.stage().unwrap());
+        for s in [&a, &b] {
+            let meta = std::fs::symlink_metadata(s.path()).unwrap();
+            assert!(meta.is_dir() && !meta.file_type().is_symlink());
+            #[cfg(unix)]
+            {
+                use std::os::unix::fs::PermissionsExt;
+                assert_eq!(meta.permissions().mode() & 0o077, 0, "owner only");
+            }
+            let name = s.path().file_name().unwrap().to_string_lossy().into_owned();
+            let random = name.trim_start_matches(".autoshovel-staging-");
+            assert_eq!(random.len(), RANDOM_CHARS, "{name}");
+            assert!(!random.contains(&std::process::id().to_string()), "{name}");
+        }
+        assert_ne!(a.path(), b.path());
+        drop((a, b));
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
+    fn a_failed_write_names_the_target_not_the_scratch_file() {
+        let d = tmpdir("names");
+        std::fs::write(d.join("file"), "x").unwrap();
+        // Its folder is a file: nothing can be made beside the target.
+        let target = d.join("file").join("out.pcd");
+        let e =
+            write_file_atomically::<ReportError>(&target, &[], (&HashSet::new(), false), |_, _| {
+                Ok(())
+            })
+            .unwrap_err();
+        let chain = format!("{e}: {}", std::error::Error::source(&e).unwrap());
+        assert!(
+            chain.starts_with(&format!("cannot write {}", target.display())),
+            "{chain}"
+        );
+        assert!(!chain.contains(".autoshovel"), "{chain}");
+        let _ = std::fs::remove_dir_all(&d);
+    }
+
+    #[test]
     fn a_lone_file_is_written_whole_or_not_at_all() {
         let d = tmpdir("lone");
         let f = d.join("pile.pcd");
-        write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), false), |p| {
+        write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), false), |p, _| {
             std::fs::write(p, "1").map_err(|e| ReportError::io(p, e))
         })
         .unwrap();
-        let e = write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), false), |p| {
+        let e = write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), false), |p, _| {
             std::fs::write(p, "2").map_err(|e| ReportError::io(p, e))
         })
         .unwrap_err();
         assert!(e.to_string().contains("--force"), "{e}");
         assert_eq!(std::fs::read_to_string(&f).unwrap(), "1");
-        let e = write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), true), |_| {
+        let e = write_file_atomically::<ReportError>(&f, &[], (&HashSet::new(), true), |_, _| {
             Err(ReportError::invalid("failed half-way"))
         })
         .unwrap_err();

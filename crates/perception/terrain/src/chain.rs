@@ -31,11 +31,14 @@ use autoshovel_point_cloud::filter::{
     OutlierSides, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
     VoxelGridParams,
 };
-use autoshovel_point_cloud::PointCloud;
+use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::Serialize;
+
+use autoshovel_core::config::{approx, short};
 
 use crate::calibrate::level;
 use crate::error::{Result, SurfaceError};
+use crate::perceive::MAX_NEIGHBOUR_VISITS;
 
 /// The kinds of stage, by their command-line flag.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
@@ -240,22 +243,124 @@ impl Stage {
         }
     }
 
-    /// Run the stage on `cloud`; a filter's refusal is
-    /// [`SurfaceError::Filter`] naming the stage.
+    /// Run the stage on `cloud`, after [`Stage::check_work`]; a filter's
+    /// refusal is [`SurfaceError::StageFailed`] in the flag's own terms.
     pub fn apply(&self, cloud: &PointCloud) -> Result<PointCloud> {
-        let stage = self.kind().flag();
-        let filter = |source| SurfaceError::Filter { stage, source };
+        self.check_work(cloud)?;
+        let flag = |e| self.flag_error(e);
         match self {
-            Stage::Voxel(p) => voxel_grid(cloud, p).map_err(filter),
-            Stage::Statistical(p) => statistical_outlier_removal(cloud, p).map_err(filter),
-            Stage::Radius(p) => radius_outlier_removal(cloud, p).map_err(filter),
-            Stage::Pass(p) => pass_through(cloud, p).map_err(filter),
+            Stage::Voxel(p) => voxel_grid(cloud, p).map_err(flag),
+            Stage::Statistical(p) => statistical_outlier_removal(cloud, p).map_err(flag),
+            Stage::Radius(p) => radius_outlier_removal(cloud, p).map_err(flag),
+            Stage::Pass(p) => pass_through(cloud, p).map_err(flag),
             Stage::Level {
                 roll_deg,
                 pitch_deg,
             } => Ok(level(cloud, roll_deg.to_radians(), pitch_deg.to_radians())),
         }
     }
+
+    /// Refuses, before any work, a value whose neighbour searches would
+    /// cost more than [`MAX_NEIGHBOUR_VISITS`] per point on `cloud` (the
+    /// ceiling `perceive` applies to its own filters): K nearest
+    /// neighbours, or the neighbours within the radius of a surface at the
+    /// cloud's own spacing (its largest face's area over its points).
+    pub fn check_work(&self, cloud: &PointCloud) -> Result<()> {
+        let n = cloud.len() as f64;
+        let (visits, how) = match self {
+            Stage::Statistical(p) => {
+                let k = (p.mean_k as f64).min(n);
+                (k, format!("{} nearest neighbours a point", approx(k)))
+            }
+            Stage::Radius(p) => {
+                let Some(spacing) = own_spacing(cloud) else {
+                    return Ok(());
+                };
+                let k = (std::f64::consts::PI * (p.radius_m / spacing).powi(2)).min(n);
+                (
+                    k,
+                    format!(
+                        "about {} neighbours within {} m of a point at this cloud's spacing of {} m",
+                        approx(k),
+                        short(p.radius_m),
+                        approx(spacing)
+                    ),
+                )
+            }
+            _ => return Ok(()),
+        };
+        if visits <= MAX_NEIGHBOUR_VISITS {
+            return Ok(());
+        }
+        Err(SurfaceError::StageTooMuchWork {
+            flag: self.kind().flag(),
+            spec: self.spec(),
+            estimate: format!(
+                "{how}, {} neighbour visits for the {n} points",
+                approx(visits * n)
+            ),
+            ceiling: format!("{} a point", approx(MAX_NEIGHBOUR_VISITS)),
+        })
+    }
+
+    /// A filter's error in the flag's terms: its parameter names become
+    /// the parts of the flag's value, its hint the change to the value.
+    fn flag_error(&self, e: CloudError) -> SurfaceError {
+        // The filters' parameter names and the flag's parts for them.
+        const PARTS: [(&str, &str); 8] = [
+            ("mean_k", "K"),
+            ("std_mul", "ALPHA"),
+            ("radius_m", "RADIUS"),
+            ("min_neighbors", "MIN_NEIGHBOURS"),
+            ("min_m", "MIN"),
+            ("max_m", "MAX"),
+            ("keep_inside", "':outside'"),
+            ("leaf_m", "LEAF"),
+        ];
+        let problem = match e {
+            CloudError::Emptied { input, .. } => format!(
+                "removed every point ({input} in, 0 out): {}",
+                match self.kind() {
+                    StageKind::Pass => "widen MIN:MAX, check the axis, or add :outside",
+                    StageKind::Statistical => "raise ALPHA",
+                    StageKind::Radius => "lower MIN_NEIGHBOURS or raise RADIUS",
+                    _ => "check the previous stage",
+                }
+            ),
+            CloudError::BadParameter { what, .. } => {
+                let axes = match self {
+                    Stage::Voxel(p) if p.leaf_m[0] == p.leaf_m[1] && p.leaf_m[1] == p.leaf_m[2] => {
+                        ["LEAF"; 3]
+                    }
+                    _ => ["LX", "LY", "LZ"],
+                };
+                let what = (0..3).fold(what, |w, a| w.replace(&format!("leaf_m[{a}]"), axes[a]));
+                PARTS.iter().fold(what, |w, (from, to)| w.replace(from, to))
+            }
+            other => {
+                return SurfaceError::Filter {
+                    stage: self.kind().flag(),
+                    source: other,
+                }
+            }
+        };
+        SurfaceError::StageFailed {
+            flag: self.kind().flag(),
+            spec: self.spec(),
+            problem,
+        }
+    }
+}
+
+/// A surface's point spacing (m): the square root of the largest face of
+/// the cloud's bounding box over its points (a wall or a flat pile alike);
+/// `None` for fewer than two points or no extent.
+fn own_spacing(cloud: &PointCloud) -> Option<f64> {
+    let (lo, hi) = cloud.bounds()?;
+    let e = [0, 1, 2].map(|a| f64::from(hi[a]) - f64::from(lo[a]));
+    let face = (e[0] * e[1]).max(e[0] * e[2]).max(e[1] * e[2]);
+    let s = (face / cloud.len() as f64).sqrt();
+    (cloud.len() > 1 && s.is_finite() && s > 0.0).then_some(s)
 }
 
 /// Run `stages` on `cloud` in order: the result and what each stage did
@@ -283,14 +388,19 @@ impl Stage {
     pub fn spec(&self) -> String {
         match self {
             Stage::Voxel(p) if p.leaf_m[0] == p.leaf_m[1] && p.leaf_m[1] == p.leaf_m[2] => {
-                format!("{}", p.leaf_m[0])
+                short(p.leaf_m[0])
             }
-            Stage::Voxel(p) => format!("{},{},{}", p.leaf_m[0], p.leaf_m[1], p.leaf_m[2]),
+            Stage::Voxel(p) => format!(
+                "{},{},{}",
+                short(p.leaf_m[0]),
+                short(p.leaf_m[1]),
+                short(p.leaf_m[2])
+            ),
             Stage::Statistical(p) => match p.sides {
-                OutlierSides::Above => format!("{},{}", p.mean_k, p.std_mul),
-                OutlierSides::Both => format!("{},{},both", p.mean_k, p.std_mul),
+                OutlierSides::Above => format!("{},{}", p.mean_k, short(p.std_mul)),
+                OutlierSides::Both => format!("{},{},both", p.mean_k, short(p.std_mul)),
             },
-            Stage::Radius(p) => format!("{},{}", p.radius_m, p.min_neighbors),
+            Stage::Radius(p) => format!("{},{}", short(p.radius_m), p.min_neighbors),
             Stage::Pass(p) => {
                 let axis = match p.axis {
                     Axis::X => "x",
@@ -298,12 +408,12 @@ impl Stage {
                     Axis::Z => "z",
                 };
                 let side = if p.keep_inside { "" } else { ":outside" };
-                format!("{axis}:{}:{}{side}", p.min_m, p.max_m)
+                format!("{axis}:{}:{}{side}", short(p.min_m), short(p.max_m))
             }
             Stage::Level {
                 roll_deg,
                 pitch_deg,
-            } => format!("{roll_deg},{pitch_deg}"),
+            } => format!("{},{}", short(*roll_deg), short(*pitch_deg)),
         }
     }
 }

@@ -109,6 +109,30 @@ pub enum SurfaceError {
         /// What a value looks like.
         syntax: &'static str,
     },
+    /// A filter-chain stage refused its value or emptied the cloud
+    /// (`autoshovel filter`), said in the flag's own terms.
+    #[error("--{flag} {spec}: {problem}")]
+    StageFailed {
+        /// The stage's flag, without dashes.
+        flag: &'static str,
+        /// The value given.
+        spec: String,
+        /// What went wrong and what to change, in the flag's terms.
+        problem: String,
+    },
+    /// A filter-chain stage's value sizes more work than the ceiling
+    /// (checked before any work).
+    #[error("--{flag} {spec} asks too much: {estimate}; the ceiling is {ceiling}")]
+    StageTooMuchWork {
+        /// The stage's flag, without dashes.
+        flag: &'static str,
+        /// The value given.
+        spec: String,
+        /// The work it implies on this cloud.
+        estimate: String,
+        /// The ceiling.
+        ceiling: String,
+    },
     /// A filter stage of the perception pipeline failed.
     #[error("{stage} filter")]
     Filter {

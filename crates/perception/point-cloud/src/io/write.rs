@@ -3,10 +3,8 @@
 //! the target, so a crash or an error never leaves a half-written file
 //! under the target's name.
 
-use std::fs::{self, File, OpenOptions};
 use std::io::BufWriter;
-use std::path::{Path, PathBuf};
-use std::sync::atomic::{AtomicU64, Ordering};
+use std::path::Path;
 
 use super::{las, pcd, ply, xyz, Encoding, Format, LasVersion};
 use crate::{CloudError, PointCloud};
@@ -42,6 +40,19 @@ pub fn write(path: &Path, cloud: &PointCloud, encoding: Encoding) -> crate::Resu
 
 /// [`write()`] with every option.
 pub fn write_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -> crate::Result<()> {
+    write_named(path, path, cloud, options)
+}
+
+/// [`write_with`] to `dest`, in the format of `name`'s extension, naming
+/// `name` in every error: what a caller writing through a scratch file
+/// uses so that errors name the user's target.
+pub fn write_named(
+    dest: &Path,
+    name: &Path,
+    cloud: &PointCloud,
+    options: &WriteOptions,
+) -> crate::Result<()> {
+    let path = name;
     let format = Format::from_path(path)?;
     let encoding = options
         .encoding
@@ -57,14 +68,21 @@ pub fn write_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -> cr
         (Format::Ply, Encoding::BinaryCompressed) => {
             return Err(bad("PLY has no binary_compressed encoding (use ascii, binary_little_endian or binary_big_endian)".into()))
         }
+        // What a writer reports is what it wrote: the text formats are
+        // text, LAS and LAZ binary, whatever was asked.
+        (Format::Xyz | Format::Csv | Format::Txt, e) if e != Encoding::Ascii => {
+            return Err(bad(format!("{} is a text format: it has no {e} encoding (use ascii, or write .pcd or .ply)", format.extension())))
+        }
+        (Format::Las | Format::Laz, e) if e != Encoding::Binary => {
+            return Err(bad(format!("{} has one encoding, binary: there is no {e} (use .pcd or .ply for {e})", format.extension())))
+        }
         _ => {}
     }
     let io = |source: std::io::Error| CloudError::Io {
         path: path.to_path_buf(),
         source,
     };
-    let (tmp_path, file) = create_temp(path).map_err(io)?;
-    let guard = TempFile(Some(tmp_path));
+    let (file, guard) = create_temp(dest).map_err(io)?.into_parts();
     let points = &cloud.points;
     let mut w = BufWriter::with_capacity(BUFFER, file);
     let file = match format {
@@ -90,51 +108,33 @@ pub fn write_with(path: &Path, cloud: &PointCloud, options: &WriteOptions) -> cr
     };
     file.sync_all().map_err(io)?;
     drop(file);
-    guard.persist(path).map_err(io)
+    guard.persist(dest).map_err(|e| io(e.error))
 }
 
-/// A temporary file removed on drop unless persisted.
-struct TempFile(Option<PathBuf>);
-
-impl TempFile {
-    fn persist(mut self, to: &Path) -> std::io::Result<()> {
-        let from = self.0.take().expect("persisted once");
-        match fs::rename(&from, to) {
-            Ok(()) => Ok(()),
-            Err(e) => {
-                let _ = fs::remove_file(&from);
-                Err(e)
-            }
-        }
-    }
-}
-
-impl Drop for TempFile {
-    fn drop(&mut self) {
-        if let Some(p) = self.0.take() {
-            let _ = fs::remove_file(p);
-        }
-    }
-}
-
-/// Creates `.NAME.PID.N.tmp` beside `path`.
-fn create_temp(path: &Path) -> std::io::Result<(PathBuf, File)> {
-    static COUNTER: AtomicU64 = AtomicU64::new(0);
+/// A new file `.NAME.RANDOM.tmp` beside `path`, made exclusively (never
+/// through an existing entry) and removed on drop unless persisted.
+fn create_temp(path: &Path) -> std::io::Result<tempfile::NamedTempFile> {
     let dir = match path.parent() {
-        Some(d) if !d.as_os_str().is_empty() => d.to_path_buf(),
-        _ => PathBuf::from("."),
+        Some(d) if !d.as_os_str().is_empty() => d,
+        _ => Path::new("."),
     };
     let name = path
         .file_name()
         .map(|n| n.to_string_lossy().into_owned())
         .unwrap_or_default();
-    loop {
-        let n = COUNTER.fetch_add(1, Ordering::Relaxed);
-        let tmp = dir.join(format!(".{name}.{}.{n}.tmp", std::process::id()));
-        match OpenOptions::new().write(true).create_new(true).open(&tmp) {
-            Ok(f) => return Ok((tmp, f)),
-            Err(e) if e.kind() == std::io::ErrorKind::AlreadyExists => continue,
-            Err(e) => return Err(e),
-        }
-    }
+    let prefix = format!(".{name}.");
+    let mut builder = tempfile::Builder::new();
+    builder.prefix(&prefix).suffix(".tmp");
+    // The mode any new file gets (0666 less the umask), not tempfile's
+    // private 0600: the temporary file becomes the user's output.
+    #[cfg(unix)]
+    builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o666));
+    // tempfile appends the temporary path to its errors: the caller
+    // names the user's target instead.
+    builder
+        .tempfile_in(dir)
+        .map_err(|e| match e.raw_os_error() {
+            Some(code) => std::io::Error::from_raw_os_error(code),
+            None => std::io::Error::from(e.kind()),
+        })
 }

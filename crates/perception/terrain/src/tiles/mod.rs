@@ -948,17 +948,18 @@ fn elapsed_ms(t: Instant) -> f64 {
     t.elapsed().as_secs_f64() * 1e3
 }
 
+/// The tiles' spill folder in `dir`: made by one `mkdir` under a random
+/// name (never through an existing entry), removed on drop.
 fn tempdir_in(dir: &Path) -> Result<WorkDir> {
-    let stamp = std::time::SystemTime::now()
-        .duration_since(std::time::UNIX_EPOCH)
-        .map(|d| d.as_nanos())
-        .unwrap_or(0);
-    let path = dir.join(format!(".autoshovel-tiles-{}-{stamp}", std::process::id()));
-    fs::create_dir_all(&path).map_err(|source| SurfaceError::Spill {
-        path: path.clone(),
-        source,
-    })?;
-    Ok(WorkDir(path))
+    let made = tempfile::Builder::new()
+        .prefix(".autoshovel-tiles-")
+        .rand_bytes(12)
+        .tempdir_in(dir)
+        .map_err(|source| SurfaceError::Spill {
+            path: dir.to_path_buf(),
+            source,
+        })?;
+    Ok(WorkDir(made.keep()))
 }
 
 /// The grid of tiles over the levelled box of the raw bounds `lo`–`hi`.
