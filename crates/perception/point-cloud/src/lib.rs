@@ -11,8 +11,10 @@
 //! place the house rule "f64 everywhere" gives way; everything computed from
 //! a cloud (fits, calibration, volumes) is f64.
 
+pub mod attributes;
 mod cloud;
 mod error;
+pub mod georef;
 pub mod filter;
 pub mod io;
 mod prefault;
@@ -21,5 +23,7 @@ pub mod simd;
 #[cfg(test)]
 mod testing;
 
+pub use attributes::{Attributes, Column, Values};
 pub use cloud::{Point, PointCloud};
+pub use georef::{Crs, Georef, LasLayout, Unit};
 pub use error::{CloudError, Result};

@@ -96,7 +96,7 @@ pub fn angles_from_normal(normal: [f64; 3]) -> Option<(f64, f64)> {
 pub(crate) fn rotate(cloud: &[Point], r: &Matrix3<f64>) -> PointCloud {
     use rayon::prelude::*;
     let points = cloud.par_iter().map(|p| rotate_point(r, p)).collect();
-    PointCloud { points }
+    PointCloud::new(points)
 }
 
 /// One point of [`rotate`]: `r · p` in f64, stored as f32.

@@ -27,9 +27,9 @@
 use std::time::Instant;
 
 use autoshovel_point_cloud::filter::{
-    pass_through, radius_outlier_removal, statistical_outlier_removal, voxel_grid, Axis,
-    OutlierSides, PassThroughParams, RadiusOutlierParams, StatisticalOutlierParams,
-    VoxelGridParams,
+    pass_through_indices, radius_outlier_removal_indices, statistical_outlier_removal_indices,
+    voxel_grid_nearest, Axis, OutlierSides, PassThroughParams, RadiusOutlierParams,
+    StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::Serialize;
@@ -248,16 +248,39 @@ impl Stage {
     pub fn apply(&self, cloud: &PointCloud) -> Result<PointCloud> {
         self.check_work(cloud)?;
         let flag = |e| self.flag_error(e);
-        match self {
-            Stage::Voxel(p) => voxel_grid(cloud, p).map_err(flag),
-            Stage::Statistical(p) => statistical_outlier_removal(cloud, p).map_err(flag),
-            Stage::Radius(p) => radius_outlier_removal(cloud, p).map_err(flag),
-            Stage::Pass(p) => pass_through(cloud, p).map_err(flag),
+        // Removal keeps the same rows of every column; a voxel's centroid
+        // takes the attributes of the point nearest it.
+        let rows = match self {
+            Stage::Voxel(p) => {
+                let (centroids, nearest) = voxel_grid_nearest(cloud, p).map_err(flag)?;
+                return Ok(cloud.derived(centroids.points, Some(&nearest)));
+            }
+            Stage::Statistical(p) => statistical_outlier_removal_indices(cloud, p),
+            Stage::Radius(p) => radius_outlier_removal_indices(cloud, p),
+            Stage::Pass(p) => {
+                // MIN and MAX are in the file's frame, the points about
+                // the cloud's origin.
+                let o = cloud.origin[p.axis as usize];
+                let relative = PassThroughParams {
+                    min_m: p.min_m - o,
+                    max_m: p.max_m - o,
+                    ..*p
+                };
+                pass_through_indices(cloud, &relative)
+            }
             Stage::Level {
                 roll_deg,
                 pitch_deg,
-            } => Ok(level(cloud, roll_deg.to_radians(), pitch_deg.to_radians())),
-        }
+            } => {
+                // About the origin: the sensor for a scan in its own frame,
+                // the middle of the data for a survey (io::ORIGIN_FREE).
+                let turned = level(cloud, roll_deg.to_radians(), pitch_deg.to_radians());
+                let mut out = cloud.clone();
+                out.points = turned.points;
+                return Ok(out);
+            }
+        };
+        Ok(cloud.select(&rows.map_err(flag)?))
     }
 
     /// Refuses, before any work, a value whose neighbour searches would

@@ -580,7 +580,7 @@ pub fn generate_pile(params: &PileParams) -> Result<PointCloud> {
             [q.x as f32, q.y as f32, q.z as f32]
         })
         .collect();
-    Ok(PointCloud { points })
+    Ok(PointCloud::new(points))
 }
 
 /// The surface points of [`ScanPattern::Area`]: (x, y) uniform over the window,

@@ -255,9 +255,7 @@ impl World {
                 })
             })
             .collect();
-        PointCloud {
-            points: hits.into_iter().flatten().collect(),
-        }
+        PointCloud::new(hits.into_iter().flatten().collect())
     }
 
     /// The distance along the ray from `eye` in direction `d` (unit) to the

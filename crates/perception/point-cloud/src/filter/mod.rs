@@ -47,4 +47,4 @@ pub use statistical_outlier::{
     statistical_outlier_removal_indices, DistanceSums, OutlierCut, OutlierSides,
     StatisticalOutlierParams,
 };
-pub use voxel_grid::{voxel_grid, VoxelCells, VoxelGridParams};
+pub use voxel_grid::{voxel_grid, voxel_grid_nearest, VoxelCells, VoxelGridParams};

@@ -116,6 +116,46 @@ pub fn voxel_grid(cloud: &[Point], params: &VoxelGridParams) -> Result<PointClou
     Ok(PointCloud::new(centroids))
 }
 
+/// [`voxel_grid`], and for each centroid the input point nearest it (the
+/// first in input order on a tie): the row whose attributes the new point
+/// takes, as PDAL's `filters.voxelcentroidnearestneighbor` does. One value
+/// of one real point a voxel keeps a classification, a return number or a
+/// GPS time meaningful, where a mean of them would not be.
+pub fn voxel_grid_nearest(
+    cloud: &[Point],
+    params: &VoxelGridParams,
+) -> Result<(PointCloud, Vec<usize>)> {
+    let centroids = voxel_grid(cloud, params)?.points;
+    let cells = VoxelCells::new(params)?;
+    // The voxels in PCL's order (z slowest, x fastest), as the centroids.
+    let mut keys: Vec<([i64; 3], usize)> = cloud
+        .par_iter()
+        .enumerate()
+        .filter(|(_, p)| is_finite(p))
+        .map(|(i, p)| {
+            let c = cells.of(p);
+            ([c[2], c[1], c[0]], i)
+        })
+        .collect();
+    keys.par_sort_unstable();
+    let mut nearest = Vec::with_capacity(centroids.len());
+    let d2 = |p: &Point, c: &Point| -> f64 {
+        (0..3).map(|a| (f64::from(p[a]) - f64::from(c[a])).powi(2)).sum()
+    };
+    for run in keys.chunk_by(|a, b| a.0 == b.0) {
+        let Some(c) = centroids.get(nearest.len()) else {
+            break;
+        };
+        let best = run
+            .iter()
+            .map(|&(_, i)| (d2(&cloud[i], c), i))
+            .fold((f64::INFINITY, usize::MAX), |b, x| if x.0 < b.0 { x } else { b });
+        nearest.push(best.1);
+    }
+    debug_assert_eq!(nearest.len(), centroids.len(), "one run a voxel");
+    Ok((PointCloud::new(centroids), nearest))
+}
+
 /// Which way [`centroids`] went.
 #[derive(Debug, Clone, Copy, PartialEq, Eq)]
 enum Way {

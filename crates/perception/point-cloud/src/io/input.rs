@@ -279,9 +279,9 @@ impl<'s> Points<'s> {
     /// Keeps a finite point given in f64, less the origin; counts a
     /// non-finite one.
     #[inline]
-    pub(crate) fn push_f64(&mut self, x: f64, y: f64, z: f64) {
+    pub(crate) fn push_f64(&mut self, x: f64, y: f64, z: f64) -> bool {
         let o = self.origin;
-        self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32]);
+        self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32])
     }
 
     /// Drops the non-finite points from position `base` on (counting
@@ -304,14 +304,16 @@ impl<'s> Points<'s> {
         }
     }
 
-    /// Keeps a finite point, counts a non-finite one.
+    /// Keeps a finite point (true), counts a non-finite one (false).
     #[inline]
-    pub(crate) fn push(&mut self, p: Point) {
-        if p[0].is_finite() && p[1].is_finite() && p[2].is_finite() {
+    pub(crate) fn push(&mut self, p: Point) -> bool {
+        let finite = p[0].is_finite() && p[1].is_finite() && p[2].is_finite();
+        if finite {
             self.points.push(p);
         } else {
             self.non_finite += 1;
         }
+        finite
     }
 }
 

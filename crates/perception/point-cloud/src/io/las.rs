@@ -45,7 +45,10 @@ use std::io::{Read, Seek, SeekFrom, Write};
 use std::path::Path;
 
 use super::input::Points;
-use crate::{CloudError, Point};
+use super::las_columns::{format_for, unwritable, LasColumns, LasRows};
+use crate::attributes::Attributes;
+use crate::georef::{las_crs, Georef, LasLayout};
+use crate::{CloudError, PointCloud};
 
 /// Most LAZ points accepted per byte of compressed data (see the module
 /// docs for the measurement behind it).
@@ -491,14 +494,45 @@ fn las_err(path: &Path, e: las::Error, at: Option<u64>, c: &Checked, total: u64)
     }
 }
 
-/// Reads a LAS or LAZ stream of `total` bytes into `out`.
+/// What [`read`] found besides the points.
+pub(crate) struct LasRead {
+    /// E.g. `"laz 1.4"`.
+    pub(crate) name: &'static str,
+    /// The header read, and the CRS it states.
+    pub(crate) georef: Georef,
+    /// The points' attributes (none when streaming).
+    pub(crate) attributes: Attributes,
+}
+
+/// Coordinates within this distance of zero (the file's unit) are held
+/// about a zero origin: f32 resolves them to 0.24 mm or better, and a
+/// local scan keeps the frame it was written in.
+pub const ORIGIN_FREE: f64 = 4096.0;
+
+/// The origin for a LAS file's points: zero when its header's bounds lie
+/// within [`ORIGIN_FREE`] of zero, otherwise the middle of the bounds
+/// rounded to a whole unit. From the header alone, so the same data in
+/// another container (LAZ, COPC) or another point order gets the same.
+fn origin_of(h: &las::Header) -> [f64; 3] {
+    let b = h.bounds();
+    let (lo, hi) = ([b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]);
+    let sane = (0..3).all(|a| lo[a].is_finite() && hi[a].is_finite() && lo[a] <= hi[a]);
+    if !sane || (0..3).all(|a| lo[a].abs().max(hi[a].abs()) <= ORIGIN_FREE) {
+        return [0.0; 3];
+    }
+    [0, 1, 2].map(|a| ((lo[a] + hi[a]) / 2.0).round())
+}
+
+/// Reads a LAS or LAZ stream of `total` bytes into `out`, its points less
+/// the origin of the header ([`origin_of`]) unless streaming (then
+/// `out.origin` as given), the attributes as columns unless streaming.
 pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
     mut src: R,
     total: u64,
     path: &Path,
     progress: &mut dyn FnMut(u64, u64),
     out: &mut Points<'_>,
-) -> crate::Result<&'static str> {
+) -> crate::Result<LasRead> {
     progress(0, total);
     let c = check(&mut src, total).map_err(|what| CloudError::Format {
         path: path.to_path_buf(),
@@ -522,12 +556,21 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
         if !c.compressed {
             out.reserve_bounded(c.count, total - c.offset, c.record_len.max(1));
         }
+        let header = reader.header().clone();
+        let mut columns = (!out.is_streaming()).then(|| {
+            out.origin = origin_of(&header);
+            LasColumns::for_format(header.point_format())
+        });
         let mut i = 0u64;
         while let Some(p) = reader
             .read_point()
             .map_err(|e| las_err(path, e, Some(i), &c, total))?
         {
-            out.push_f64(p.x, p.y, p.z);
+            if out.push_f64(p.x, p.y, p.z) {
+                if let Some(cols) = &mut columns {
+                    cols.push(&p);
+                }
+            }
             out.hand_on(false)?;
             i += 1;
             if i.is_multiple_of(PROGRESS_POINTS) {
@@ -539,10 +582,17 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
                 progress(done.min(total), total);
             }
         }
-        out.hand_on(true)
-    })?;
-    progress(total, total);
-    Ok(version_name(c.compressed, c.major, c.minor))
+        out.hand_on(true)?;
+        Ok(LasRead {
+            name: version_name(c.compressed, c.major, c.minor),
+            georef: Georef {
+                crs: las_crs(&header),
+                las: Some(LasLayout(header)),
+            },
+            attributes: columns.map(LasColumns::into_attributes).unwrap_or_default(),
+        })
+    })
+    .inspect(|_| progress(total, total))
 }
 
 /// What a LAS or LAZ file's header says: enough to lay tiles over a
@@ -662,55 +712,105 @@ fn transform(lo: f64, hi: f64) -> las::Transform {
     las::Transform { scale, offset }
 }
 
-/// Writes `points` as LAS (or LAZ when `compressed`) into `w`.
+/// User ids of the records a LAS writer makes itself (LASzip's) or that
+/// describe a layout the copy does not have (COPC's octree): dropped from
+/// a header read before it is written again.
+const NOT_COPIED: [&str; 2] = ["laszip encoded", "copc"];
+
+/// The header to write `cloud` with: the one it was read with (version,
+/// point format, scale, offset, CRS and every other record), or, for a
+/// cloud from another format, LAS `version` with a point format holding
+/// its columns, 1 mm steps about whole-unit offsets.
+fn header_for(
+    cloud: &PointCloud,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    version: LasVersion,
+) -> Result<las::Builder, String> {
+    let Some(layout) = &cloud.georef.las else {
+        let mut builder = match version {
+            LasVersion::V1_2 => las::Builder::from((1, 2)),
+            LasVersion::V1_4 => las::Builder::from((1, 4)),
+        };
+        let format = format_for(&cloud.attributes, version == LasVersion::V1_4);
+        builder.point_format = las::point::Format::new(format).map_err(|e| e.to_string())?;
+        builder.generating_software = "autoshovel".into();
+        builder.transforms = las::Vector {
+            x: transform(lo[0], hi[0]),
+            y: transform(lo[1], hi[1]),
+            z: transform(lo[2], hi[2]),
+        };
+        return Ok(builder);
+    };
+    let mut builder = las::Builder::from(layout.0.clone());
+    if builder.point_format.has_waveform {
+        return Err(format!(
+            "point format {} carries waveform packets, which are not kept: write .pcd or .ply, or convert the file first",
+            layout.point_format()
+        ));
+    }
+    builder
+        .vlrs
+        .retain(|v| !NOT_COPIED.contains(&v.user_id.as_str()));
+    builder
+        .evlrs
+        .retain(|v| !NOT_COPIED.contains(&v.user_id.as_str()));
+    // The file's scale is kept; its offset too unless a point moved out
+    // of the integers' reach (a levelled cloud), then re-centred.
+    let t = &mut builder.transforms;
+    for (a, t) in [&mut t.x, &mut t.y, &mut t.z].into_iter().enumerate() {
+        if lo[a] <= hi[a] && (t.inverse(lo[a]).is_err() || t.inverse(hi[a]).is_err()) {
+            let scale = t.scale;
+            *t = transform(lo[a], hi[a]);
+            t.scale = t.scale.max(scale);
+        }
+    }
+    Ok(builder)
+}
+
+/// Writes `cloud` as LAS (or LAZ when `compressed`) into `w`: its points
+/// at `origin + point` in f64, its columns into the point records' fields
+/// ([`super::las_columns`]).
 pub(crate) fn write<W: Write + Seek + Send + Sync + 'static>(
     w: W,
-    points: &[Point],
+    cloud: &PointCloud,
     compressed: bool,
     version: LasVersion,
 ) -> Result<W, String> {
+    if let Some((name, len)) = cloud.attributes.mismatch(cloud.len()) {
+        return Err(format!(
+            "the column {name} has {len} rows for {} points",
+            cloud.len()
+        ));
+    }
+    let lost = unwritable(&cloud.attributes);
+    if !lost.is_empty() {
+        return Err(format!(
+            "LAS has no field for the column(s) {}: write .pcd or .ply to keep them",
+            lost.join(", ")
+        ));
+    }
     let mut lo = [f64::INFINITY; 3];
     let mut hi = [f64::NEG_INFINITY; 3];
-    for p in points {
+    for i in 0..cloud.len() {
+        let p = cloud.world(i);
         for k in 0..3 {
-            let v = f64::from(p[k]);
-            if !v.is_finite() {
-                return Err(format!("LAS cannot store the non-finite coordinate {v}"));
+            if !p[k].is_finite() {
+                return Err(format!("LAS cannot store the non-finite coordinate {}", p[k]));
             }
-            lo[k] = lo[k].min(v);
-            hi[k] = hi[k].max(v);
+            lo[k] = lo[k].min(p[k]);
+            hi[k] = hi[k].max(p[k]);
         }
     }
-    let mut builder = match version {
-        LasVersion::V1_2 => las::Builder::from((1, 2)),
-        LasVersion::V1_4 => las::Builder::from((1, 4)),
-    };
-    builder.point_format = las::point::Format::new(match version {
-        LasVersion::V1_2 => 0,
-        LasVersion::V1_4 => 6,
-    })
-    .map_err(|e| e.to_string())?;
+    let mut builder = header_for(cloud, lo, hi, version)?;
     builder.point_format.is_compressed = compressed;
-    builder.generating_software = "autoshovel".into();
-    builder.transforms = las::Vector {
-        x: transform(lo[0], hi[0]),
-        y: transform(lo[1], hi[1]),
-        z: transform(lo[2], hi[2]),
-    };
+    let format = builder.point_format;
     let header = builder.into_header().map_err(|e| e.to_string())?;
-    let gps_time = (version == LasVersion::V1_4).then_some(0.0);
+    let rows = LasRows::new(&cloud.attributes, format);
     let mut writer = las::Writer::new(w, header).map_err(|e| e.to_string())?;
-    for p in points {
+    for i in 0..cloud.len() {
         writer
-            .write_point(las::Point {
-                x: f64::from(p[0]),
-                y: f64::from(p[1]),
-                z: f64::from(p[2]),
-                return_number: 1,
-                number_of_returns: 1,
-                gps_time,
-                ..Default::default()
-            })
+            .write_point(rows.point(i, cloud.world(i)))
             .map_err(|e| e.to_string())?;
     }
     writer.into_inner().map_err(|e| e.to_string())

@@ -64,7 +64,7 @@ pub fn read(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> crate::Result<Re
     let format = Format::from_path(path)?;
     let (file, total) = open(path)?;
     let mut out = Points::default();
-    let name = match format {
+    let got = match format {
         Format::Las | Format::Laz => las::read(
             BufReader::with_capacity(BUFFER, file),
             total,
@@ -79,10 +79,19 @@ pub fn read(path: &Path, progress: &mut dyn FnMut(u64, u64)) -> crate::Result<Re
                 path,
                 progress,
             );
-            read_text_or_binary(format, &mut input, &mut out)?
+            plain(read_text_or_binary(format, &mut input, &mut out)?)
         }
     };
-    Ok(report(out, name))
+    Ok(report(out, got))
+}
+
+/// What a reader without attributes or georeference found.
+fn plain(name: &'static str) -> las::LasRead {
+    las::LasRead {
+        name,
+        georef: Default::default(),
+        attributes: Default::default(),
+    }
 }
 
 /// What [`read_chunks`] found.
@@ -131,7 +140,7 @@ pub fn read_chunks(
     let (file, total) = open(path)?;
     let mut out = Points::streaming(chunk, on_chunk);
     out.origin = origin;
-    let name = las::read(
+    let got = las::read(
         BufReader::with_capacity(BUFFER, file),
         total,
         path,
@@ -141,7 +150,7 @@ pub fn read_chunks(
     Ok(StreamReport {
         points: out.streamed,
         non_finite_dropped: out.non_finite,
-        format: name,
+        format: got.name,
     })
 }
 
@@ -180,7 +189,7 @@ pub fn read_from_bytes(format: Format, bytes: &[u8]) -> crate::Result<ReadReport
     let mut progress = |_: u64, _: u64| {};
     let total = bytes.len() as u64;
     let mut out = Points::default();
-    let name = match format {
+    let got = match format {
         // `las` wants an owned, seekable source.
         Format::Las | Format::Laz => las::read(
             Cursor::new(bytes.to_vec()),
@@ -191,10 +200,10 @@ pub fn read_from_bytes(format: Format, bytes: &[u8]) -> crate::Result<ReadReport
         )?,
         _ => {
             let mut input = Input::new(bytes, total, &path, &mut progress);
-            read_text_or_binary(format, &mut input, &mut out)?
+            plain(read_text_or_binary(format, &mut input, &mut out)?)
         }
     };
-    Ok(report(out, name))
+    Ok(report(out, got))
 }
 
 fn read_text_or_binary<R: BufRead>(
@@ -219,13 +228,18 @@ fn read_text_or_binary<R: BufRead>(
     Ok(name)
 }
 
-fn report(out: Points<'_>, format: &'static str) -> ReadReport {
+fn report(out: Points<'_>, got: las::LasRead) -> ReadReport {
     let mut points = out.points;
     points.shrink_to_fit();
     ReadReport {
-        cloud: PointCloud { points },
+        cloud: PointCloud {
+            points,
+            origin: out.origin,
+            attributes: got.attributes,
+            georef: got.georef,
+        },
         non_finite_dropped: out.non_finite,
         ignored_columns: out.ignored_columns,
-        format,
+        format: got.name,
     }
 }

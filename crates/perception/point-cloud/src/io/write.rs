@@ -88,7 +88,7 @@ pub fn write_named(
     let file = match format {
         Format::Las | Format::Laz => {
             let w =
-                las::write(w, points, format == Format::Laz, options.las_version).map_err(bad)?;
+                las::write(w, cloud, format == Format::Laz, options.las_version).map_err(bad)?;
             w.into_inner().map_err(|e| io(e.into_error()))?
         }
         _ => {

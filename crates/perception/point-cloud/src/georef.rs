@@ -1,0 +1,232 @@
+//! What a file said about its coordinates: the coordinate system (an EPSG
+//! code, WKT, its linear unit) and, for LAS/LAZ, the header it was read
+//! with (version, point format, scale, offset, every VLR), so that a cloud
+//! read and written again keeps its CRS, point format and precision.
+
+use std::fmt;
+
+/// GeoTIFF key: the model type (1 projected, 2 geographic, 3 geocentric).
+const GT_MODEL_TYPE: u16 = 1024;
+/// GeoTIFF key: the geographic CRS's EPSG code.
+const GEOGRAPHIC_TYPE: u16 = 2048;
+/// GeoTIFF key: the projected CRS's EPSG code.
+const PROJECTED_CS_TYPE: u16 = 3072;
+/// GeoTIFF key: the projected CRS's linear unit (EPSG unit code).
+const PROJ_LINEAR_UNITS: u16 = 3076;
+/// GeoTIFF key: the geographic CRS's angular unit.
+const GEOG_ANGULAR_UNITS: u16 = 2054;
+/// GeoTIFF model type of a geographic (degree) CRS.
+const MODEL_GEOGRAPHIC: u16 = 2;
+/// GeoTIFF "user-defined" code: no EPSG code.
+const USER_DEFINED: u16 = 32767;
+
+/// A CRS's linear unit, as far as the file tells it.
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Default)]
+pub enum Unit {
+    /// The file does not say (or names a unit not listed here).
+    #[default]
+    Unknown,
+    /// Metres (EPSG 9001).
+    Metre,
+    /// International feet, 0.3048 m (EPSG 9002).
+    Foot,
+    /// US survey feet, 1200/3937 m (EPSG 9003).
+    UsSurveyFoot,
+    /// Degrees of a geographic CRS: not a length.
+    Degree,
+}
+
+impl Unit {
+    /// Metres a unit; `None` for degrees and an unknown unit.
+    pub fn metres(self) -> Option<f64> {
+        match self {
+            Unit::Metre => Some(1.0),
+            Unit::Foot => Some(0.3048),
+            Unit::UsSurveyFoot => Some(1200.0 / 3937.0),
+            Unit::Degree | Unit::Unknown => None,
+        }
+    }
+
+    /// The unit from its EPSG code.
+    pub fn from_epsg(code: u16) -> Unit {
+        match code {
+            9001 => Unit::Metre,
+            9002 => Unit::Foot,
+            9003 => Unit::UsSurveyFoot,
+            9102 | 9122 => Unit::Degree,
+            _ => Unit::Unknown,
+        }
+    }
+
+    /// The unit a WKT string names for its axes: the last `UNIT[...]` of a
+    /// projected CRS's own (outside its base geographic CRS), or degrees
+    /// for a geographic CRS.
+    pub fn from_wkt(wkt: &str) -> Unit {
+        let t = wkt.trim_start();
+        let upper = t.to_ascii_uppercase();
+        if upper.starts_with("GEOGCS") || upper.starts_with("GEOGCRS") {
+            return Unit::Degree;
+        }
+        if !(upper.starts_with("PROJCS") || upper.starts_with("PROJCRS")) {
+            return Unit::Unknown;
+        }
+        // The projected CRS's own unit comes after its base CRS closes.
+        let Some(at) = upper.rfind("UNIT[").or_else(|| upper.rfind("LENGTHUNIT[")) else {
+            return Unit::Unknown;
+        };
+        let name = upper[at..].split('"').nth(1).unwrap_or("");
+        match name {
+            "METRE" | "METER" | "METRES" | "METERS" => Unit::Metre,
+            "US SURVEY FOOT" | "FOOT_US" | "US_SURVEY_FOOT" | "U.S. SURVEY FOOT" => {
+                Unit::UsSurveyFoot
+            }
+            "FOOT" | "INTERNATIONAL FOOT" | "FOOT_INTL" => Unit::Foot,
+            _ => Unit::Unknown,
+        }
+    }
+
+    /// Its name in messages and summaries.
+    pub fn name(self) -> &'static str {
+        match self {
+            Unit::Unknown => "unknown",
+            Unit::Metre => "metre",
+            Unit::Foot => "foot",
+            Unit::UsSurveyFoot => "US survey foot",
+            Unit::Degree => "degree",
+        }
+    }
+}
+
+/// The coordinate system a file states.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Crs {
+    /// The horizontal CRS's EPSG code, when the file gives one.
+    pub epsg: Option<u32>,
+    /// The WKT, when the file gives one.
+    pub wkt: Option<String>,
+    /// The linear unit of x and y.
+    pub unit: Unit,
+}
+
+impl Crs {
+    /// Whether the file states no CRS at all.
+    pub fn is_unknown(&self) -> bool {
+        self.epsg.is_none() && self.wkt.is_none() && self.unit == Unit::Unknown
+    }
+
+    /// Whether x and y are degrees of longitude and latitude.
+    pub fn is_geographic(&self) -> bool {
+        self.unit == Unit::Degree
+    }
+}
+
+impl fmt::Display for Crs {
+    /// `EPSG:26910 (metre)`, `WKT (US survey foot)` or `none stated`.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        match (self.epsg, &self.wkt) {
+            (Some(code), _) => write!(f, "EPSG:{code} ({})", self.unit.name()),
+            (None, Some(_)) => write!(f, "WKT ({})", self.unit.name()),
+            (None, None) if self.unit != Unit::Unknown => write!(f, "{}", self.unit.name()),
+            (None, None) => f.write_str("none stated"),
+        }
+    }
+}
+
+/// The LAS header a cloud was read with, written back with it.
+#[derive(Debug, Clone, PartialEq)]
+pub struct LasLayout(pub(crate) las::Header);
+
+impl LasLayout {
+    /// (major, minor) version.
+    pub fn version(&self) -> (u8, u8) {
+        let v = self.0.version();
+        (v.major, v.minor)
+    }
+
+    /// The point format number (0–10).
+    pub fn point_format(&self) -> u8 {
+        self.0.point_format().to_u8().unwrap_or(0)
+    }
+
+    /// Scale per axis (the file's unit a step).
+    pub fn scale(&self) -> [f64; 3] {
+        let t = self.0.transforms();
+        [t.x.scale, t.y.scale, t.z.scale]
+    }
+
+    /// Offset per axis.
+    pub fn offset(&self) -> [f64; 3] {
+        let t = self.0.transforms();
+        [t.x.offset, t.y.offset, t.z.offset]
+    }
+}
+
+/// What a file said of its coordinates.
+#[derive(Debug, Clone, Default, PartialEq)]
+pub struct Georef {
+    /// The coordinate system.
+    pub crs: Crs,
+    /// The LAS header read, for LAS and LAZ.
+    pub las: Option<LasLayout>,
+}
+
+/// The CRS a LAS header states (GeoTIFF keys or WKT).
+pub(crate) fn las_crs(h: &las::Header) -> Crs {
+    let mut crs = Crs::default();
+    if let Some(bytes) = h.get_wkt_crs_bytes() {
+        let text = String::from_utf8_lossy(bytes)
+            .trim_end_matches('\0')
+            .to_string();
+        crs.unit = Unit::from_wkt(&text);
+        crs.wkt = Some(text);
+    }
+    if let Ok(Some(keys)) = h.get_geotiff_crs() {
+        let key = |id: u16| {
+            keys.entries.iter().find(|e| e.id == id).and_then(|e| match e.data {
+                las::crs::GeoTiffData::U16(v) => Some(v),
+                _ => None,
+            })
+        };
+        let projected = key(PROJECTED_CS_TYPE).filter(|&c| c != USER_DEFINED);
+        let geographic = key(GEOGRAPHIC_TYPE).filter(|&c| c != USER_DEFINED);
+        crs.epsg = projected.or(geographic).map(u32::from);
+        let unit = match key(GT_MODEL_TYPE) {
+            Some(MODEL_GEOGRAPHIC) => Unit::Degree,
+            _ if projected.is_none() && geographic.is_some() => Unit::Degree,
+            _ => key(PROJ_LINEAR_UNITS)
+                .or(key(GEOG_ANGULAR_UNITS).filter(|_| projected.is_none()))
+                .map_or(Unit::Unknown, Unit::from_epsg),
+        };
+        if crs.unit == Unit::Unknown {
+            crs.unit = unit;
+        }
+        // A projected EPSG code without a unit key: UTM zones are metres.
+        if crs.unit == Unit::Unknown && projected.is_some_and(is_utm) {
+            crs.unit = Unit::Metre;
+        }
+    }
+    crs
+}
+
+/// Whether an EPSG code is a UTM zone of WGS 84 (326xx, 327xx) or NAD83
+/// (269xx), whose unit is the metre.
+fn is_utm(code: u16) -> bool {
+    matches!(code, 32601..=32660 | 32701..=32760 | 26901..=26923)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn units_come_from_the_wkt_axes_not_the_base_crs() {
+        let utm = r#"PROJCS["NAD83 / UTM zone 10N",GEOGCS["NAD83",UNIT["degree",0.0174532925199433]],UNIT["metre",1]]"#;
+        assert_eq!(Unit::from_wkt(utm), Unit::Metre);
+        let spcs = r#"PROJCS["NAD83(HARN) / Oregon GIC Lambert (ft)",GEOGCS["NAD83(HARN)",UNIT["degree",0.01745]],UNIT["foot",0.3048]]"#;
+        assert_eq!(Unit::from_wkt(spcs), Unit::Foot);
+        let us = r#"PROJCS["NAD83 / Texas Central (ftUS)",GEOGCS["NAD83"],UNIT["US survey foot",0.304800609601219]]"#;
+        assert_eq!(Unit::from_wkt(us), Unit::UsSurveyFoot);
+        assert_eq!(Unit::from_wkt(r#"GEOGCS["WGS 84",UNIT["degree",0.01745]]"#), Unit::Degree);
+        assert!((Unit::UsSurveyFoot.metres().unwrap() - 0.304_800_609_6).abs() < 1e-10);
+    }
+}
