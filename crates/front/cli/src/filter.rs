@@ -92,10 +92,11 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
     )?;
     job.report(args.report.json, |s| {
         crate::say!(
-            "filter {} ({}, {} points)",
+            "filter {} ({}, {} points, CRS {})",
             s.input,
             s.input_format,
-            s.points_in
+            s.points_in,
+            s.crs
         );
         for st in &s.stages {
             crate::say!(
@@ -113,5 +114,8 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
             s.output,
             s.output_encoding
         );
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
     })
 }

@@ -118,6 +118,16 @@ pub fn filter(
         points_in: got.cloud.len(),
         non_finite_dropped: got.non_finite_dropped,
         points_out: cloud.len(),
+        crs: got.cloud.georef.crs.to_string(),
+        origin: got.cloud.origin,
+        attributes: got
+            .cloud
+            .attributes
+            .columns()
+            .iter()
+            .map(|c| c.name.clone())
+            .collect(),
+        warnings: warnings(&got.cloud),
         stages: report,
         read_ms,
         filter_ms,
@@ -131,6 +141,22 @@ pub fn filter(
             written,
         )?)
     })
+}
+
+/// What a user of `cloud` should hear before trusting the output.
+fn warnings(cloud: &PointCloud) -> Vec<String> {
+    cloud
+        .coarser_than_file()
+        .into_iter()
+        .map(|(axis, held, step)| {
+            format!(
+                "{axis} is held to {} about the origin, coarser than half the file's step of {}: written back, a coordinate may move by up to {} steps",
+                autoshovel_core::config::approx(held),
+                autoshovel_core::config::short(step),
+                (held / step).ceil()
+            )
+        })
+        .collect()
 }
 
 /// Whether `a` and `b` name the same file (`b` need not exist).

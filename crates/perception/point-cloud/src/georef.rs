@@ -182,10 +182,13 @@ pub(crate) fn las_crs(h: &las::Header) -> Crs {
     }
     if let Ok(Some(keys)) = h.get_geotiff_crs() {
         let key = |id: u16| {
-            keys.entries.iter().find(|e| e.id == id).and_then(|e| match e.data {
-                las::crs::GeoTiffData::U16(v) => Some(v),
-                _ => None,
-            })
+            keys.entries
+                .iter()
+                .find(|e| e.id == id)
+                .and_then(|e| match e.data {
+                    las::crs::GeoTiffData::U16(v) => Some(v),
+                    _ => None,
+                })
         };
         let projected = key(PROJECTED_CS_TYPE).filter(|&c| c != USER_DEFINED);
         let geographic = key(GEOGRAPHIC_TYPE).filter(|&c| c != USER_DEFINED);
@@ -226,7 +229,10 @@ mod tests {
         assert_eq!(Unit::from_wkt(spcs), Unit::Foot);
         let us = r#"PROJCS["NAD83 / Texas Central (ftUS)",GEOGCS["NAD83"],UNIT["US survey foot",0.304800609601219]]"#;
         assert_eq!(Unit::from_wkt(us), Unit::UsSurveyFoot);
-        assert_eq!(Unit::from_wkt(r#"GEOGCS["WGS 84",UNIT["degree",0.01745]]"#), Unit::Degree);
+        assert_eq!(
+            Unit::from_wkt(r#"GEOGCS["WGS 84",UNIT["degree",0.01745]]"#),
+            Unit::Degree
+        );
         assert!((Unit::UsSurveyFoot.metres().unwrap() - 0.304_800_609_6).abs() < 1e-10);
     }
 }

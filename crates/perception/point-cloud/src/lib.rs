@@ -14,8 +14,8 @@
 pub mod attributes;
 mod cloud;
 mod error;
-pub mod georef;
 pub mod filter;
+pub mod georef;
 pub mod io;
 mod prefault;
 pub(crate) mod search;
@@ -25,5 +25,5 @@ mod testing;
 
 pub use attributes::{Attributes, Column, Values};
 pub use cloud::{Point, PointCloud};
-pub use georef::{Crs, Georef, LasLayout, Unit};
 pub use error::{CloudError, Result};
+pub use georef::{Crs, Georef, LasLayout, Unit};

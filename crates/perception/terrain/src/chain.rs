@@ -246,8 +246,53 @@ impl Stage {
     /// Run the stage on `cloud`, after [`Stage::check_work`]; a filter's
     /// refusal is [`SurfaceError::StageFailed`] in the flag's own terms.
     pub fn apply(&self, cloud: &PointCloud) -> Result<PointCloud> {
-        self.check_work(cloud)?;
-        let flag = |e| self.flag_error(e);
+        self.check_units(cloud)?;
+        let scaled = self.in_file_units(cloud);
+        scaled.check_work_as(cloud, self)?;
+        scaled.run(cloud, self)
+    }
+
+    /// Refuses a stage that measures in metres on a cloud whose x and y
+    /// are degrees (a geographic CRS such as EPSG:4326): a voxel, a radius,
+    /// a neighbour distance or a rotation would mix degrees with metres.
+    fn check_units(&self, cloud: &PointCloud) -> Result<()> {
+        let crs = &cloud.georef.crs;
+        if !crs.is_geographic() || matches!(self, Stage::Pass(_)) {
+            return Ok(());
+        }
+        Err(SurfaceError::StageFailed {
+            flag: self.kind().flag(),
+            spec: self.spec(),
+            problem: format!(
+                "the cloud's x and y are degrees of longitude and latitude ({crs}), not metres: \
+                 project it first (e.g. `pdal translate IN OUT reprojection --filters.reprojection.out_srs=EPSG:326NN` \
+                 for its UTM zone); only --pass works on degrees"
+            ),
+        })
+    }
+
+    /// The stage with its lengths (a leaf, a radius), given in metres,
+    /// in the cloud's own unit (a foot or a US survey foot where its CRS
+    /// says so); coordinates (--pass) are the file's own already.
+    fn in_file_units(&self, cloud: &PointCloud) -> Stage {
+        let Some(unit_m) = cloud.georef.crs.unit.metres().filter(|&u| u != 1.0) else {
+            return *self;
+        };
+        match *self {
+            Stage::Voxel(p) => Stage::Voxel(VoxelGridParams {
+                leaf_m: p.leaf_m.map(|l| l / unit_m),
+            }),
+            Stage::Radius(p) => Stage::Radius(RadiusOutlierParams {
+                radius_m: p.radius_m / unit_m,
+                ..p
+            }),
+            other => other,
+        }
+    }
+
+    /// Runs the stage, its errors naming `shown` (the value as given).
+    fn run(&self, cloud: &PointCloud, shown: &Stage) -> Result<PointCloud> {
+        let flag = |e| shown.flag_error(e);
         // Removal keeps the same rows of every column; a voxel's centroid
         // takes the attributes of the point nearest it.
         let rows = match self {
@@ -273,7 +318,8 @@ impl Stage {
                 pitch_deg,
             } => {
                 // About the origin: the sensor for a scan in its own frame,
-                // the middle of the data for a survey (io::ORIGIN_FREE).
+                // the middle of the data for a survey (the LAS reader's
+                // origin).
                 let turned = level(cloud, roll_deg.to_radians(), pitch_deg.to_radians());
                 let mut out = cloud.clone();
                 out.points = turned.points;
@@ -289,7 +335,17 @@ impl Stage {
     /// neighbours, or the neighbours within the radius of a surface at the
     /// cloud's own spacing (its largest face's area over its points).
     pub fn check_work(&self, cloud: &PointCloud) -> Result<()> {
+        self.check_work_as(cloud, self)
+    }
+
+    /// [`Stage::check_work`], the refusal naming `shown`.
+    fn check_work_as(&self, cloud: &PointCloud, shown: &Stage) -> Result<()> {
         let n = cloud.len() as f64;
+        let unit = match cloud.georef.crs.unit {
+            autoshovel_point_cloud::Unit::Foot => "ft",
+            autoshovel_point_cloud::Unit::UsSurveyFoot => "US ft",
+            _ => "m",
+        };
         let (visits, how) = match self {
             Stage::Statistical(p) => {
                 let k = (p.mean_k as f64).min(n);
@@ -303,9 +359,9 @@ impl Stage {
                 (
                     k,
                     format!(
-                        "about {} neighbours within {} m of a point at this cloud's spacing of {} m",
+                        "about {} neighbours within {} {unit} of a point at this cloud's spacing of {} {unit}",
                         approx(k),
-                        short(p.radius_m),
+                        approx(p.radius_m),
                         approx(spacing)
                     ),
                 )
@@ -316,8 +372,8 @@ impl Stage {
             return Ok(());
         }
         Err(SurfaceError::StageTooMuchWork {
-            flag: self.kind().flag(),
-            spec: self.spec(),
+            flag: shown.kind().flag(),
+            spec: shown.spec(),
             estimate: format!(
                 "{how}, {} neighbour visits for the {n} points",
                 approx(visits * n)
@@ -463,6 +519,16 @@ pub struct FilterSummary {
     pub non_finite_dropped: usize,
     /// Points written.
     pub points_out: usize,
+    /// The coordinate system the input states (`EPSG:26910 (metre)`,
+    /// `none stated`), written back with the output.
+    pub crs: String,
+    /// The f64 origin the points were held about (the file's frame).
+    pub origin: [f64; 3],
+    /// The attribute columns carried through, as PDAL names them.
+    pub attributes: Vec<String>,
+    /// What the user should know: coordinates the f32 points cannot hold
+    /// to the file's own step, and the like.
+    pub warnings: Vec<String>,
     /// Each stage, in the order run.
     pub stages: Vec<StageReport>,
     /// Reading (ms).

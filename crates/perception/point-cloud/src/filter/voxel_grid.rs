@@ -140,16 +140,18 @@ pub fn voxel_grid_nearest(
     keys.par_sort_unstable();
     let mut nearest = Vec::with_capacity(centroids.len());
     let d2 = |p: &Point, c: &Point| -> f64 {
-        (0..3).map(|a| (f64::from(p[a]) - f64::from(c[a])).powi(2)).sum()
+        (0..3)
+            .map(|a| (f64::from(p[a]) - f64::from(c[a])).powi(2))
+            .sum()
     };
     for run in keys.chunk_by(|a, b| a.0 == b.0) {
         let Some(c) = centroids.get(nearest.len()) else {
             break;
         };
-        let best = run
-            .iter()
-            .map(|&(_, i)| (d2(&cloud[i], c), i))
-            .fold((f64::INFINITY, usize::MAX), |b, x| if x.0 < b.0 { x } else { b });
+        let best = run.iter().map(|&(_, i)| (d2(&cloud[i], c), i)).fold(
+            (f64::INFINITY, usize::MAX),
+            |b, x| if x.0 < b.0 { x } else { b },
+        );
         nearest.push(best.1);
     }
     debug_assert_eq!(nearest.len(), centroids.len(), "one run a voxel");

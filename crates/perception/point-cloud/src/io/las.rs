@@ -504,23 +504,33 @@ pub(crate) struct LasRead {
     pub(crate) attributes: Attributes,
 }
 
-/// Coordinates within this distance of zero (the file's unit) are held
-/// about a zero origin: f32 resolves them to 0.24 mm or better, and a
-/// local scan keeps the frame it was written in.
-pub const ORIGIN_FREE: f64 = 4096.0;
-
-/// The origin for a LAS file's points: zero when its header's bounds lie
-/// within [`ORIGIN_FREE`] of zero, otherwise the middle of the bounds
-/// rounded to a whole unit. From the header alone, so the same data in
-/// another container (LAZ, COPC) or another point order gets the same.
+/// The origin for a LAS file's points, an axis at a time: zero where f32
+/// about zero already resolves a quarter of the file's step at the
+/// header's largest coordinate (a local scan keeps the frame it was
+/// written in), otherwise the middle of the header's bounds on the file's
+/// own grid (offset plus whole steps), so the offsets from it are whole
+/// steps too. From the header alone: the same data in another container
+/// (LAZ, COPC) or in another point order gets the same origin.
 fn origin_of(h: &las::Header) -> [f64; 3] {
     let b = h.bounds();
+    let t = h.transforms();
     let (lo, hi) = ([b.min.x, b.min.y, b.min.z], [b.max.x, b.max.y, b.max.z]);
-    let sane = (0..3).all(|a| lo[a].is_finite() && hi[a].is_finite() && lo[a] <= hi[a]);
-    if !sane || (0..3).all(|a| lo[a].abs().max(hi[a].abs()) <= ORIGIN_FREE) {
-        return [0.0; 3];
-    }
-    [0, 1, 2].map(|a| ((lo[a] + hi[a]) / 2.0).round())
+    let grid = [t.x, t.y, t.z];
+    [0, 1, 2].map(|a| {
+        let (scale, offset) = (grid[a].scale, grid[a].offset);
+        let far = lo[a].abs().max(hi[a].abs());
+        let sane = lo[a].is_finite() && hi[a].is_finite() && lo[a] <= hi[a] && scale > 0.0;
+        if !sane || half_ulp(far) <= scale / 4.0 {
+            return 0.0;
+        }
+        offset + (((lo[a] + hi[a]) / 2.0 - offset) / scale).round() * scale
+    })
+}
+
+/// Half the f32 spacing at `v`.
+fn half_ulp(v: f64) -> f64 {
+    let f = v.abs() as f32;
+    f64::from(f32::from_bits(f.to_bits() + 1) - f) / 2.0
 }
 
 /// Reads a LAS or LAZ stream of `total` bytes into `out`, its points less
@@ -796,7 +806,10 @@ pub(crate) fn write<W: Write + Seek + Send + Sync + 'static>(
         let p = cloud.world(i);
         for k in 0..3 {
             if !p[k].is_finite() {
-                return Err(format!("LAS cannot store the non-finite coordinate {}", p[k]));
+                return Err(format!(
+                    "LAS cannot store the non-finite coordinate {}",
+                    p[k]
+                ));
             }
             lo[k] = lo[k].min(p[k]);
             hi[k] = hi[k].max(p[k]);

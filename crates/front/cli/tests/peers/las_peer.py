@@ -1,0 +1,109 @@
+"""laspy as the independent reader and writer of LAS for tests/real_scans.rs.
+
+  las_peer.py wide IN OUT      write OUT: IN's points and a copy of them
+                               12 km east, at 1 mm steps (a survey more than
+                               10 km across), with every attribute and IN's CRS
+  las_peer.py same IN OUT      OUT holds exactly IN's points: every
+                               coordinate within half the file's scale, the
+                               same CRS, point format, version and attributes
+  las_peer.py subset IN OUT    every point of OUT is a point of IN with all
+                               its attributes (the rows a removal filter kept)
+
+Prints one JSON line; exits 1 with the first difference.
+"""
+import json
+import sys
+
+import laspy
+import numpy as np
+
+# The copy's shift east (m): with the original, a survey 13 km across.
+SHIFT_M = 12_000.0
+# Steps of the wide survey (m): the finest in common use.
+WIDE_SCALE = 0.001
+
+
+def fail(msg):
+    print(json.dumps({"ok": False, "why": msg}))
+    sys.exit(1)
+
+
+def dims(las):
+    return [d for d in las.point_format.dimension_names if d not in ("X", "Y", "Z")]
+
+
+def wide(src, dst):
+    a = laspy.read(src)
+    h = laspy.LasHeader(point_format=a.header.point_format, version=a.header.version)
+    h.scales = np.array([WIDE_SCALE] * 3)
+    h.offsets = np.round(a.header.mins)
+    for v in a.header.vlrs:
+        h.vlrs.append(v)
+    out = laspy.LasData(h)
+    n = len(a.points)
+    for d in dims(a):
+        col = np.asarray(a[d])
+        out[d] = np.concatenate([col, col])
+    out.x = np.concatenate([a.x, a.x + SHIFT_M])
+    out.y = np.concatenate([a.y, a.y])
+    out.z = np.concatenate([a.z, a.z])
+    out.write(dst)
+    b = laspy.read(dst)
+    span = float(b.header.maxs[0] - b.header.mins[0])
+    print(json.dumps({"ok": True, "points": 2 * n, "span_m": span}))
+
+
+def table(las):
+    """Every point's record as a tuple: integer X, Y, Z and every attribute."""
+    cols = [np.asarray(las.X), np.asarray(las.Y), np.asarray(las.Z)]
+    cols += [np.asarray(las[d]) for d in dims(las)]
+    return cols
+
+
+def header_same(a, b):
+    ha, hb = a.header, b.header
+    if ha.point_format.id != hb.point_format.id:
+        fail(f"point format {hb.point_format.id}, the input's is {ha.point_format.id}")
+    if str(ha.version) != str(hb.version):
+        fail(f"version {hb.version}, the input's is {ha.version}")
+    if not np.allclose(ha.scales, hb.scales, rtol=0, atol=0):
+        fail(f"scales {hb.scales}, the input's are {ha.scales}")
+    ca, cb = ha.parse_crs(), hb.parse_crs()
+    if (ca is None) != (cb is None) or (ca is not None and not ca.equals(cb)):
+        fail(f"CRS {cb}, the input's is {ca}")
+    if dims(a) != dims(b):
+        fail(f"dimensions {dims(b)}, the input's are {dims(a)}")
+
+
+def same(src, dst):
+    a, b = laspy.read(src), laspy.read(dst)
+    header_same(a, b)
+    if len(a.points) != len(b.points):
+        fail(f"{len(b.points)} points, the input has {len(a.points)}")
+    worst = 0.0
+    for ax, s in zip("xyz", a.header.scales):
+        d = float(np.max(np.abs(np.asarray(getattr(a, ax)) - np.asarray(getattr(b, ax)))))
+        worst = max(worst, d / s)
+        if d > s / 2:
+            fail(f"{ax} moved by {d}, more than half the scale {s}")
+    for d in dims(a):
+        if not np.array_equal(np.asarray(a[d]), np.asarray(b[d])):
+            fail(f"attribute {d} differs")
+    crs = a.header.parse_crs()
+    print(json.dumps({"ok": True, "points": len(b.points), "worst_steps": worst,
+                      "epsg": crs.to_epsg() if crs else None}))
+
+
+def subset(src, dst):
+    a, b = laspy.read(src), laspy.read(dst)
+    header_same(a, b)
+    rows_a = set(zip(*[c.tolist() for c in table(a)]))
+    rows_b = list(zip(*[c.tolist() for c in table(b)]))
+    missing = [r for r in rows_b if r not in rows_a]
+    if missing:
+        fail(f"{len(missing)} of {len(rows_b)} points are not the input's, e.g. {missing[0]}")
+    print(json.dumps({"ok": True, "points": len(rows_b), "of": len(a.points)}))
+
+
+if __name__ == "__main__":
+    {"wide": wide, "same": same, "subset": subset}[sys.argv[1]](*sys.argv[2:])
