@@ -8,6 +8,9 @@
                                same CRS, point format, version and attributes
   las_peer.py subset IN OUT    every point of OUT is a point of IN with all
                                its attributes (the rows a removal filter kept)
+  las_peer.py copy IN OUT      OUT: IN's points as plain LAS, in IN's order
+  las_peer.py shuffle IN OUT   OUT: IN's points as plain LAS, shuffled
+                               (numpy's generator, seed 1)
 
 Prints one JSON line; exits 1 with the first difference.
 """
@@ -105,5 +108,22 @@ def subset(src, dst):
     print(json.dumps({"ok": True, "points": len(rows_b), "of": len(a.points)}))
 
 
+def copy(src, dst, shuffle=False):
+    a = laspy.read(src)
+    h = laspy.LasHeader(point_format=a.header.point_format.id, version="1.4")
+    h.scales, h.offsets = a.header.scales, a.header.offsets
+    for v in a.header.vlrs:
+        if v.user_id not in ("copc", "laszip encoded"):
+            h.vlrs.append(v)
+    out = laspy.LasData(h)
+    order = np.random.default_rng(1).permutation(len(a.points)) if shuffle else np.arange(len(a.points))
+    for d in a.point_format.dimension_names:
+        out[d] = np.asarray(a[d])[order]
+    out.write(dst)
+    print(json.dumps({"ok": True, "points": len(order), "shuffled": shuffle}))
+
+
 if __name__ == "__main__":
-    {"wide": wide, "same": same, "subset": subset}[sys.argv[1]](*sys.argv[2:])
+    modes = {"wide": wide, "same": same, "subset": subset, "copy": copy,
+             "shuffle": lambda i, o: copy(i, o, shuffle=True)}
+    modes[sys.argv[1]](*sys.argv[2:])

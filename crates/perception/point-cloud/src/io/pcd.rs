@@ -251,10 +251,11 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     let mut value_index = 0usize;
     let mut axes: [Option<Axis>; 3] = [None; 3];
     for (k, f) in fields.iter().enumerate() {
+        // Any case: PDAL writes its dimensions X, Y and Z.
         let axis = match f.name.as_str() {
-            "x" => Some(0),
-            "y" => Some(1),
-            "z" => Some(2),
+            "x" | "X" => Some(0),
+            "y" | "Y" => Some(1),
+            "z" | "Z" => Some(2),
             _ => None,
         };
         if let Some(a) = axis {

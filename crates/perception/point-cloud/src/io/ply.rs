@@ -161,10 +161,11 @@ fn vertex_axes<R: BufRead>(
 ) -> crate::Result<[(usize, Scalar); 3]> {
     let mut axes = [None; 3];
     for (k, p) in el.props.iter().enumerate() {
+        // Any case: PDAL writes its dimensions X, Y and Z.
         let a = match p.name() {
-            "x" => 0,
-            "y" => 1,
-            "z" => 2,
+            "x" | "X" => 0,
+            "y" | "Y" => 1,
+            "z" | "Z" => 2,
             _ => continue,
         };
         match p {
