@@ -185,3 +185,86 @@ fn the_same_scan_levels_the_same_from_las_laz_copc_and_shuffled() {
         "a real estimate, not the default: {angles:?}"
     );
 }
+
+/// The height model's volume above a given base against laspy + numpy's
+/// own grid of the same definition (mean height a cell of three point
+/// spacings, the points at or above the base), in metres by pyproj's unit
+/// of the file's CRS: a survey in UTM metres and one in US survey feet
+/// (EPSG:2903). Every filter off, so both grid the same points.
+#[test]
+fn volume_above_a_given_base_agrees_with_laspy_and_numpy_in_metres() {
+    let Some(py) = python() else { return };
+    let tmp = TempDir::new("real-volume");
+    for (file, base_m) in [("autzen-utm.las", 140.0), ("4_6_crop.las", 2160.0)] {
+        let config = tmp.write(
+            "volume.toml",
+            format!(
+                "[level]\nmode = \"none\"\n[ground]\nmode = \"height\"\nheight_m = {base_m}\nmargin_m = 0\n\
+                 [radius]\nenabled = false\n[statistical]\nenabled = false\n[voxel]\nenabled = false\n\
+                 [smooth]\nenabled = false\n[fit]\ncell_spacings = 3\n"
+            ),
+        );
+        let input = data(file);
+        let v = run(&[
+            "perceive".as_ref(),
+            "--input".as_ref(),
+            input.as_os_str(),
+            "--config".as_ref(),
+            config.as_os_str(),
+            "--json".as_ref(),
+        ])
+        .ok()
+        .json();
+        assert_eq!(v["ground_mode"], "height", "{file}");
+        let ours = f64_field(&v, "volume_m3");
+        let base = f64_field(&v, "volume_base_m");
+        assert!((base - base_m).abs() < 1e-6, "{file}: base {base}");
+        let script = Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/peers/las_peer.py");
+        let out = Command::new(&py)
+            .arg(script)
+            .args(["volume", input.to_str().unwrap(), &base_m.to_string(), "3"])
+            .output()
+            .unwrap();
+        let theirs: serde_json::Value = serde_json::from_slice(&out.stdout).unwrap();
+        let theirs = theirs["volume_m3"].as_f64().unwrap();
+        assert!(theirs > 100.0, "{file}: a real volume, {theirs}");
+        assert!(
+            (ours - theirs).abs() <= 0.01 * theirs,
+            "{file}: ours {ours} m³, laspy + numpy {theirs} m³"
+        );
+        let model = &v["height_model"];
+        assert!(model["rms_residual_m"].as_f64().unwrap() > 0.0, "{model}");
+    }
+}
+
+/// With no settings at all, a survey perceives, naming what the level and
+/// ground stages chose; a longitude–latitude cloud is refused naming its
+/// CRS and what to do.
+#[test]
+fn surveys_perceive_with_no_settings_and_degrees_are_refused() {
+    for file in ["autzen-utm.las", "4_6_crop.las", "mvk-thin.las"] {
+        let input = data(file);
+        let v = run(&[
+            "perceive".as_ref(),
+            "--input".as_ref(),
+            input.as_os_str(),
+            "--json".as_ref(),
+        ])
+        .ok()
+        .json();
+        assert_eq!(v["level_mode"], "none", "{file}: a survey is level");
+        assert!(
+            v["ground_note"].as_str().unwrap_or("").contains("survey"),
+            "{file}: {}",
+            v["ground_note"]
+        );
+        assert!(f64_field(&v, "volume_m3") > 0.0);
+    }
+    let input = data("epsg_4326.las");
+    let r = run(&["perceive".as_ref(), "--input".as_ref(), input.as_os_str()]).fails();
+    let m = r.error_message();
+    assert!(
+        m.contains("epsg_4326.las") && m.contains("EPSG:4326") && m.contains("project it first"),
+        "{m}"
+    );
+}

@@ -181,13 +181,17 @@ pub fn perceive_tiles(
 }
 
 /// The pile of a scan for `plan-dig --cloud`: the perception pipeline, then
-/// the dig profile cut by the library's rule.
+/// the dig profile cut by the library's rule. The dig planner stands on the
+/// paper's polynomial surface ([RS eq. 21]), so its R² gate applies here
+/// whatever model `params` names.
 pub fn scan_pile(
     path: &Path,
     params: &PerceptionParams,
     profile: &MachineProfile,
     progress: bool,
 ) -> Result<Pile> {
-    let got = read_and_perceive(path, params, progress)?;
+    let mut params = params.clone();
+    params.fit.model = autoshovel_terrain::perceive::SurfaceModel::Polynomial;
+    let got = read_and_perceive(path, &params, progress)?;
     Ok(Pile::scan(path, &got, profile)?)
 }

@@ -109,6 +109,16 @@ pub enum SurfaceError {
         /// What a value looks like.
         syntax: &'static str,
     },
+    /// The cloud's x and y are degrees (a geographic CRS): perception
+    /// measures in metres.
+    #[error(
+        "the scan's x and y are degrees of longitude and latitude ({crs}), not metres: project it first \
+         (e.g. `pdal translate IN OUT reprojection --filters.reprojection.out_srs=EPSG:326NN` for its UTM zone)"
+    )]
+    Geographic {
+        /// The CRS the file states.
+        crs: String,
+    },
     /// A filter-chain stage refused its value or emptied the cloud
     /// (`autoshovel filter`), said in the flag's own terms.
     #[error("--{flag} {spec}: {problem}")]

@@ -26,10 +26,12 @@
 
 mod calibrate;
 pub mod chain;
+pub mod dem;
 mod error;
 mod fit;
 mod floor;
 pub mod frames;
+pub mod ground;
 pub mod perceive;
 mod ransac;
 mod sample;

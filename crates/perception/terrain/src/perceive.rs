@@ -36,23 +36,28 @@ use std::time::Instant;
 
 use autoshovel_core::config::{self, TomlFile};
 use autoshovel_point_cloud::filter::{
-    bilateral_normal_smoothing, pass_through, radius_outlier_removal, radius_outlier_removal_then,
-    statistical_outlier_removal, voxel_grid, BilateralParams, OutlierSides, PassThroughParams,
-    RadiusKept, RadiusOutlierParams, StatisticalOutlierParams, VoxelGridParams,
+    bilateral_normal_smoothing, pass_through_indices, radius_outlier_removal_indices,
+    radius_outlier_removal_then, statistical_outlier_removal_indices, voxel_grid, BilateralParams,
+    OutlierSides, PassThroughParams, RadiusKept, RadiusOutlierParams, StatisticalOutlierParams,
+    VoxelGridParams,
 };
 use autoshovel_point_cloud::PointCloud;
-use rayon::prelude::*;
 use serde::{Deserialize, Serialize};
 
 use crate::calibrate::level;
+use crate::dem::{GridSummary, HeightGrid};
 use crate::error::{Result, SurfaceError};
 use crate::fit::{fit_surface, FitParams, SurfaceFit, Term};
-use crate::floor::{estimate_tilt, TiltEstimate, TiltParams};
+use crate::floor::{TiltEstimate, TiltParams};
+use crate::ground::{level_and_ground, GroundMode, GroundUsed, LevelAsked, Levelled};
 
 /// How the scan is levelled.
 #[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
 pub enum LevelMode {
+    /// A survey in a projected CRS is level; otherwise estimate from the
+    /// floor when one is in view, else take the scan as level (ground.rs).
+    Auto,
     /// Estimate roll and pitch from the floor (RANSAC plane).
     Estimate,
     /// Use the given roll and pitch.
@@ -143,7 +148,7 @@ pub struct PerceptionParams {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct LevelStage {
-    /// estimate, given or none.
+    /// auto, estimate, given or none (ground.rs).
     pub mode: LevelMode,
     /// Roll α (deg) when given.
     pub roll_deg: f64,
@@ -159,6 +164,10 @@ pub struct LevelStage {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct GroundStage {
+    /// auto, floor, height or none (ground.rs).
+    pub mode: GroundMode,
+    /// The base's height for mode "height" (the file's frame).
+    pub height_m: Option<f64>,
     /// Keep points this far above the floor and higher (m at scale 1).
     pub margin_m: f64,
 }
@@ -235,10 +244,30 @@ pub struct SmoothStage {
 #[derive(Debug, Clone, PartialEq, Serialize, Deserialize)]
 #[serde(default, deny_unknown_fields)]
 pub struct FitStage {
-    /// Refuse a fit with R² at or under this (0 to accept any).
+    /// The surface model perceive stands on: "grid" (a height model of
+    /// cells, which holds real terrain; the default) or "polynomial" (the
+    /// paper's 8 × 8 samples and polynomial, `[RS eq. 21]`, which the
+    /// rope-shovel dig planner uses). Both are always made; only the
+    /// chosen one can refuse a scan.
+    pub model: SurfaceModel,
+    /// Refuse a polynomial fit with R² at or under this (0 to accept any);
+    /// applies with `model = "polynomial"`.
     pub r2_threshold: f64,
     /// Highest total polynomial degree tried.
     pub max_degree: usize,
+    /// The height model's cell edge (point spacings).
+    pub cell_spacings: f64,
+}
+
+/// The surface model a perception stands on ([`FitStage::model`]).
+#[derive(Debug, Clone, Copy, PartialEq, Eq, Serialize, Deserialize, Default)]
+#[serde(rename_all = "lowercase")]
+pub enum SurfaceModel {
+    /// The gridded height model (dem.rs).
+    #[default]
+    Grid,
+    /// The paper's polynomial of [RS eq. 21].
+    Polynomial,
 }
 
 impl Default for PerceptionParams {
@@ -259,7 +288,7 @@ impl Default for PerceptionParams {
 impl Default for LevelStage {
     fn default() -> Self {
         Self {
-            mode: LevelMode::Estimate,
+            mode: LevelMode::Auto,
             roll_deg: 0.0,
             pitch_deg: 0.0,
             min_floor_share: TiltParams::default().min_floor_share,
@@ -268,7 +297,11 @@ impl Default for LevelStage {
 }
 impl Default for GroundStage {
     fn default() -> Self {
-        Self { margin_m: 0.2 }
+        Self {
+            mode: GroundMode::Auto,
+            height_m: None,
+            margin_m: 0.2,
+        }
     }
 }
 // The paper gives no filter settings. These (in point spacings) are checked
@@ -316,8 +349,13 @@ impl Default for FitStage {
     fn default() -> Self {
         let p = FitParams::default();
         Self {
+            model: SurfaceModel::Grid,
             r2_threshold: p.r2_threshold.unwrap_or(0.95),
             max_degree: p.max_degree,
+            // Three spacings: about nine raw points, two or three voxel
+            // centroids a cell; finer leaves holes, coarser smooths a
+            // face's toe and crest away.
+            cell_spacings: 3.0,
         }
     }
 }
@@ -464,6 +502,19 @@ impl TomlFile for PerceptionParams {
 }
 
 impl PerceptionParams {
+    /// What the level and ground stages are asked (ground.rs), with the
+    /// scene's `scale`.
+    pub(crate) fn level_asked(&self, scale: f64) -> LevelAsked {
+        LevelAsked {
+            mode: self.level.mode,
+            roll_rad: self.level.roll_deg.to_radians(),
+            pitch_rad: self.level.pitch_deg.to_radians(),
+            ground: self.ground.mode,
+            height_m: self.ground.height_m,
+            margin: self.ground.margin_m * scale,
+        }
+    }
+
     /// Neighbour visits per point of each enabled neighbourhood stage on a
     /// cloud of `n` points whose true spacing is `ratio` times smaller than
     /// the spacing the settings scale by (1 for "auto"); neighbours within
@@ -601,6 +652,41 @@ pub struct Perceived {
     pub format: Option<&'static str>,
     /// Non-finite points dropped while reading.
     pub non_finite_dropped: usize,
+    /// The height model and the volume above the base.
+    pub model: Model,
+    /// What the level and ground stages did.
+    pub used: GroundUsed,
+}
+
+/// The gridded height model of a perceived scan and the volume it holds.
+#[derive(Debug, Clone)]
+pub struct Model {
+    /// The grid (levelled frame).
+    pub grid: HeightGrid,
+    /// Its cells, holes and residuals on the cleaned points.
+    pub summary: GridSummary,
+    /// The base the volume stands on: the floor or the given height, or,
+    /// with no ground, the lowest cleaned point (levelled frame).
+    pub base: f64,
+    /// Volume between the model and the base.
+    pub volume_m3: f64,
+}
+
+impl Model {
+    fn of(cloud: &PointCloud, cell: f64, used: &GroundUsed, floor: &TiltEstimate) -> Result<Self> {
+        let grid = HeightGrid::of(cloud, cell)?;
+        let summary = grid.summary(cloud);
+        let base = match used.ground_mode {
+            "none" => cloud.bounds().map_or(0.0, |(lo, _)| f64::from(lo[2])),
+            _ => floor.floor_height_m,
+        };
+        Ok(Self {
+            volume_m3: grid.volume_above(base),
+            grid,
+            summary,
+            base,
+        })
+    }
 }
 
 impl Perceived {
@@ -766,6 +852,21 @@ pub fn perceive_after(
 ) -> Result<Perceived> {
     let p = params;
     let input_points = cloud.len();
+    if cloud.georef.crs.is_geographic() {
+        return Err(SurfaceError::Geographic {
+            crs: cloud.georef.crs.to_string(),
+        });
+    }
+    // Perception measures in metres: a cloud in feet (a State Plane
+    // survey) is converted first, and what perception returns is metres.
+    let converted;
+    let cloud = match in_metres(cloud) {
+        Some(c) => {
+            converted = c;
+            &converted
+        }
+        None => cloud,
+    };
     if input_points == 0 {
         return Err(SurfaceError::NoFinitePoints {
             non_finite_dropped: 0,
@@ -813,59 +914,38 @@ pub fn perceive_after(
             source: Box::new(source),
         }
     };
-    // Level [RS eq. 11]–[RS eq. 12].
+    // Level [RS eq. 11]–[RS eq. 12], and the ground (ground.rs).
     on_stage("level");
     let t = Instant::now();
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
-    // The floor found while estimating the tilt is the levelled cloud's
-    // floor too: levelling turns its normal onto the z axis and keeps its
-    // offset, so it is the plane z = d with the same inliers ([RS eq. 11]–12).
-    let (cloud, roll, pitch, found) = match (prior, p.level.mode) {
-        (Some(prior), _) => (
-            level(cloud, prior.roll_rad, prior.pitch_rad),
-            prior.roll_rad,
-            prior.pitch_rad,
-            Some(prior.floor),
-        ),
-        (None, LevelMode::Estimate) => {
-            let est = estimate_tilt(cloud, &tilt_params)
-                .map_err(in_stage("estimating roll and pitch from the floor"))?;
-            let floor = TiltEstimate {
-                roll_rad: 0.0,
-                pitch_rad: 0.0,
-                normal: [0.0, 0.0, 1.0],
-                ..est
-            };
-            (
-                level(cloud, est.roll_rad, est.pitch_rad),
-                est.roll_rad,
-                est.pitch_rad,
-                Some(floor),
-            )
-        }
-        (None, LevelMode::Given) => {
-            let (r, q) = (
-                p.level.roll_deg.to_radians(),
-                p.level.pitch_deg.to_radians(),
-            );
-            if !(r.is_finite() && q.is_finite()) {
-                return Err(SurfaceError::BadParameter {
-                    name: "level.roll_deg / level.pitch_deg",
-                    value: if r.is_finite() { q } else { r },
-                    expected: "finite angles",
-                });
+    let levelled = match prior {
+        // A prior's angles and floor, no search.
+        Some(prior) => {
+            let mut c = cloud.clone();
+            c.points = level(cloud, prior.roll_rad, prior.pitch_rad).points;
+            Levelled {
+                cloud: c,
+                roll: prior.roll_rad,
+                pitch: prior.pitch_rad,
+                floor: prior.floor,
+                used: GroundUsed {
+                    level_mode: "given",
+                    ground_mode: "floor",
+                    note: None,
+                    cut_at: Some(prior.floor.floor_height_m + p.ground.margin_m * scale),
+                },
             }
-            (level(cloud, r, q), r, q, None)
         }
-        (None, LevelMode::None) => (cloud.clone(), 0.0, 0.0, None),
+        None => level_and_ground(cloud, &p.level_asked(scale), &tilt_params)?,
     };
-    // Otherwise the floor after levelling (for the pass-through threshold).
-    let floor = match found {
-        Some(floor) => floor,
-        None => estimate_tilt(&cloud, &tilt_params)
-            .map_err(in_stage("finding the floor after levelling"))?,
-    };
+    let Levelled {
+        cloud,
+        roll,
+        pitch,
+        floor,
+        used,
+    } = levelled;
     stages.push(StageRecord {
         stage: "level",
         points: cloud.len(),
@@ -878,14 +958,11 @@ pub fn perceive_after(
     let filters: [(&'static str, bool, Filter); 5] = [
         (
             "ground",
-            true,
+            used.cut_at.is_some(),
             Box::new(|c: &PointCloud| {
-                pass_through(
-                    c,
-                    &PassThroughParams::ground_removal(
-                        floor.floor_height_m + p.ground.margin_m * scale,
-                    ),
-                )
+                let at = used.cut_at.unwrap_or(f64::NEG_INFINITY);
+                let kept = pass_through_indices(c, &PassThroughParams::ground_removal(at))?;
+                Ok(c.select(&kept))
             }),
         ),
         (
@@ -898,11 +975,11 @@ pub fn perceive_after(
                     min_neighbors: p.radius.min_neighbors,
                 };
                 if !p.statistical.enabled {
-                    return radius_outlier_removal(c, &params);
+                    return Ok(c.select(&radius_outlier_removal_indices(c, &params)?));
                 }
                 // The statistical stage searches the same index next.
                 let first = radius_outlier_removal_then(c, &params, p.statistical.mean_k)?;
-                let kept = PointCloud::new(first.kept.par_iter().map(|&i| c.points[i]).collect());
+                let kept = c.select(&first.kept);
                 *after_radius.borrow_mut() = Some(first);
                 Ok(kept)
             }),
@@ -917,23 +994,22 @@ pub fn perceive_after(
                     std_mul: p.statistical.std_mul,
                     sides: p.statistical.sides,
                 };
-                match after_radius.borrow_mut().take() {
-                    Some(first) => {
-                        let kept = first.statistical_indices(c, &params)?;
-                        Ok(PointCloud::new(
-                            kept.par_iter().map(|&i| c.points[i]).collect(),
-                        ))
-                    }
-                    None => statistical_outlier_removal(c, &params),
-                }
+                let kept = match after_radius.borrow_mut().take() {
+                    Some(first) => first.statistical_indices(c, &params)?,
+                    None => statistical_outlier_removal_indices(c, &params)?,
+                };
+                Ok(c.select(&kept))
             }),
         ),
         (
             "voxel",
             p.voxel.enabled,
             // [RS eq. 17]–[RS eq. 18]
+            // New points: the cloud's frame kept, its attributes not
+            // (`filter --voxel` carries them, at the cost of a sort).
             Box::new(|c: &PointCloud| {
-                voxel_grid(c, &VoxelGridParams::cube(p.voxel.leaf_spacings * spacing))
+                let v = voxel_grid(c, &VoxelGridParams::cube(p.voxel.leaf_spacings * spacing))?;
+                Ok(c.derived(v.points, None))
             }),
         ),
         (
@@ -947,7 +1023,7 @@ pub fn perceive_after(
                     sigma_n_m: p.smooth.sigma_n_m * scale,
                     iterations: p.smooth.iterations,
                 };
-                bilateral_normal_smoothing(c, &params)
+                Ok(c.derived(bilateral_normal_smoothing(c, &params)?.points, None))
             }),
         ),
     ];
@@ -970,12 +1046,15 @@ pub fn perceive_after(
     // Fit [RS eq. 21].
     on_stage("fit");
     let t = Instant::now();
+    let gate = p.fit.model == SurfaceModel::Polynomial && p.fit.r2_threshold > 0.0;
     let fit_params = FitParams {
         max_degree: p.fit.max_degree,
-        r2_threshold: (p.fit.r2_threshold > 0.0).then_some(p.fit.r2_threshold),
+        r2_threshold: gate.then_some(p.fit.r2_threshold),
         ..FitParams::default()
     };
     let fit = fit_surface(&cloud, &fit_params).map_err(in_stage("fitting the surface"))?;
+    let model = Model::of(&cloud, p.fit.cell_spacings * spacing, &used, &floor)
+        .map_err(in_stage("making the height model"))?;
     stages.push(StageRecord {
         stage: "fit",
         points: fit.samples.len(),
@@ -984,7 +1063,9 @@ pub fn perceive_after(
     Ok(Perceived {
         cloud,
         fit,
-        floor_height_m: floor.floor_height_m,
+        floor_height_m: model.base,
+        model,
+        used,
         floor,
         roll_rad: roll,
         pitch_rad: pitch,
@@ -995,6 +1076,26 @@ pub fn perceive_after(
         format: None,
         non_finite_dropped: 0,
     })
+}
+
+/// `cloud` in metres when its CRS's unit is another length (feet, US
+/// survey feet): points and origin scaled, the CRS then stated as metres
+/// with no code (the file's CRS is in feet); `None` when it is metres or
+/// not stated.
+fn in_metres(cloud: &PointCloud) -> Option<PointCloud> {
+    let u = cloud.georef.crs.unit.metres().filter(|&u| u != 1.0)?;
+    let mut c = cloud.clone();
+    let uf = u as f32;
+    c.points.iter_mut().for_each(|p| *p = p.map(|v| v * uf));
+    c.origin = c.origin.map(|o| o * u);
+    c.georef = autoshovel_point_cloud::Georef {
+        crs: autoshovel_point_cloud::Crs {
+            unit: autoshovel_point_cloud::Unit::Metre,
+            ..Default::default()
+        },
+        las: None,
+    };
+    Some(c)
 }
 
 /// A filter's error restated in the perceive settings' terms: the hint of
@@ -1130,6 +1231,21 @@ pub struct PerceiveSummary {
     pub spacing_m: f64,
     /// R² of the fit on the grid samples.
     pub r2: f64,
+    /// The levelling that ran: estimate, given or none.
+    pub level_mode: &'static str,
+    /// The ground that ran: floor, height or none.
+    pub ground_mode: &'static str,
+    /// Why, where `auto` chose.
+    pub ground_note: Option<String>,
+    /// The gridded height model: cells, holes, residuals on the cleaned
+    /// points.
+    pub height_model: GridSummary,
+    /// Volume between the height model and the base.
+    pub volume_m3: f64,
+    /// The base's height in the file's frame (with `origin`).
+    pub volume_base_m: f64,
+    /// The f64 origin the points were held about.
+    pub origin: [f64; 3],
     /// Wall time of each stage (ms).
     pub timings_ms: BTreeMap<&'static str, f64>,
     /// Wall time of all stages (ms).
@@ -1165,6 +1281,13 @@ impl PerceiveSummary {
             scale: got.scale,
             spacing_m: got.spacing_m,
             r2: fit.r2,
+            level_mode: got.used.level_mode,
+            ground_mode: got.used.ground_mode,
+            ground_note: got.used.note.clone(),
+            height_model: got.model.summary.clone(),
+            volume_m3: got.model.volume_m3,
+            volume_base_m: got.model.base + got.cloud.origin[2],
+            origin: got.cloud.origin,
             timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
             total_ms: got.total_ms(),
             fit: FitSummary::of(fit),

@@ -11,6 +11,11 @@
   las_peer.py copy IN OUT      OUT: IN's points as plain LAS, in IN's order
   las_peer.py shuffle IN OUT   OUT: IN's points as plain LAS, shuffled
                                (numpy's generator, seed 1)
+  las_peer.py volume IN BASE CELLS
+                               the volume above z = BASE (m) of IN's mean-height
+                               grid, cells CELLS point spacings wide, the points
+                               at or above BASE only, in metres by pyproj's
+                               unit of IN's CRS (perceive with every filter off)
 
 Prints one JSON line; exits 1 with the first difference.
 """
@@ -108,6 +113,29 @@ def subset(src, dst):
     print(json.dumps({"ok": True, "points": len(rows_b), "of": len(a.points)}))
 
 
+def volume(src, base, cells):
+    a = laspy.read(src)
+    crs = a.header.parse_crs()
+    unit = crs.axis_info[0].unit_conversion_factor if crs is not None else 1.0
+    x, y, z = (np.asarray(getattr(a, ax), dtype=np.float64) * unit for ax in "xyz")
+    spacing = np.sqrt((x.max() - x.min()) * (y.max() - y.min()) / len(x))
+    base = float(base)
+    keep = z >= base
+    x, y, z = x[keep], y[keep], z[keep]
+    cell = float(cells) * spacing
+    ix = np.floor((x - x.min()) / cell).astype(np.int64)
+    iy = np.floor((y - y.min()) / cell).astype(np.int64)
+    nx = int(np.floor((x.max() - x.min()) / cell)) + 1
+    flat = iy * nx + ix
+    sums = np.bincount(flat, weights=z)
+    counts = np.bincount(flat)
+    seen = counts > 0
+    mean = sums[seen] / counts[seen]
+    v = float(np.sum(np.maximum(mean - base, 0.0)) * cell * cell)
+    print(json.dumps({"ok": True, "volume_m3": v, "unit_m": unit, "cells": int(seen.sum()),
+                      "kept": int(keep.sum())}))
+
+
 def copy(src, dst, shuffle=False):
     a = laspy.read(src)
     h = laspy.LasHeader(point_format=a.header.point_format.id, version="1.4")
@@ -124,6 +152,6 @@ def copy(src, dst, shuffle=False):
 
 
 if __name__ == "__main__":
-    modes = {"wide": wide, "same": same, "subset": subset, "copy": copy,
+    modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

@@ -88,13 +88,13 @@ use store::{dist_path, f32_at, Filing, RawSpill, Rec, StageFiles, TileLayout, DI
 use task::{filter_err, Step};
 pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
-use crate::calibrate::{level, level_from_sensor, rotate_point};
+use crate::calibrate::{level_from_sensor, rotate_point};
 use crate::error::{Result, SurfaceError};
 use crate::fit::{fit_surface, FitParams, SurfaceFit};
-use crate::floor::{estimate_tilt, TiltEstimate, TiltParams};
+use crate::floor::{TiltEstimate, TiltParams};
 use crate::frames::HeightModel;
 use crate::perceive::{
-    in_settings_terms, scale_and_spacing_of, FitSummary, LevelMode, PerceptionParams, StageRecord,
+    in_settings_terms, scale_and_spacing_of, FitSummary, PerceptionParams, StageRecord,
 };
 
 /// Working memory a point of a tile needs through the heaviest stage
@@ -627,41 +627,18 @@ pub fn perceive_tiled_with(
     }
     let (scale, spacing) = scale_and_spacing_of(lo, hi, n, p)?;
     p.check_work(1.0, usize::try_from(n).unwrap_or(usize::MAX))?;
-    let in_stage = |stage: &'static str| {
-        move |source: SurfaceError| SurfaceError::Stage {
-            stage,
-            source: Box::new(source),
-        }
-    };
     // Level [RS eq. 11]–[RS eq. 12], from the sample.
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
     let sample = PointCloud::new(sample);
-    let (roll, pitch) = match p.level.mode {
-        LevelMode::Estimate => {
-            let est = estimate_tilt(&sample, &tilt_params)
-                .map_err(in_stage("estimating roll and pitch from the floor"))?;
-            (est.roll_rad, est.pitch_rad)
-        }
-        LevelMode::Given => {
-            let (r, q) = (
-                p.level.roll_deg.to_radians(),
-                p.level.pitch_deg.to_radians(),
-            );
-            if !(r.is_finite() && q.is_finite()) {
-                return Err(SurfaceError::BadParameter {
-                    name: "level.roll_deg / level.pitch_deg",
-                    value: if r.is_finite() { q } else { r },
-                    expected: "finite angles",
-                });
-            }
-            (r, q)
-        }
-        LevelMode::None => (0.0, 0.0),
-    };
-    let levelled_sample = level(&sample, roll, pitch);
-    let floor = estimate_tilt(&levelled_sample, &tilt_params)
-        .map_err(in_stage("finding the floor after levelling"))?;
+    // The same level and ground decisions as a single scan (ground.rs).
+    let crate::ground::Levelled {
+        roll,
+        pitch,
+        floor,
+        used,
+        cloud: levelled_sample,
+    } = crate::ground::level_and_ground(&sample, &p.level_asked(scale), &tilt_params)?;
     let sample_points = sample.len();
     drop((sample, levelled_sample));
     stages.push(StageRecord {
@@ -697,8 +674,7 @@ pub fn perceive_tiled_with(
     let halo = halo * (1.0 + 1e-6) + 1e-6 * (grid.origin[0].abs() + grid.origin[1].abs());
     // Pass 2: level, remove the floor, file by tile.
     let t1 = Instant::now();
-    let threshold = floor.floor_height_m + p.ground.margin_m * scale;
-    let ground = PassThroughParams::ground_removal(threshold);
+    let ground = PassThroughParams::ground_removal(used.cut_at.unwrap_or(f64::NEG_INFINITY));
     let mut lists = Filing::new(StageFiles::create(&work.0, 0, grid.tiles())?);
     let mut id = 0u64;
     let mut by_tile: Vec<Vec<Rec>> = vec![Vec::new(); grid.tiles()];
