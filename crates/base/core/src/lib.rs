@@ -21,7 +21,7 @@ mod travel;
 
 pub use angle::{angle_diff, deg, rad, wrap_angle};
 pub use bspline::{CubicBSpline, CurveSample};
-pub use chain::error_chain;
+pub use chain::{check_dir, error_chain, os_error};
 pub use consts::G;
 pub use geom::{heading_vec, perp, Pose2, Vec2};
 pub use panic::panic_message;

@@ -92,11 +92,12 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
     )?;
     job.report(args.report.json, |s| {
         crate::say!(
-            "filter {} ({}, {} points, CRS {})",
+            "filter {} ({}, {} points, CRS {}{})",
             s.input,
             s.input_format,
             s.points_in,
-            s.crs
+            s.crs,
+            dropped(s.non_finite_dropped)
         );
         for st in &s.stages {
             crate::say!(
@@ -118,4 +119,14 @@ pub fn run(args: &Args, matches: &ArgMatches) -> Result<()> {
             eprintln!("warning: {w}");
         }
     })
+}
+
+/// ", N non-finite points dropped" when N > 0 (an organised scan's NaN
+/// returns): said on the first line, not only in summary.json.
+pub(crate) fn dropped(n: usize) -> String {
+    if n == 0 {
+        String::new()
+    } else {
+        format!(", {n} non-finite points dropped")
+    }
 }

@@ -196,7 +196,12 @@ pub fn run(args: &Args) -> Result<()> {
     }
     let job = autoshovel_jobs::perceive(input, &params, out.as_ref(), !args.output.json)?;
     job.report(args.output.json, |s| {
-        crate::say!("perceive {}", s.input);
+        crate::say!(
+            "perceive {} ({} points{})",
+            s.input,
+            s.input_points,
+            crate::filter::dropped(s.non_finite_dropped)
+        );
         for st in &s.stages {
             crate::say!(
                 "  {:<12} {:>10} points  {:>9.1} ms",
@@ -206,7 +211,9 @@ pub fn run(args: &Args) -> Result<()> {
             );
         }
         crate::say!(
-            "  roll {:.3} deg, pitch {:.3} deg from a floor of {} points ({:.1} % of the scan, RMS {:.1} mm), fit degree {}, R² {:.4} (all points {:.4})",
+            "  level {}, ground {}: roll {:.3} deg, pitch {:.3} deg from a floor of {} points ({:.1} % of the scan, RMS {:.1} mm), fit degree {}, R² {:.4} (all points {:.4})",
+            s.level_mode,
+            s.ground_mode,
             s.roll_deg,
             s.pitch_deg,
             s.floor_points,
@@ -216,5 +223,19 @@ pub fn run(args: &Args) -> Result<()> {
             s.r2,
             s.fit.r2_all_points
         );
+        let m = &s.height_model;
+        crate::say!(
+            "  height model {} × {} cells of {:.3} m ({:.1} % holes), residual RMS {:.1} mm; volume {:.1} m³ above z = {:.3} m",
+            m.size[0],
+            m.size[1],
+            m.cell_m,
+            100.0 * m.hole_share,
+            1e3 * m.rms_residual_m,
+            s.volume_m3,
+            s.volume_base_m
+        );
+        if let Some(note) = &s.ground_note {
+            crate::say!("  {note}");
+        }
     })
 }

@@ -268,3 +268,33 @@ fn surveys_perceive_with_no_settings_and_degrees_are_refused() {
         "{m}"
     );
 }
+
+/// PDAL's own PCD of Autzen in UTM (X Y Z as F8 doubles, upper case, and
+/// its LAS dimensions as fields) reads with every coordinate and attribute
+/// laspy reads from PDAL's LAS of the same points; and a survey written to
+/// PCD in each encoding (doubles about no origin, the columns as fields)
+/// comes back to LAS with the same coordinates and attributes.
+#[test]
+fn pdal_pcd_and_pcd_round_trips_keep_coordinates_and_attributes() {
+    let Some(py) = python() else { return };
+    let tmp = TempDir::new("real-pcd");
+    let las = data("autzen-utm.las");
+    let from_pcd = tmp.path().join("from-pcd.las");
+    filter(
+        &data("pdal_autzen-utm.pcd"),
+        &from_pcd,
+        &["--pass", "z:-inf:inf"],
+    );
+    peer(&py, &[&las, &from_pcd], "values");
+    for encoding in ["binary", "ascii", "binary-compressed"] {
+        let pcd = tmp.path().join(format!("{encoding}.pcd"));
+        filter(
+            &las,
+            &pcd,
+            &["--pass", "z:-inf:inf", "--encoding", encoding],
+        );
+        let back = tmp.path().join(format!("{encoding}.las"));
+        filter(&pcd, &back, &["--pass", "z:-inf:inf"]);
+        peer(&py, &[&las, &back], "values");
+    }
+}

@@ -124,6 +124,7 @@ pub fn private_dir(dir: &Path, tag: &str) -> std::io::Result<PathBuf> {
     builder.prefix(&prefix).rand_bytes(RANDOM_CHARS);
     #[cfg(unix)]
     builder.permissions(std::os::unix::fs::PermissionsExt::from_mode(0o700));
+    autoshovel_core::check_dir(dir)?;
     let made = builder.tempdir_in(dir).map_err(without_path)?;
     Ok(made.keep())
 }
@@ -131,10 +132,7 @@ pub fn private_dir(dir: &Path, tag: &str) -> std::io::Result<PathBuf> {
 /// The operating system's error without the path tempfile appends (the
 /// caller names the user's target, never the temporary name).
 pub fn without_path(e: std::io::Error) -> std::io::Error {
-    match e.raw_os_error() {
-        Some(code) => std::io::Error::from_raw_os_error(code),
-        None => std::io::Error::from(e.kind()),
-    }
+    autoshovel_core::os_error(e)
 }
 
 /// Staging folders and temporary files not yet committed or removed, for

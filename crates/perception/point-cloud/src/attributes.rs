@@ -113,6 +113,145 @@ impl Values {
         }
     }
 
+    /// Appends row `i`'s little-endian bytes to `out`.
+    pub fn le_bytes_at(&self, i: usize, out: &mut Vec<u8>) {
+        match self {
+            Values::U8(v) => out.push(v[i]),
+            Values::I8(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::U16(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::I16(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::U32(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::I32(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::U64(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::I64(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::F32(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::F64(v) => out.extend_from_slice(&v[i].to_le_bytes()),
+            Values::Bytes { width, data } => {
+                out.extend_from_slice(&data[i * width..(i + 1) * width])
+            }
+        }
+    }
+
+    /// Appends row `i` as text (floats the shortest that reads back the
+    /// same; a `Bytes` row as its bytes, space separated) to `out`.
+    pub fn text_at(&self, i: usize, out: &mut String) {
+        use std::fmt::Write;
+        let _ = match self {
+            Values::U8(v) => write!(out, "{}", v[i]),
+            Values::I8(v) => write!(out, "{}", v[i]),
+            Values::U16(v) => write!(out, "{}", v[i]),
+            Values::I16(v) => write!(out, "{}", v[i]),
+            Values::U32(v) => write!(out, "{}", v[i]),
+            Values::I32(v) => write!(out, "{}", v[i]),
+            Values::U64(v) => write!(out, "{}", v[i]),
+            Values::I64(v) => write!(out, "{}", v[i]),
+            Values::F32(v) => write!(out, "{:?}", v[i]),
+            Values::F64(v) => write!(out, "{:?}", v[i]),
+            Values::Bytes { width, data } => {
+                let row = &data[i * width..(i + 1) * width];
+                let words: Vec<String> = row.iter().map(|b| b.to_string()).collect();
+                write!(out, "{}", words.join(" "))
+            }
+        };
+    }
+
+    /// PCD's TYPE, SIZE and COUNT for this column.
+    pub fn pcd_type(&self) -> (char, usize, usize) {
+        match self {
+            Values::U8(_) => ('U', 1, 1),
+            Values::I8(_) => ('I', 1, 1),
+            Values::U16(_) => ('U', 2, 1),
+            Values::I16(_) => ('I', 2, 1),
+            Values::U32(_) => ('U', 4, 1),
+            Values::I32(_) => ('I', 4, 1),
+            Values::U64(_) => ('U', 8, 1),
+            Values::I64(_) => ('I', 8, 1),
+            Values::F32(_) => ('F', 4, 1),
+            Values::F64(_) => ('F', 8, 1),
+            Values::Bytes { width, .. } => ('U', 1, *width),
+        }
+    }
+
+    /// An empty column of PCD's TYPE `kind` and SIZE `size` (`count`
+    /// values a point: only bytes may have more than one).
+    pub(crate) fn for_pcd(kind: char, size: usize, count: usize) -> Option<Values> {
+        Some(match (kind, size, count) {
+            ('U' | 'I', 1, w) if w > 1 => Values::Bytes {
+                width: w,
+                data: Vec::new(),
+            },
+            (_, _, c) if c != 1 => return None,
+            ('U', 1, _) => Values::U8(Vec::new()),
+            ('I', 1, _) => Values::I8(Vec::new()),
+            ('U', 2, _) => Values::U16(Vec::new()),
+            ('I', 2, _) => Values::I16(Vec::new()),
+            ('U', 4, _) => Values::U32(Vec::new()),
+            ('I', 4, _) => Values::I32(Vec::new()),
+            ('U', 8, _) => Values::U64(Vec::new()),
+            ('I', 8, _) => Values::I64(Vec::new()),
+            ('F', 4, _) => Values::F32(Vec::new()),
+            ('F', 8, _) => Values::F64(Vec::new()),
+            _ => return None,
+        })
+    }
+
+    /// Appends a row from its little-endian bytes (as many as the type
+    /// takes; `big_endian` for PLY's other order).
+    pub(crate) fn push_bytes(&mut self, b: &[u8], big_endian: bool) {
+        macro_rules! num {
+            ($v:ident, $t:ty, $n:expr) => {{
+                let mut a = [0u8; $n];
+                a.copy_from_slice(&b[..$n]);
+                $v.push(if big_endian {
+                    <$t>::from_be_bytes(a)
+                } else {
+                    <$t>::from_le_bytes(a)
+                })
+            }};
+        }
+        match self {
+            Values::U8(v) => v.push(b[0]),
+            Values::I8(v) => v.push(b[0] as i8),
+            Values::U16(v) => num!(v, u16, 2),
+            Values::I16(v) => num!(v, i16, 2),
+            Values::U32(v) => num!(v, u32, 4),
+            Values::I32(v) => num!(v, i32, 4),
+            Values::U64(v) => num!(v, u64, 8),
+            Values::I64(v) => num!(v, i64, 8),
+            Values::F32(v) => num!(v, f32, 4),
+            Values::F64(v) => num!(v, f64, 8),
+            Values::Bytes { width, data } => data.extend_from_slice(&b[..*width]),
+        }
+    }
+
+    /// Appends a row from its text (the value's own type: an integer must
+    /// be one, in range); the reason when it is not.
+    pub(crate) fn push_text(&mut self, words: &[&str]) -> Result<(), String> {
+        fn parse<T: std::str::FromStr>(w: &str) -> Result<T, String> {
+            w.parse::<T>()
+                .map_err(|_| format!("{w:?} is not a value of the field's type"))
+        }
+        let w = words.first().copied().unwrap_or("");
+        match self {
+            Values::U8(v) => v.push(parse(w)?),
+            Values::I8(v) => v.push(parse(w)?),
+            Values::U16(v) => v.push(parse(w)?),
+            Values::I16(v) => v.push(parse(w)?),
+            Values::U32(v) => v.push(parse(w)?),
+            Values::I32(v) => v.push(parse(w)?),
+            Values::U64(v) => v.push(parse(w)?),
+            Values::I64(v) => v.push(parse(w)?),
+            Values::F32(v) => v.push(parse(w)?),
+            Values::F64(v) => v.push(parse(w)?),
+            Values::Bytes { width, data } => {
+                for k in 0..*width {
+                    data.push(parse(words.get(k).copied().unwrap_or(""))?);
+                }
+            }
+        }
+        Ok(())
+    }
+
     /// The type's name as PDAL prints it (`uint8`, `float`, `double`,
     /// `bytes`).
     pub fn type_name(&self) -> &'static str {

@@ -11,6 +11,10 @@
   las_peer.py copy IN OUT      OUT: IN's points as plain LAS, in IN's order
   las_peer.py shuffle IN OUT   OUT: IN's points as plain LAS, shuffled
                                (numpy's generator, seed 1)
+  las_peer.py values IN OUT    OUT has IN's points in IN's order, every
+                               coordinate within 1e-6 and every dimension
+                               of IN equal, whatever OUT's header (a trip
+                               through a format with no CRS)
   las_peer.py volume IN BASE CELLS
                                the volume above z = BASE (m) of IN's mean-height
                                grid, cells CELLS point spacings wide, the points
@@ -113,6 +117,22 @@ def subset(src, dst):
     print(json.dumps({"ok": True, "points": len(rows_b), "of": len(a.points)}))
 
 
+def values(src, dst):
+    a, b = laspy.read(src), laspy.read(dst)
+    if len(a.points) != len(b.points):
+        fail(f"{len(b.points)} points, the input has {len(a.points)}")
+    for ax in "xyz":
+        d = float(np.max(np.abs(np.asarray(getattr(a, ax)) - np.asarray(getattr(b, ax)))))
+        if d > 1e-6:
+            fail(f"{ax} moved by {d}")
+    for d in dims(a):
+        if d not in dims(b):
+            fail(f"dimension {d} is gone")
+        if not np.array_equal(np.asarray(a[d]), np.asarray(b[d])):
+            fail(f"attribute {d} differs")
+    print(json.dumps({"ok": True, "points": len(b.points)}))
+
+
 def volume(src, base, cells):
     a = laspy.read(src)
     crs = a.header.parse_crs()
@@ -152,6 +172,6 @@ def copy(src, dst, shuffle=False):
 
 
 if __name__ == "__main__":
-    modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume,
+    modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume, "values": values,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

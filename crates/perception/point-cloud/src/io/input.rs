@@ -223,7 +223,16 @@ pub(crate) struct Points<'s> {
     pub(crate) streamed: u64,
     /// Subtracted from LAS/LAZ coordinates in f64, before they become f32.
     pub(crate) origin: [f64; 3],
+    /// Set the origin from the first finite point given in f64 (readers
+    /// of formats whose header gives no bounds: PCD, PLY, text).
+    pub(crate) origin_from_first: bool,
+    /// Columns besides x, y and z, a row for every point kept.
+    pub(crate) attributes: crate::Attributes,
 }
+
+/// Coordinates within this distance of zero are held about a zero origin
+/// when a file's header gives no bounds (f32 resolves 0.24 mm there).
+pub(crate) const ORIGIN_FREE: f64 = 4096.0;
 
 /// The receiver of a stream's chunks.
 pub(crate) type Sink<'s> = &'s mut dyn FnMut(&[Point]) -> crate::Result<()>;
@@ -280,6 +289,17 @@ impl<'s> Points<'s> {
     /// non-finite one.
     #[inline]
     pub(crate) fn push_f64(&mut self, x: f64, y: f64, z: f64) -> bool {
+        if self.origin_from_first && x.is_finite() && y.is_finite() && z.is_finite() {
+            // The first point's whole units where they are far from zero.
+            self.origin = [x, y, z].map(|v| {
+                if v.abs() > ORIGIN_FREE {
+                    v.round()
+                } else {
+                    0.0
+                }
+            });
+            self.origin_from_first = false;
+        }
         let o = self.origin;
         self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32])
     }

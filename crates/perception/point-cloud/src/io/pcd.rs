@@ -17,7 +17,7 @@ use super::input::{line_str, Input, Points};
 use super::lzf;
 use super::scalar::Scalar;
 use super::Encoding;
-use crate::Point;
+use crate::{Point, Values};
 
 /// Longest header or ASCII data line accepted (bytes).
 const MAX_LINE: usize = 1 << 20;
@@ -58,11 +58,26 @@ struct Axis {
     scalar: Scalar,
 }
 
+/// A field besides x, y and z, carried as a column of the cloud.
+#[derive(Debug, Clone)]
+struct Extra {
+    /// Byte offset in a binary record.
+    offset: usize,
+    /// Index among the values of an ASCII line.
+    value_index: usize,
+    /// Index of the field.
+    field: usize,
+    scalar: Scalar,
+    count: usize,
+}
+
 struct Header {
     fields: Vec<Field>,
     points: u64,
     data: Data,
     axes: [Axis; 3],
+    /// The fields carried as columns (one value a point, or bytes).
+    extras: Vec<Extra>,
     point_step: usize,
     values_per_point: usize,
     /// Lines read so far (the DATA line is the last one).
@@ -250,6 +265,7 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     let mut offset = 0usize;
     let mut value_index = 0usize;
     let mut axes: [Option<Axis>; 3] = [None; 3];
+    let mut extras = Vec::new();
     for (k, f) in fields.iter().enumerate() {
         // Any case: PDAL writes its dimensions X, Y and Z.
         let axis = match f.name.as_str() {
@@ -270,6 +286,16 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
                     scalar: f.scalar,
                 });
             }
+        } else if f.name != "_" && column_for(f.scalar, f.count).is_some() {
+            // PCL's "_" is padding; a field of several non-byte values (a
+            // descriptor's histogram) has no column and is skipped.
+            extras.push(Extra {
+                offset,
+                value_index,
+                field: k,
+                scalar: f.scalar,
+                count: f.count,
+            });
         }
         offset = f
             .scalar
@@ -312,6 +338,7 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
         points: n,
         data,
         axes: [x, y, z],
+        extras,
         point_step: offset,
         values_per_point: value_index,
         lines: line_no,
@@ -324,17 +351,37 @@ pub(crate) fn read<R: BufRead>(
     out: &mut Points<'_>,
 ) -> crate::Result<&'static str> {
     let h = read_header(input)?;
-    match h.data {
-        Data::Ascii => read_ascii(input, &h, out).map(|()| "pcd ascii"),
-        Data::Binary => read_binary(input, &h, out).map(|()| "pcd binary"),
-        Data::BinaryCompressed => read_compressed(input, &h, out).map(|()| "pcd binary_compressed"),
+    out.origin_from_first = true;
+    let mut cols: Vec<Values> = h
+        .extras
+        .iter()
+        .filter_map(|e| column_for(e.scalar, e.count))
+        .collect();
+    let name = match h.data {
+        Data::Ascii => read_ascii(input, &h, out, &mut cols).map(|()| "pcd ascii"),
+        Data::Binary => read_binary(input, &h, out, &mut cols).map(|()| "pcd binary"),
+        Data::BinaryCompressed => {
+            read_compressed(input, &h, out, &mut cols).map(|()| "pcd binary_compressed")
+        }
+    }?;
+    for (e, values) in h.extras.iter().zip(cols) {
+        out.attributes
+            .insert(h.fields[e.field].name.clone(), values);
     }
+    Ok(name)
+}
+
+/// An empty column for a field of `count` values of `scalar` (bytes may
+/// be several a point; other types one).
+fn column_for(scalar: Scalar, count: usize) -> Option<Values> {
+    Values::for_pcd(scalar.pcd_kind(), scalar.size(), count)
 }
 
 fn read_ascii<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
     out: &mut Points<'_>,
+    cols: &mut [Values],
 ) -> crate::Result<()> {
     // At least "0 " per value.
     out.reserve_bounded(h.points, input.remaining(), 2 * h.values_per_point as u64);
@@ -356,12 +403,14 @@ fn read_ascii<R: BufRead>(
                 h.points
             )));
         }
-        let mut p: Point = [0.0; 3];
-        let mut found = 0;
-        for (i, word) in text.split_ascii_whitespace().enumerate() {
+        // Coordinates at the text's own precision (f64), so a survey's
+        // northings keep their digits about the cloud's origin.
+        let mut p = [0.0_f64; 3];
+        let words: Vec<&str> = text.split_ascii_whitespace().collect();
+        for (i, word) in words.iter().enumerate() {
             for (a, axis) in h.axes.iter().enumerate() {
                 if axis.value_index == i {
-                    p[a] = axis.scalar.parse_f32(word).map_err(|why| {
+                    p[a] = axis.scalar.parse_f64(word).map_err(|why| {
                         input.format_err(format!(
                             "line {line_no}: {:?} is not a valid {} value ({why})",
                             word, h.fields[axis.field].name
@@ -369,15 +418,25 @@ fn read_ascii<R: BufRead>(
                     })?;
                 }
             }
-            found = i + 1;
         }
+        let found = words.len();
         if found != h.values_per_point {
             return Err(input.format_err(format!(
                 "line {line_no}: {found} values, the header's fields make {} per point",
                 h.values_per_point
             )));
         }
-        out.push(p);
+        if out.push_f64(p[0], p[1], p[2]) {
+            for (e, col) in h.extras.iter().zip(cols.iter_mut()) {
+                col.push_text(&words[e.value_index..e.value_index + e.count])
+                    .map_err(|why| {
+                        input.format_err(format!(
+                            "line {line_no}: field {}: {why}",
+                            h.fields[e.field].name
+                        ))
+                    })?;
+            }
+        }
         done += 1;
     }
     if done != h.points {
@@ -448,6 +507,7 @@ fn read_binary<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
     out: &mut Points<'_>,
+    cols: &mut [Values],
 ) -> crate::Result<()> {
     let step = h.point_step;
     let extra = check_data_size(input, h.points.checked_mul(step as u64), h, "binary data")?;
@@ -481,16 +541,21 @@ fn read_binary<R: BufRead>(
         let chunk = &mut buf[..k * step];
         input.read_exact_or(chunk, "binary point data")?;
         for rec in chunk.chunks_exact(step) {
-            let p = if all_f32 {
-                [f32le(&rec[ox..]), f32le(&rec[oy..]), f32le(&rec[oz..])]
+            let kept = if all_f32 {
+                out.push([f32le(&rec[ox..]), f32le(&rec[oy..]), f32le(&rec[oz..])])
             } else {
-                [
-                    h.axes[0].scalar.to_f32(&rec[ox..], false),
-                    h.axes[1].scalar.to_f32(&rec[oy..], false),
-                    h.axes[2].scalar.to_f32(&rec[oz..], false),
-                ]
+                // Doubles (PDAL writes X Y Z as F8) about the origin.
+                out.push_f64(
+                    h.axes[0].scalar.to_f64(&rec[ox..], false),
+                    h.axes[1].scalar.to_f64(&rec[oy..], false),
+                    h.axes[2].scalar.to_f64(&rec[oz..], false),
+                )
             };
-            out.push(p);
+            if kept {
+                for (e, col) in h.extras.iter().zip(cols.iter_mut()) {
+                    col.push_bytes(&rec[e.offset..], false);
+                }
+            }
         }
         left -= k as u64;
     }
@@ -512,6 +577,7 @@ fn read_compressed<R: BufRead>(
     input: &mut Input<'_, R>,
     h: &Header,
     out: &mut Points<'_>,
+    cols: &mut [Values],
 ) -> crate::Result<()> {
     let at = input.pos();
     let mut sizes = [0u8; 8];
@@ -548,14 +614,17 @@ fn read_compressed<R: BufRead>(
     // number is bounded by the compressed size times LZF's largest ratio.
     let n = usize::try_from(h.points)
         .map_err(|_| input.format_err("too many points for this machine"))?;
-    let mut points: Vec<Point> = vec![[0.0; 3]; n];
+    // Coordinates other than f32 (PDAL's F8) are gathered as raw columns
+    // and read in f64 about the origin, as the other encodings read them.
+    let doubles = h.axes.iter().any(|a| a.scalar != Scalar::F32);
+    let mut points: Vec<Point> = vec![[0.0; 3]; if doubles { 0 } else { n }];
     let mut column_start = 0u64;
-    let mut cols = Vec::with_capacity(3);
+    let mut axis_cols = Vec::with_capacity(3);
     for (k, f) in h.fields.iter().enumerate() {
         let stride = (f.scalar.size() * f.count) as u64;
         for (a, axis) in h.axes.iter().enumerate() {
             if axis.field == k {
-                cols.push(Column {
+                axis_cols.push(Column {
                     axis: a,
                     start: column_start,
                     stride,
@@ -566,12 +635,75 @@ fn read_compressed<R: BufRead>(
         }
         column_start += stride * h.points;
     }
+    // The other fields' columns, their bytes gathered as they stream by.
+    let starts: Vec<u64> = h
+        .fields
+        .iter()
+        .scan(0u64, |at, f| {
+            let s = *at;
+            *at += (f.scalar.size() * f.count) as u64 * h.points;
+            Some(s)
+        })
+        .collect();
+    let wanted = h
+        .extras
+        .iter()
+        .map(|e| (e.field, e.scalar.size() * e.count))
+        .chain(
+            h.axes
+                .iter()
+                .filter(|_| doubles)
+                .map(|a| (a.field, a.scalar.size())),
+        );
+    let mut raw: Vec<(u64, u64, Vec<u8>)> = wanted
+        .map(|(field, width)| {
+            let len = width as u64 * h.points;
+            (starts[field], len, Vec::with_capacity(len as usize))
+        })
+        .collect();
+    if doubles {
+        axis_cols.clear();
+    }
     lzf::decompress_stream(input, compressed, uncompressed, &mut |offset, bytes| {
-        for c in cols.iter_mut() {
+        for c in axis_cols.iter_mut() {
             c.take(offset, bytes, &mut points);
+        }
+        let end = offset + bytes.len() as u64;
+        for (start, len, buf) in raw.iter_mut() {
+            let want_end = *start + *len;
+            let (lo, hi) = ((*start + buf.len() as u64).max(offset), want_end.min(end));
+            if lo < hi {
+                buf.extend_from_slice(&bytes[(lo - offset) as usize..(hi - offset) as usize]);
+            }
         }
     })?;
     check_padding(input, left - compressed)?;
+    if doubles {
+        let axes = &raw[h.extras.len()..];
+        for i in 0..n {
+            let v = |a: usize| {
+                let size = h.axes[a].scalar.size();
+                h.axes[a].scalar.to_f64(&axes[a].2[i * size..], false)
+            };
+            if out.push_f64(v(0), v(1), v(2)) {
+                for ((e, col), (_, _, buf)) in h.extras.iter().zip(cols.iter_mut()).zip(&raw) {
+                    let w = e.scalar.size() * e.count;
+                    col.push_bytes(&buf[i * w..(i + 1) * w], false);
+                }
+            }
+        }
+        return Ok(());
+    }
+    let finite: Vec<bool> = points
+        .iter()
+        .map(|p| p.iter().all(|v| v.is_finite()))
+        .collect();
+    for ((e, col), (_, _, buf)) in h.extras.iter().zip(cols.iter_mut()).zip(&raw) {
+        let w = e.scalar.size() * e.count;
+        for (i, _) in finite.iter().enumerate().filter(|(_, &f)| f) {
+            col.push_bytes(&buf[i * w..(i + 1) * w], false);
+        }
+    }
     let before = points.len();
     points.retain(|p| p.iter().all(|v| v.is_finite()));
     out.non_finite += before - points.len();
@@ -627,12 +759,134 @@ impl Column {
     }
 }
 
-/// Writes `points` as PCD (fields x y z, F4) in the given encoding.
+/// Writes `cloud` as PCD in the given encoding: fields x y z as F4 for a
+/// cloud about a zero origin with no attributes (a sensor's frame, PCL's
+/// PointXYZ, bit for bit), otherwise [`write_fields`].
 ///
 /// binary_compressed builds the column-major buffer (12 bytes a point) and
 /// its LZF image in memory, as PCL does: the sizes precede the data, and
 /// LZF compresses one block. Use binary for clouds near the format's
 /// 4 GiB uncompressed limit.
+pub(crate) fn write_cloud<W: Write>(
+    w: &mut W,
+    cloud: &crate::PointCloud,
+    encoding: Encoding,
+) -> std::io::Result<()> {
+    if cloud.origin == [0.0; 3] && cloud.attributes.is_empty() {
+        write(w, &cloud.points, encoding)
+    } else {
+        write_fields(w, cloud, encoding)
+    }
+}
+
+/// A cloud about an origin, or with attributes, as PCD: x y z as F8 (the
+/// file's coordinates, origin added, as PDAL writes them) when the origin
+/// is not zero, then every column as a field of its own type (bytes as a
+/// U1 field of COUNT their width).
+fn write_fields<W: Write>(
+    w: &mut W,
+    cloud: &crate::PointCloud,
+    encoding: Encoding,
+) -> std::io::Result<()> {
+    let data = match encoding {
+        Encoding::Ascii => "ascii",
+        Encoding::Binary => "binary",
+        Encoding::BinaryCompressed => "binary_compressed",
+        Encoding::BinaryBigEndian => {
+            return Err(std::io::Error::other("PCD has no big-endian encoding"))
+        }
+    };
+    if let Some((name, len)) = cloud.attributes.mismatch(cloud.len()) {
+        return Err(std::io::Error::other(format!(
+            "the column {name} has {len} rows for {} points",
+            cloud.len()
+        )));
+    }
+    let wide = cloud.origin != [0.0; 3];
+    let xyz = if wide { ('F', 8) } else { ('F', 4) };
+    let cols = cloud.attributes.columns();
+    let mut names = vec!["x".to_string(), "y".into(), "z".into()];
+    let mut types = vec![xyz; 3];
+    let mut counts = vec![1usize; 3];
+    for c in cols {
+        let (k, size, count) = c.values.pcd_type();
+        names.push(c.name.replace(char::is_whitespace, "_"));
+        types.push((k, size));
+        counts.push(count);
+    }
+    let join = |v: Vec<String>| v.join(" ");
+    let n = cloud.len();
+    write!(
+        w,
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n",
+        join(names),
+        join(types.iter().map(|t| t.1.to_string()).collect()),
+        join(types.iter().map(|t| t.0.to_string()).collect()),
+        join(counts.iter().map(|c| c.to_string()).collect()),
+    )?;
+    // One value of field `f` of row `i` as bytes or text.
+    let coord = |i: usize, a: usize| cloud.origin[a] + f64::from(cloud.points[i][a]);
+    let bytes = |i: usize, f: usize, out: &mut Vec<u8>| match f {
+        0..=2 if wide => out.extend_from_slice(&coord(i, f).to_le_bytes()),
+        0..=2 => out.extend_from_slice(&cloud.points[i][f].to_le_bytes()),
+        _ => cols[f - 3].values.le_bytes_at(i, out),
+    };
+    let fields = 3 + cols.len();
+    match encoding {
+        Encoding::Ascii => {
+            let mut line = String::new();
+            for i in 0..n {
+                line.clear();
+                for f in 0..fields {
+                    if f > 0 {
+                        line.push(' ');
+                    }
+                    match f {
+                        0..=2 if wide => line.push_str(&format!("{:?}", coord(i, f))),
+                        0..=2 => line.push_str(&format!("{:?}", cloud.points[i][f])),
+                        _ => cols[f - 3].values.text_at(i, &mut line),
+                    }
+                }
+                line.push('\n');
+                w.write_all(line.as_bytes())?;
+            }
+        }
+        Encoding::Binary => {
+            let mut buf = Vec::with_capacity(CHUNK);
+            for i in 0..n {
+                for f in 0..fields {
+                    bytes(i, f, &mut buf);
+                }
+                if buf.len() >= CHUNK {
+                    w.write_all(&buf)?;
+                    buf.clear();
+                }
+            }
+            w.write_all(&buf)?;
+        }
+        Encoding::BinaryCompressed => {
+            let mut columns = Vec::new();
+            for f in 0..fields {
+                for i in 0..n {
+                    bytes(i, f, &mut columns);
+                }
+            }
+            let packed = lzf::compress(&columns);
+            let (Ok(c), Ok(u)) = (u32::try_from(packed.len()), u32::try_from(columns.len())) else {
+                return Err(std::io::Error::other(
+                    "binary_compressed PCD holds at most 4 GiB of uncompressed data; use binary",
+                ));
+            };
+            w.write_all(&c.to_le_bytes())?;
+            w.write_all(&u.to_le_bytes())?;
+            w.write_all(&packed)?;
+        }
+        Encoding::BinaryBigEndian => {}
+    }
+    Ok(())
+}
+
+/// Writes `points` as PCD (fields x y z, F4) in the given encoding.
 pub(crate) fn write<W: Write>(
     w: &mut W,
     points: &[Point],

@@ -235,7 +235,11 @@ fn report(out: Points<'_>, got: las::LasRead) -> ReadReport {
         cloud: PointCloud {
             points,
             origin: out.origin,
-            attributes: got.attributes,
+            attributes: if got.attributes.is_empty() {
+                out.attributes
+            } else {
+                got.attributes
+            },
             georef: got.georef,
         },
         non_finite_dropped: out.non_finite,

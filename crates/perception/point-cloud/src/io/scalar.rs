@@ -93,6 +93,43 @@ impl Scalar {
         }
     }
 
+    /// The value at the start of `b` as an `f64` (exact for every type but
+    /// 64-bit integers beyond 2⁵³).
+    #[inline]
+    pub(crate) fn to_f64(self, b: &[u8], big_endian: bool) -> f64 {
+        match self {
+            Scalar::F64 => {
+                let mut a = [0u8; 8];
+                a.copy_from_slice(&b[..8]);
+                if big_endian {
+                    f64::from_be_bytes(a)
+                } else {
+                    f64::from_le_bytes(a)
+                }
+            }
+            Scalar::I64 | Scalar::U64 => self.to_i128(b, big_endian) as f64,
+            other => f64::from(other.to_f32(b, big_endian)),
+        }
+    }
+
+    /// A text value as an `f64` (floats at the text's own precision;
+    /// integers checked as [`Scalar::parse_f32`] checks them).
+    pub(crate) fn parse_f64(self, s: &str) -> Result<f64, String> {
+        match self {
+            Scalar::F32 | Scalar::F64 => s.parse::<f64>().map_err(|_| "not a number".to_string()),
+            _ => self.parse_f32(s).map(f64::from),
+        }
+    }
+
+    /// PCD's TYPE letter.
+    pub(crate) fn pcd_kind(self) -> char {
+        match self {
+            Scalar::I8 | Scalar::I16 | Scalar::I32 | Scalar::I64 => 'I',
+            Scalar::U8 | Scalar::U16 | Scalar::U32 | Scalar::U64 => 'U',
+            Scalar::F32 | Scalar::F64 => 'F',
+        }
+    }
+
     /// The value at the start of `b` as an unsigned count (PLY list
     /// lengths); `None` for a negative value or a float type.
     pub(crate) fn to_count(self, b: &[u8], big_endian: bool) -> Option<u64> {

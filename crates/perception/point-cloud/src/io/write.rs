@@ -93,7 +93,7 @@ pub fn write_named(
         }
         _ => {
             let r = match format {
-                Format::Pcd => pcd::write(&mut w, points, encoding),
+                Format::Pcd => pcd::write_cloud(&mut w, cloud, encoding),
                 Format::Ply => ply::write(&mut w, points, encoding),
                 Format::Csv => xyz::write(&mut w, points, b',', Some("x,y,z")),
                 _ => xyz::write(&mut w, points, b' ', None),

@@ -933,7 +933,7 @@ fn tempdir_in(dir: &Path) -> Result<WorkDir> {
         .tempdir_in(dir)
         .map_err(|source| SurfaceError::Spill {
             path: dir.to_path_buf(),
-            source,
+            source: autoshovel_core::os_error(source),
         })?;
     Ok(WorkDir(made.keep()))
 }
