@@ -71,10 +71,14 @@ impl PointCloud {
         }
     }
 
-    /// Point `i` in the file's frame (f64).
+    /// Point `i` in the file's frame (f64); about a zero origin the point
+    /// itself (a −0 stays −0).
     pub fn world(&self, i: usize) -> [f64; 3] {
         let p = self.points[i];
-        [0, 1, 2].map(|a| self.origin[a] + f64::from(p[a]))
+        [0, 1, 2].map(|a| match self.origin[a] {
+            0.0 => f64::from(p[a]),
+            o => o + f64::from(p[a]),
+        })
     }
 
     /// The largest rounding error of a coordinate held as f32 about the

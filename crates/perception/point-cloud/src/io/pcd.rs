@@ -385,6 +385,7 @@ fn read_ascii<R: BufRead>(
 ) -> crate::Result<()> {
     // At least "0 " per value.
     out.reserve_bounded(h.points, input.remaining(), 2 * h.values_per_point as u64);
+    let all_f32 = h.axes.iter().all(|a| a.scalar == Scalar::F32);
     let mut line = Vec::new();
     let mut line_no = h.lines;
     let mut done = 0u64;
@@ -403,14 +404,20 @@ fn read_ascii<R: BufRead>(
                 h.points
             )));
         }
-        // Coordinates at the text's own precision (f64), so a survey's
-        // northings keep their digits about the cloud's origin.
+        // F4 coordinates are the f32 values the file holds, read as
+        // before; any other type (F8, integers) at its own precision (f64),
+        // so a survey's northings keep their digits about the origin.
         let mut p = [0.0_f64; 3];
         let words: Vec<&str> = text.split_ascii_whitespace().collect();
         for (i, word) in words.iter().enumerate() {
             for (a, axis) in h.axes.iter().enumerate() {
                 if axis.value_index == i {
-                    p[a] = axis.scalar.parse_f64(word).map_err(|why| {
+                    let v = if all_f32 {
+                        axis.scalar.parse_f32(word).map(f64::from)
+                    } else {
+                        axis.scalar.parse_f64(word)
+                    };
+                    p[a] = v.map_err(|why| {
                         input.format_err(format!(
                             "line {line_no}: {:?} is not a valid {} value ({why})",
                             word, h.fields[axis.field].name
@@ -426,7 +433,12 @@ fn read_ascii<R: BufRead>(
                 h.values_per_point
             )));
         }
-        if out.push_f64(p[0], p[1], p[2]) {
+        let kept = if all_f32 {
+            out.push(p.map(|v| v as f32))
+        } else {
+            out.push_f64(p[0], p[1], p[2])
+        };
+        if kept {
             for (e, col) in h.extras.iter().zip(cols.iter_mut()) {
                 col.push_text(&words[e.value_index..e.value_index + e.count])
                     .map_err(|why| {
