@@ -109,12 +109,12 @@ fn is_survey(cloud: &PointCloud) -> bool {
     cloud.georef.crs.unit.metres().is_some()
 }
 
+/// What step 1 decided: roll, pitch, the floor found while finding them,
+/// the mode that ran and why.
+type Angles = (f64, f64, Option<TiltEstimate>, &'static str, Option<String>);
+
 /// Step 1: the angles, and the floor found while finding them.
-fn angles(
-    cloud: &PointCloud,
-    a: &LevelAsked,
-    tilt: &TiltParams,
-) -> Result<(f64, f64, Option<TiltEstimate>, &'static str, Option<String>)> {
+fn angles(cloud: &PointCloud, a: &LevelAsked, tilt: &TiltParams) -> Result<Angles> {
     use crate::perceive::LevelMode;
     let estimate = |why: &'static str| -> Result<_> {
         let est = estimate_tilt(cloud, tilt).map_err(|e| stage(why, e))?;
@@ -227,7 +227,7 @@ pub(crate) fn level_and_ground(
             Err(e) => return Err(stage("finding the floor", e)),
         },
     };
-    let cut_at = (ground_mode != "none").then(|| floor.floor_height_m + a.margin);
+    let cut_at = (ground_mode != "none").then_some(floor.floor_height_m + a.margin);
     let note = match (level_note, ground_note) {
         (Some(l), Some(g)) => Some(format!("{l}; {g}")),
         (l, g) => l.or(g),
