@@ -29,10 +29,20 @@ fn read_cloud(
         .detach(|| autoshovel_point_cloud::io::read(&path, &mut |_, _| {}))
         .map_err(lib_err)?;
     Ok((
-        to_numpy(py, report.cloud.points),
+        to_numpy(py, world_points(report.cloud)),
         report.format,
         report.non_finite_dropped,
     ))
+}
+
+/// The file's coordinates, as the Python API has always returned them: a
+/// cloud held about an f64 origin (a UTM survey) has it added back, in
+/// f32 as the array is.
+fn world_points(c: PointCloud) -> Vec<autoshovel_point_cloud::Point> {
+    if c.origin == [0.0; 3] {
+        return c.points;
+    }
+    (0..c.len()).map(|i| c.world(i).map(|v| v as f32)).collect()
 }
 
 /// `write_cloud(path, points, encoding, overwrite)`: the points written
@@ -344,7 +354,10 @@ impl Perception {
         self.summary.clone()
     }
 
-    /// The cleaned, levelled points (a copy: the perception keeps its own).
+    /// The cleaned, levelled points (a copy: the perception keeps its own),
+    /// in the frame of `surface_height` and `floor_height_m`: about the
+    /// scan's origin (`origin` in `summary_json`; zero but for a survey in
+    /// map coordinates).
     fn points<'py>(&self, py: Python<'py>) -> Bound<'py, PyArray2<f32>> {
         to_numpy(py, self.got.cloud.points.clone())
     }
