@@ -51,8 +51,11 @@ impl PointCloud {
     /// attribute column, with the same origin and georeference (what a
     /// filter that drops points returns).
     pub fn select(&self, rows: &[usize]) -> PointCloud {
+        use rayon::prelude::*;
         PointCloud {
-            points: rows.iter().map(|&i| self.points[i]).collect(),
+            // In parallel: a stage of `perceive` keeps most of a 1 M-point
+            // scan, and a serial copy of it was 3 ms of the ground stage.
+            points: rows.par_iter().map(|&i| self.points[i]).collect(),
             origin: self.origin,
             attributes: self.attributes.select(rows),
             georef: self.georef.clone(),

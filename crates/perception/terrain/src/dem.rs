@@ -196,15 +196,28 @@ impl HeightGrid {
 
     /// The model's summary, its residuals measured on `cloud`.
     pub fn summary(&self, cloud: &PointCloud) -> GridSummary {
-        let (mut sum2, mut max, mut n) = (0.0_f64, 0.0_f64, 0_usize);
-        for p in &cloud.points {
-            let d = f64::from(p[2]) - self.height(f64::from(p[0]), f64::from(p[1]));
-            if d.is_finite() {
-                sum2 += d * d;
-                max = max.max(d.abs());
-                n += 1;
-            }
-        }
+        use rayon::prelude::*;
+        // In parallel chunks, summed in chunk order: the same sums on any
+        // number of threads.
+        let parts: Vec<(f64, f64, usize)> = cloud
+            .points
+            .par_chunks(1 << 14)
+            .map(|chunk| {
+                let (mut sum2, mut max, mut n) = (0.0_f64, 0.0_f64, 0_usize);
+                for p in chunk {
+                    let d = f64::from(p[2]) - self.height(f64::from(p[0]), f64::from(p[1]));
+                    if d.is_finite() {
+                        sum2 += d * d;
+                        max = max.max(d.abs());
+                        n += 1;
+                    }
+                }
+                (sum2, max, n)
+            })
+            .collect();
+        let (sum2, max, n) = parts.into_iter().fold((0.0, 0.0_f64, 0), |a, b| {
+            (a.0 + b.0, a.1.max(b.1), a.2 + b.2)
+        });
         let holes = self.holes();
         GridSummary {
             cell_m: self.cell,

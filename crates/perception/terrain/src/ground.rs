@@ -174,10 +174,16 @@ pub(crate) fn level_and_ground(
     tilt: &TiltParams,
 ) -> Result<Levelled> {
     let (roll, pitch, found, level_mode, level_note) = angles(cloud, a, tilt)?;
-    let mut levelled = cloud.clone();
-    if roll != 0.0 || pitch != 0.0 {
-        levelled.points = level(cloud, roll, pitch).points;
-    }
+    let levelled = PointCloud {
+        points: if roll != 0.0 || pitch != 0.0 {
+            level(cloud, roll, pitch).points
+        } else {
+            cloud.points.clone()
+        },
+        origin: cloud.origin,
+        attributes: cloud.attributes.clone(),
+        georef: cloud.georef.clone(),
+    };
     // A floor found while levelling is the levelled cloud's floor too:
     // levelling turns its normal onto z and keeps its offset ([RS eq. 11]–12).
     let found = found.map(|est| TiltEstimate {

@@ -922,8 +922,12 @@ pub fn perceive_after(
     let levelled = match prior {
         // A prior's angles and floor, no search.
         Some(prior) => {
-            let mut c = cloud.clone();
-            c.points = level(cloud, prior.roll_rad, prior.pitch_rad).points;
+            let c = PointCloud {
+                points: level(cloud, prior.roll_rad, prior.pitch_rad).points,
+                origin: cloud.origin,
+                attributes: cloud.attributes.clone(),
+                georef: cloud.georef.clone(),
+            };
             Levelled {
                 cloud: c,
                 roll: prior.roll_rad,
