@@ -221,3 +221,37 @@ fn bad_stages_and_outputs_are_refused_by_name_with_nothing_written() {
         "{m}"
     );
 }
+
+/// Issue 46: points dropped for a non-finite coordinate (an organised
+/// scan's NaN returns) are said on the first line and in the summary, and
+/// a field besides x, y, z (PCL's `intensity`) travels to the output.
+#[test]
+fn dropped_points_are_said_and_other_fields_are_kept() {
+    let dir = TempDir::new("filter-nan");
+    let input = std::path::Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("../../perception/point-cloud/tests/data/pcl_binary.pcd");
+    let output = dir.path().join("out.pcd");
+    let r = run(&[
+        "filter".as_ref(),
+        "--input".as_ref(),
+        input.as_os_str(),
+        "--output".as_ref(),
+        output.as_os_str(),
+        "--pass".as_ref(),
+        "z:-inf:inf".as_ref(),
+    ])
+    .ok();
+    let first = r.stdout.lines().next().unwrap_or("");
+    assert!(first.contains("1 non-finite points dropped"), "{first}");
+    let back = read(&output, &mut |_, _| {}).unwrap();
+    assert_eq!(back.cloud.len(), 6);
+    let intensity = back
+        .cloud
+        .attributes
+        .get("intensity")
+        .expect("intensity kept");
+    // The source's intensities 1 to 7 in order; the NaN point's (6) gone
+    // with it (tests/data/pcl_source.pcd).
+    let got: Vec<f64> = (0..6).map(|i| intensity.f64_at(i)).collect();
+    assert_eq!(got, [1.0, 2.0, 3.0, 4.0, 5.0, 7.0]);
+}
