@@ -28,7 +28,7 @@ use std::time::Instant;
 
 use autoshovel_point_cloud::filter::{
     pass_through_indices, radius_outlier_removal_indices, statistical_outlier_removal_indices,
-    voxel_grid_nearest, Axis, OutlierSides, PassThroughParams, RadiusOutlierParams,
+    voxel_grid, voxel_grid_nearest, Axis, OutlierSides, PassThroughParams, RadiusOutlierParams,
     StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, PointCloud};
@@ -296,6 +296,12 @@ impl Stage {
         // Removal keeps the same rows of every column; a voxel's centroid
         // takes the attributes of the point nearest it.
         let rows = match self {
+            // The nearest points' sort only where there are attributes
+            // to take from them.
+            Stage::Voxel(p) if cloud.attributes.is_empty() => {
+                let centroids = voxel_grid(cloud, p).map_err(flag)?;
+                return Ok(cloud.derived(centroids.points, None));
+            }
             Stage::Voxel(p) => {
                 let (centroids, nearest) = voxel_grid_nearest(cloud, p).map_err(flag)?;
                 return Ok(cloud.derived(centroids.points, Some(&nearest)));

@@ -126,18 +126,8 @@ pub fn voxel_grid_nearest(
     params: &VoxelGridParams,
 ) -> Result<(PointCloud, Vec<usize>)> {
     let centroids = voxel_grid(cloud, params)?.points;
-    let cells = VoxelCells::new(params)?;
     // The voxels in PCL's order (z slowest, x fastest), as the centroids.
-    let mut keys: Vec<([i64; 3], usize)> = cloud
-        .par_iter()
-        .enumerate()
-        .filter(|(_, p)| is_finite(p))
-        .map(|(i, p)| {
-            let c = cells.of(p);
-            ([c[2], c[1], c[0]], i)
-        })
-        .collect();
-    keys.par_sort_unstable();
+    let keys = sorted_triplets(cloud, &VoxelCells::new(params)?);
     let mut nearest = Vec::with_capacity(centroids.len());
     let d2 = |p: &Point, c: &Point| -> f64 {
         (0..3)
@@ -156,6 +146,23 @@ pub fn voxel_grid_nearest(
     }
     debug_assert_eq!(nearest.len(), centroids.len(), "one run a voxel");
     Ok((PointCloud::new(centroids), nearest))
+}
+
+/// Every finite point's voxel as a (z, y, x) triplet with its index,
+/// sorted: PCL's order (z slowest, x fastest), a voxel's points in input
+/// order.
+fn sorted_triplets(points: &[Point], cells: &VoxelCells) -> Vec<([i64; 3], usize)> {
+    let mut keys: Vec<([i64; 3], usize)> = points
+        .par_iter()
+        .enumerate()
+        .filter(|(_, p)| is_finite(p))
+        .map(|(i, p)| {
+            let c = cells.of(p);
+            ([c[2], c[1], c[0]], i)
+        })
+        .collect();
+    keys.par_sort_unstable();
+    keys
 }
 
 /// Which way [`centroids`] went.
@@ -300,16 +307,7 @@ fn centroids(
         )
     } else {
         // A box of 2⁶⁴ voxels or more: sort (z, y, x) triplets, same order.
-        let mut keys: Vec<([i64; 3], usize)> = points
-            .par_iter()
-            .enumerate()
-            .filter(|(_, p)| is_finite(p))
-            .map(|(i, p)| {
-                let c = cells.of(p);
-                ([c[2], c[1], c[0]], i)
-            })
-            .collect();
-        keys.par_sort_unstable();
+        let keys = sorted_triplets(points, &cells);
         (
             centroids_of_runs(points, &keys, |k| k.0, |k| k.1),
             Way::Triplets,

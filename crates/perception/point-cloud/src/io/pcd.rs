@@ -883,19 +883,25 @@ fn write_fields<W: Write>(
                     bytes(i, f, &mut columns);
                 }
             }
-            let packed = lzf::compress(&columns);
-            let (Ok(c), Ok(u)) = (u32::try_from(packed.len()), u32::try_from(columns.len())) else {
-                return Err(std::io::Error::other(
-                    "binary_compressed PCD holds at most 4 GiB of uncompressed data; use binary",
-                ));
-            };
-            w.write_all(&c.to_le_bytes())?;
-            w.write_all(&u.to_le_bytes())?;
-            w.write_all(&packed)?;
+            write_lzf(w, &columns)?;
         }
         Encoding::BinaryBigEndian => {}
     }
     Ok(())
+}
+
+/// The data of a binary_compressed PCD: the compressed and uncompressed
+/// sizes, then the LZF image of the column-major `columns`.
+fn write_lzf<W: Write>(w: &mut W, columns: &[u8]) -> std::io::Result<()> {
+    let packed = lzf::compress(columns);
+    let (Ok(c), Ok(u)) = (u32::try_from(packed.len()), u32::try_from(columns.len())) else {
+        return Err(std::io::Error::other(
+            "binary_compressed PCD holds at most 4 GiB of uncompressed data (357 913 941 x y z points); use binary",
+        ));
+    };
+    w.write_all(&c.to_le_bytes())?;
+    w.write_all(&u.to_le_bytes())?;
+    w.write_all(&packed)
 }
 
 /// Writes `points` as PCD (fields x y z, F4) in the given encoding.
@@ -943,15 +949,7 @@ pub(crate) fn write<W: Write>(
                     columns.extend_from_slice(&p[a].to_le_bytes());
                 }
             }
-            let packed = lzf::compress(&columns);
-            let (Ok(c), Ok(u)) = (u32::try_from(packed.len()), u32::try_from(columns.len())) else {
-                return Err(std::io::Error::other(
-                    "binary_compressed PCD holds at most 4 GiB of uncompressed data (357 913 941 points); use binary",
-                ));
-            };
-            w.write_all(&c.to_le_bytes())?;
-            w.write_all(&u.to_le_bytes())?;
-            w.write_all(&packed)?;
+            write_lzf(w, &columns)?;
         }
         Encoding::BinaryBigEndian => {}
     }
