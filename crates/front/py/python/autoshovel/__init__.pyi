@@ -37,10 +37,15 @@ class Perception(Summary):
     floor_rms_m: float
     floor_share: float
     format: str
+    ground_mode: str
+    ground_note: Optional[str]
+    height_model: Summary
     input: str
     input_points: int
     job: str
+    level_mode: str
     non_finite_dropped: int
+    origin: list[float]
     output_points: int
     pipeline: Summary
     pitch_deg: float
@@ -54,6 +59,8 @@ class Perception(Summary):
     success: bool
     timings_ms: Summary
     total_ms: float
+    volume_base_m: float
+    volume_m3: float
     @property
     def points(self) -> npt.NDArray[np.float32]: ...
     def surface_height(self, x: npt.ArrayLike, y: npt.ArrayLike) -> npt.NDArray[np.float64]: ...
