@@ -14,11 +14,12 @@ use crate::output::Report as _;
 use crate::pile::EncodingArg;
 
 /// The stage flags, in no particular order (the command line gives it).
-const STAGES: [StageKind; 5] = [
+const STAGES: [StageKind; 6] = [
     StageKind::Voxel,
     StageKind::Statistical,
     StageKind::Radius,
     StageKind::Pass,
+    StageKind::Range,
     StageKind::Level,
 ];
 
@@ -46,6 +47,9 @@ pub struct Args {
     /// Pass-through (PCL PassThrough): AXIS:MIN:MAX keeps MIN ≤ v ≤ MAX; add :outside for the rest; -inf/inf for no limit.
     #[arg(long, value_name = "AXIS:MIN:MAX", allow_hyphen_values = true)]
     pub pass: Vec<String>,
+    /// Keep points by dimension ranges (PDAL filters.range): e.g. Classification[2:2] for a classified survey's ground; ranges of one dimension ORed, of different ones ANDed; X/Y/Z are the file's coordinates.
+    #[arg(long, value_name = "LIMITS", allow_hyphen_values = true)]
+    pub range: Vec<String>,
     /// Level the sensor frame: ROLL,PITCH (deg).
     #[arg(long, value_name = "ROLL,PITCH", allow_hyphen_values = true)]
     pub level: Vec<String>,

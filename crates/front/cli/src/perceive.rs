@@ -237,5 +237,8 @@ pub fn run(args: &Args) -> Result<()> {
         if let Some(note) = &s.ground_note {
             crate::say!("  {note}");
         }
+        for w in &s.warnings {
+            eprintln!("warning: {w}");
+        }
     })
 }

@@ -104,7 +104,8 @@ pub fn filter(
     .during(|| format!("reading {}", input.display()))?;
     bar.finish_and_clear();
     let read_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let (cloud, report) = run_chain(&got.cloud, stages)?;
+    let (cloud, report) =
+        run_chain(&got.cloud, stages).during(|| format!("filtering {}", input.display()))?;
     let filter_ms: f64 = report.iter().map(|r| r.ms).sum();
     let t1 = std::time::Instant::now();
     let encoding = write_cloud(output, &[input.to_path_buf()], &cloud, encoding, force)?;

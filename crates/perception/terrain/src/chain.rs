@@ -6,7 +6,7 @@
 //!
 //! A stage is written as on the command line of `autoshovel filter`
 //! (`--voxel 0.05`, `--statistical 50,1.0`, `--radius 0.05,3`,
-//! `--pass z:-10.5:-3`, `--level 3,-2`):
+//! `--pass z:-10.5:-3`, `--range Classification[2:2]`, `--level 3,-2`):
 //!
 //! ```
 //! use autoshovel_terrain::chain::{run_chain, Stage, StageKind};
@@ -27,9 +27,10 @@
 use std::time::Instant;
 
 use autoshovel_point_cloud::filter::{
-    pass_through_indices, radius_outlier_removal_indices, statistical_outlier_removal_indices,
-    voxel_grid, voxel_grid_nearest, Axis, OutlierSides, PassThroughParams, RadiusOutlierParams,
-    StatisticalOutlierParams, VoxelGridParams,
+    pass_through_indices, radius_outlier_removal_indices, range_indices,
+    statistical_outlier_removal_indices, voxel_grid, voxel_grid_nearest, Axis, OutlierSides,
+    PassThroughParams, RadiusOutlierParams, RangeLimits, StatisticalOutlierParams,
+    VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::Serialize;
@@ -53,6 +54,9 @@ pub enum StageKind {
     /// `--pass AXIS:MIN:MAX[:outside]` (m): PCL's PassThrough, keeping
     /// MIN ≤ v ≤ MAX (or the rest with `outside`); `-inf`/`inf` for no limit.
     Pass,
+    /// `--range LIMITS`: PDAL's range filter, e.g. `Classification[2:2]`
+    /// (a classified survey's ground) or `Z[0:100],Intensity(50:]`.
+    Range,
     /// `--level ROLL,PITCH` (deg): rotate the sensor frame level
     /// ([RS eq. 11]–[RS eq. 12]).
     Level,
@@ -66,6 +70,7 @@ impl StageKind {
             StageKind::Statistical => "statistical",
             StageKind::Radius => "radius",
             StageKind::Pass => "pass",
+            StageKind::Range => "range",
             StageKind::Level => "level",
         }
     }
@@ -77,13 +82,16 @@ impl StageKind {
             StageKind::Statistical => "K,ALPHA or K,ALPHA,both, e.g. 50,1.0",
             StageKind::Radius => "RADIUS,MIN_NEIGHBOURS, e.g. 0.05,3",
             StageKind::Pass => "AXIS:MIN:MAX or AXIS:MIN:MAX:outside, e.g. z:-10.5:-3",
+            StageKind::Range => {
+                "PDAL's ranges, Dimension[MIN:MAX] (! negates, ( ) open ends), comma-separated, e.g. Classification[2:2]"
+            }
             StageKind::Level => "ROLL,PITCH in degrees, e.g. 3,-2",
         }
     }
 }
 
 /// One stage of a chain.
-#[derive(Debug, Clone, Copy, PartialEq)]
+#[derive(Debug, Clone, PartialEq)]
 pub enum Stage {
     /// Voxel-grid down-sampling to centroids.
     Voxel(VoxelGridParams),
@@ -93,6 +101,8 @@ pub enum Stage {
     Radius(RadiusOutlierParams),
     /// Pass-through on one axis.
     Pass(PassThroughParams),
+    /// Selection by dimension ranges (PDAL's `filters.range`).
+    Range(RangeLimits),
     /// Levelling by roll and pitch, in degrees as given.
     Level {
         /// Sensor roll α (deg).
@@ -222,6 +232,7 @@ impl Stage {
                     keep_inside,
                 })
             }
+            StageKind::Range => Stage::Range(RangeLimits::parse(spec).map_err(bad)?),
             StageKind::Level => {
                 arity(&[2])?;
                 Stage::Level {
@@ -239,6 +250,7 @@ impl Stage {
             Stage::Statistical(_) => StageKind::Statistical,
             Stage::Radius(_) => StageKind::Radius,
             Stage::Pass(_) => StageKind::Pass,
+            Stage::Range(_) => StageKind::Range,
             Stage::Level { .. } => StageKind::Level,
         }
     }
@@ -257,7 +269,7 @@ impl Stage {
     /// a neighbour distance or a rotation would mix degrees with metres.
     fn check_units(&self, cloud: &PointCloud) -> Result<()> {
         let crs = &cloud.georef.crs;
-        if !crs.is_geographic() || matches!(self, Stage::Pass(_)) {
+        if !crs.is_geographic() || matches!(self, Stage::Pass(_) | Stage::Range(_)) {
             return Ok(());
         }
         Err(SurfaceError::StageFailed {
@@ -266,7 +278,7 @@ impl Stage {
             problem: format!(
                 "the cloud's x and y are degrees of longitude and latitude ({crs}), not metres: \
                  project it first (e.g. `pdal translate IN OUT reprojection --filters.reprojection.out_srs=EPSG:326NN` \
-                 for its UTM zone); only --pass works on degrees"
+                 for its UTM zone); only --pass and --range work on degrees"
             ),
         })
     }
@@ -276,17 +288,17 @@ impl Stage {
     /// says so); coordinates (--pass) are the file's own already.
     fn in_file_units(&self, cloud: &PointCloud) -> Stage {
         let Some(unit_m) = cloud.georef.crs.unit.metres().filter(|&u| u != 1.0) else {
-            return *self;
+            return self.clone();
         };
-        match *self {
+        match self {
             Stage::Voxel(p) => Stage::Voxel(VoxelGridParams {
                 leaf_m: p.leaf_m.map(|l| l / unit_m),
             }),
             Stage::Radius(p) => Stage::Radius(RadiusOutlierParams {
                 radius_m: p.radius_m / unit_m,
-                ..p
+                ..*p
             }),
-            other => other,
+            other => other.clone(),
         }
     }
 
@@ -308,6 +320,7 @@ impl Stage {
             }
             Stage::Statistical(p) => statistical_outlier_removal_indices(cloud, p),
             Stage::Radius(p) => radius_outlier_removal_indices(cloud, p),
+            Stage::Range(limits) => range_indices(cloud, limits),
             Stage::Pass(p) => {
                 // MIN and MAX are in the file's frame, the points about
                 // the cloud's origin.
@@ -409,6 +422,7 @@ impl Stage {
                     StageKind::Pass => "widen MIN:MAX, check the axis, or add :outside",
                     StageKind::Statistical => "raise ALPHA",
                     StageKind::Radius => "lower MIN_NEIGHBOURS or raise RADIUS",
+                    StageKind::Range => "check the ranges against the file's values",
                     _ => "check the previous stage",
                 }
             ),
@@ -499,6 +513,7 @@ impl Stage {
                 roll_deg,
                 pitch_deg,
             } => format!("{},{}", short(*roll_deg), short(*pitch_deg)),
+            Stage::Range(limits) => limits.to_string(),
         }
     }
 }

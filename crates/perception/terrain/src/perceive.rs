@@ -37,11 +37,11 @@ use std::time::Instant;
 use autoshovel_core::config::{self, TomlFile};
 use autoshovel_point_cloud::filter::{
     bilateral_normal_smoothing, pass_through_indices, radius_outlier_removal_indices,
-    radius_outlier_removal_then, statistical_outlier_removal_indices, voxel_grid, BilateralParams,
-    OutlierSides, PassThroughParams, RadiusKept, RadiusOutlierParams, StatisticalOutlierParams,
-    VoxelGridParams,
+    radius_outlier_removal_then, range_indices, statistical_outlier_removal_indices, voxel_grid,
+    BilateralParams, OutlierSides, PassThroughParams, RadiusKept, RadiusOutlierParams,
+    RangeLimits, StatisticalOutlierParams, VoxelGridParams,
 };
-use autoshovel_point_cloud::PointCloud;
+use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::{Deserialize, Serialize};
 
 use crate::calibrate::level;
@@ -128,6 +128,8 @@ pub struct PerceptionParams {
     pub scale: ScaleSetting,
     /// Mean point spacing (m): a number, or "auto" (√(area / points)).
     pub spacing: ScaleSetting,
+    /// Selection by dimension ranges, before anything else.
+    pub range: RangeStage,
     /// Levelling.
     pub level: LevelStage,
     /// Floor removal.
@@ -142,6 +144,19 @@ pub struct PerceptionParams {
     pub smooth: SmoothStage,
     /// Surface fit.
     pub fit: FitStage,
+}
+
+/// Selection settings: PDAL's range filter (`filters.range`) on the
+/// file's dimensions, first of all the stages, e.g. `limits =
+/// "Classification[2:2]"` to perceive a classified survey's ground
+/// without its trees and buildings. Unset, every point goes on.
+#[derive(Debug, Clone, Default, PartialEq, Serialize, Deserialize)]
+#[serde(default, deny_unknown_fields)]
+pub struct RangeStage {
+    /// PDAL's ranges (`Dimension[MIN:MAX]`, `!` negates, `(`/`)` open
+    /// ends, comma-separated; one dimension's ranges ORed, different
+    /// dimensions' ANDed); X, Y and Z are the file's coordinates.
+    pub limits: Option<String>,
 }
 
 /// Levelling settings.
@@ -275,6 +290,7 @@ impl Default for PerceptionParams {
         Self {
             scale: ScaleSetting::Word(AutoWord::Auto),
             spacing: ScaleSetting::Word(AutoWord::Auto),
+            range: RangeStage::default(),
             level: LevelStage::default(),
             ground: GroundStage::default(),
             radius: RadiusStage::default(),
@@ -365,6 +381,19 @@ impl TomlFile for PerceptionParams {
 
     /// Every number in range, named by its TOML key.
     fn check(&self, text: &str, file: &str) -> Result<()> {
+        if let Some(spec) = &self.range.limits {
+            if let Err(problem) = RangeLimits::parse(spec) {
+                return Err(config::invalid(
+                    text,
+                    file,
+                    ("range", 0),
+                    "limits",
+                    format!("{spec:?}"),
+                    format!("PDAL's ranges, e.g. \"Classification[2:2]\" ({problem})"),
+                )
+                .into());
+            }
+        }
         for (key, s) in [("scale", self.scale), ("spacing", self.spacing)] {
             if let ScaleSetting::Factor(v) = s {
                 if !(v.is_finite() && v > 0.0) {
@@ -656,6 +685,9 @@ pub struct Perceived {
     pub model: Model,
     /// What the level and ground stages did.
     pub used: GroundUsed,
+    /// What the result does not hold well, with what to do
+    /// ([`surface_warnings`]).
+    pub warnings: Vec<String>,
 }
 
 /// The gridded height model of a perceived scan and the volume it holds.
@@ -857,6 +889,9 @@ pub fn perceive_after(
             crs: cloud.georef.crs.to_string(),
         });
     }
+    let given = cloud;
+    let ranged = select_range(cloud, p)?;
+    let cloud = ranged.as_ref().map_or(cloud, |(c, _)| c);
     // Perception measures in metres: a cloud in feet (a State Plane
     // survey) is converted first, and what perception returns is metres.
     let converted;
@@ -908,6 +943,13 @@ pub fn perceive_after(
     }
     p.check_work(1.0, input_points)?;
     let mut stages: Vec<StageRecord> = Vec::new();
+    if let Some((c, ms)) = &ranged {
+        stages.push(StageRecord {
+            stage: "range",
+            points: c.len(),
+            ms: *ms,
+        });
+    }
     let in_stage = |stage: &'static str| {
         move |source: SurfaceError| SurfaceError::Stage {
             stage,
@@ -1064,6 +1106,7 @@ pub fn perceive_after(
         points: fit.samples.len(),
         ms: elapsed_ms(t),
     });
+    let warnings = surface_warnings(given, &model.summary, p);
     Ok(Perceived {
         cloud,
         fit,
@@ -1079,7 +1122,88 @@ pub fn perceive_after(
         input_points,
         format: None,
         non_finite_dropped: 0,
+        warnings,
     })
+}
+
+/// The height model's RMS residual, over its cell's edge, past which the
+/// cleaned points lie on more than one surface at once (trees over the
+/// ground, walls, overhangs): on one surface of any slope up to 45° the
+/// points of a cell stray from a bilinear model by well under the cell's
+/// edge.
+pub const LAYERED_RESIDUAL_PER_CELL: f64 = 1.0;
+
+/// The ASPRS class of ground points in a LAS file (LAS 1.4 R15, table 17).
+const ASPRS_GROUND: f64 = 2.0;
+
+/// What the result does not hold well, each with what to do: a height
+/// model whose residual says the points lie on several surfaces, with,
+/// where the file classifies ground and no `[range]` was given, the
+/// setting that perceives the ground alone.
+fn surface_warnings(given: &PointCloud, model: &GridSummary, p: &PerceptionParams) -> Vec<String> {
+    let mut out = Vec::new();
+    let per_cell = model.rms_residual_m / model.cell_m;
+    if per_cell.is_nan() || per_cell <= LAYERED_RESIDUAL_PER_CELL {
+        return out;
+    }
+    let ground = match (&p.range.limits, given.attributes.get("Classification")) {
+        (None, Some(class)) => (0..class.len())
+            .filter(|&i| class.f64_at(i) == ASPRS_GROUND)
+            .count(),
+        _ => 0,
+    };
+    let advice = if ground > 0 {
+        format!(
+            "the file classifies {ground} of its {} points as ground (class 2): \
+             [range] limits = \"Classification[2:2]\" perceives them alone",
+            given.len()
+        )
+    } else {
+        "keep one surface with [range] limits (e.g. a classification, or Z below the canopy), \
+         or classify the ground first (e.g. PDAL's filters.smrf)"
+            .to_string()
+    };
+    out.push(format!(
+        "the height model's RMS residual is {} m on cells of {} m: the points lie on more than \
+         one surface (trees or buildings over the ground, walls, overhangs); {advice}",
+        config::approx(model.rms_residual_m),
+        config::approx(model.cell_m)
+    ));
+    out
+}
+
+/// The rows of `cloud` that `[range] limits` keeps, and the stage's time
+/// (ms); `None` without limits.
+fn select_range(cloud: &PointCloud, p: &PerceptionParams) -> Result<Option<(PointCloud, f64)>> {
+    let Some(spec) = &p.range.limits else {
+        return Ok(None);
+    };
+    let t = Instant::now();
+    let filter = |source| SurfaceError::Filter {
+        stage: "range",
+        source,
+    };
+    let limits = RangeLimits::parse(spec).map_err(|problem| {
+        filter(CloudError::BadParameter {
+            filter: "range",
+            what: format!("[range] limits = {spec:?}: {problem}"),
+        })
+    })?;
+    let rows = range_indices(cloud, &limits).map_err(|e| {
+        filter(match e {
+            CloudError::BadParameter { filter, what } => CloudError::BadParameter {
+                filter,
+                what: format!("[range] limits = {spec:?}: {what}"),
+            },
+            CloudError::Emptied { filter, input, .. } => CloudError::Emptied {
+                filter,
+                input,
+                hint: format!("no point passes [range] limits = {spec:?}: check them against the file's values"),
+            },
+            other => other,
+        })
+    })?;
+    Ok(Some((cloud.select(&rows), elapsed_ms(t))))
 }
 
 /// `cloud` in metres when its CRS's unit is another length (feet, US
@@ -1241,6 +1365,9 @@ pub struct PerceiveSummary {
     pub ground_mode: &'static str,
     /// Why, where `auto` chose.
     pub ground_note: Option<String>,
+    /// What the result does not hold well, each with what to do (also
+    /// printed on stderr).
+    pub warnings: Vec<String>,
     /// The gridded height model: cells, holes, residuals on the cleaned
     /// points.
     pub height_model: GridSummary,
@@ -1288,6 +1415,7 @@ impl PerceiveSummary {
             level_mode: got.used.level_mode,
             ground_mode: got.used.ground_mode,
             ground_note: got.used.note.clone(),
+            warnings: got.warnings.clone(),
             height_model: got.model.summary.clone(),
             volume_m3: got.model.volume_m3,
             volume_base_m: got.model.base + got.cloud.origin[2],

@@ -15,11 +15,16 @@
                                coordinate within 1e-6 and every dimension
                                of IN equal, whatever OUT's header (a trip
                                through a format with no CRS)
-  las_peer.py volume IN BASE CELLS
+  las_peer.py range IN OUT CLASS ZMIN
+                               OUT is exactly IN's rows of classification CLASS
+                               with z >= ZMIN, in order (filter --range)
+  las_peer.py volume IN BASE CELLS [CLASS]
                                the volume above z = BASE (m) of IN's mean-height
                                grid, cells CELLS point spacings wide, the points
                                at or above BASE only, in metres by pyproj's
-                               unit of IN's CRS (perceive with every filter off)
+                               unit of IN's CRS (perceive with every filter off);
+                               with CLASS, of the points of that classification
+                               alone (perceive's [range] Classification[C:C])
 
 Prints one JSON line; exits 1 with the first difference.
 """
@@ -117,6 +122,18 @@ def subset(src, dst):
     print(json.dumps({"ok": True, "points": len(rows_b), "of": len(a.points)}))
 
 
+def ranged(src, dst, klass, zmin):
+    """OUT is exactly IN's rows of classification KLASS with z >= ZMIN, in order."""
+    a, b = laspy.read(src), laspy.read(dst)
+    header_same(a, b)
+    keep = (np.asarray(a.classification) == int(klass)) & (np.asarray(a.z) >= float(zmin))
+    want = list(zip(*[np.asarray(c)[keep].tolist() for c in table(a)]))
+    got = list(zip(*[c.tolist() for c in table(b)]))
+    if want != got:
+        fail(f"{len(got)} points, numpy selects {len(want)} (or the rows differ)")
+    print(json.dumps({"ok": True, "points": len(got), "of": len(a.points)}))
+
+
 def values(src, dst):
     a, b = laspy.read(src), laspy.read(dst)
     if len(a.points) != len(b.points):
@@ -133,11 +150,14 @@ def values(src, dst):
     print(json.dumps({"ok": True, "points": len(b.points)}))
 
 
-def volume(src, base, cells):
+def volume(src, base, cells, klass=None):
     a = laspy.read(src)
     crs = a.header.parse_crs()
     unit = crs.axis_info[0].unit_conversion_factor if crs is not None else 1.0
     x, y, z = (np.asarray(getattr(a, ax), dtype=np.float64) * unit for ax in "xyz")
+    if klass is not None:
+        mine = np.asarray(a.classification) == int(klass)
+        x, y, z = x[mine], y[mine], z[mine]
     spacing = np.sqrt((x.max() - x.min()) * (y.max() - y.min()) / len(x))
     base = float(base)
     keep = z >= base
@@ -173,5 +193,6 @@ def copy(src, dst, shuffle=False):
 
 if __name__ == "__main__":
     modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume, "values": values,
+             "range": ranged,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

@@ -10,6 +10,7 @@
 //! | down-sampling to voxel centroids | [`voxel_grid`] | [RS eq. 17]–[RS eq. 18] | `pcl::VoxelGrid` |
 //! | normals by PCA | [`estimate_normals`] | §3.2, before [RS eq. 19] | `pcl::NormalEstimation` |
 //! | bilateral smoothing along normals | [`bilateral_normal_smoothing`] | [RS eq. 19]–[RS eq. 20] | none in PCL's filters or in Open3D |
+//! | selection by attribute ranges | [`range_indices`] | not in the papers (a classified survey's ground) | PDAL `filters.range` |
 //!
 //! Every filter is a free function taking the cloud and a plain parameter
 //! struct with a `Default`; the removal filters also come as `*_indices`
@@ -31,6 +32,7 @@ mod common;
 mod exp;
 mod normals;
 mod pass_through;
+mod range;
 mod radius_outlier;
 mod statistical_outlier;
 mod voxel_grid;
@@ -38,6 +40,7 @@ mod voxel_grid;
 pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
 pub use pass_through::{pass_through, pass_through_indices, Axis, PassThroughParams};
+pub use range::{range_indices, Range, RangeLimits};
 pub use radius_outlier::{
     radius_outlier_removal, radius_outlier_removal_indices, radius_outlier_removal_then,
     RadiusKept, RadiusOutlierParams,
