@@ -258,8 +258,15 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     };
     let rms = |v: &serde_json::Value| v["height_model"]["rms_residual_m"].as_f64().unwrap();
     let plain = perceive(None);
-    assert!(rms(&plain) > 1.0, "trees over the ground: {}", plain["height_model"]);
-    let warning = plain["warnings"][0].as_str().unwrap_or_default().to_string();
+    assert!(
+        rms(&plain) > 1.0,
+        "trees over the ground: {}",
+        plain["height_model"]
+    );
+    let warning = plain["warnings"][0]
+        .as_str()
+        .unwrap_or_default()
+        .to_string();
     let setting = warning
         .split_once("[range] limits = ")
         .and_then(|(_, rest)| rest.split_whitespace().next())
@@ -267,15 +274,49 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     assert_eq!(setting, "\"Classification[2:2]\"");
     let advised = tmp.write("advised.toml", format!("[range]\nlimits = {setting}\n"));
     let ground = perceive(Some(&advised));
-    assert!(rms(&ground) < 0.05, "the ground alone: {}", ground["height_model"]);
+    assert!(
+        rms(&ground) < 0.05,
+        "the ground alone: {}",
+        ground["height_model"]
+    );
     assert_eq!(ground["warnings"], serde_json::json!([]));
-    assert_eq!(ground["stage_points"]["range"], 9003, "laspy counts 9003 of class 2");
+    assert_eq!(
+        ground["stage_points"]["range"], 9003,
+        "laspy counts 9003 of class 2"
+    );
     // The same ranges through `filter`, as PDAL writes them, against numpy's
     // selection of the same rows (z in the file's US survey feet).
     let out = tmp.path().join("ground.las");
     filter(&input, &out, &["--range", "Classification[2:2],z[7085:]"]);
-    let v = peer(&py, &[&input, &out, Path::new("2"), Path::new("7085")], "range");
+    let v = peer(
+        &py,
+        &[&input, &out, Path::new("2"), Path::new("7085")],
+        "range",
+    );
     assert!(v["points"].as_u64().unwrap() > 1000, "{v}");
+    // The survey path reads no dimensions: it refuses the range, saying to
+    // select first; done so, the selected file perceives by tiles.
+    let args = |f: &Path, c: Option<&Path>| {
+        let mut a = vec![
+            "perceive".into(),
+            "--tiles".into(),
+            "--input".into(),
+            f.display().to_string(),
+        ];
+        if let Some(c) = c {
+            a.extend(["--config".into(), c.display().to_string()]);
+        }
+        a
+    };
+    let refused = run(&args(&input, Some(&advised))).fails();
+    let m = refused.error_message();
+    assert!(
+        m.contains("not applied with --tiles") && m.contains("--range"),
+        "{m}"
+    );
+    let ground_only = tmp.path().join("ground-only.las");
+    filter(&input, &ground_only, &["--range", "Classification[2:2]"]);
+    run(&args(&ground_only, None)).ok();
 
     let base_m = 2160.0;
     let with_base = tmp.write(
@@ -290,7 +331,11 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     let v = perceive(Some(&with_base));
     let ours = f64_field(&v, "volume_m3");
     let base = Path::new(&base_m.to_string()).to_path_buf();
-    let theirs = peer(&py, &[&input, &base, Path::new("3"), Path::new("2")], "volume");
+    let theirs = peer(
+        &py,
+        &[&input, &base, Path::new("3"), Path::new("2")],
+        "volume",
+    );
     let theirs = theirs["volume_m3"].as_f64().unwrap();
     assert!(theirs > 100.0, "a real volume, {theirs}");
     assert!(

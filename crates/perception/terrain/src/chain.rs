@@ -29,8 +29,7 @@ use std::time::Instant;
 use autoshovel_point_cloud::filter::{
     pass_through_indices, radius_outlier_removal_indices, range_indices,
     statistical_outlier_removal_indices, voxel_grid, voxel_grid_nearest, Axis, OutlierSides,
-    PassThroughParams, RadiusOutlierParams, RangeLimits, StatisticalOutlierParams,
-    VoxelGridParams,
+    PassThroughParams, RadiusOutlierParams, RangeLimits, StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::Serialize;

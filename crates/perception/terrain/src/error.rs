@@ -152,6 +152,15 @@ pub enum SurfaceError {
         #[source]
         source: autoshovel_point_cloud::CloudError,
     },
+    /// A setting the tiled survey path (`perceive --tiles`) does not
+    /// apply: refused rather than ignored.
+    #[error("{setting} is not applied with --tiles: {instead}")]
+    NotWithTiles {
+        /// The setting as written (`[range] limits = "..."`).
+        setting: String,
+        /// What to do instead.
+        instead: &'static str,
+    },
     /// A stage of the perception pipeline failed.
     #[error("{stage}")]
     Stage {

@@ -38,8 +38,8 @@ use autoshovel_core::config::{self, TomlFile};
 use autoshovel_point_cloud::filter::{
     bilateral_normal_smoothing, pass_through_indices, radius_outlier_removal_indices,
     radius_outlier_removal_then, range_indices, statistical_outlier_removal_indices, voxel_grid,
-    BilateralParams, OutlierSides, PassThroughParams, RadiusKept, RadiusOutlierParams,
-    RangeLimits, StatisticalOutlierParams, VoxelGridParams,
+    BilateralParams, OutlierSides, PassThroughParams, RadiusKept, RadiusOutlierParams, RangeLimits,
+    StatisticalOutlierParams, VoxelGridParams,
 };
 use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::{Deserialize, Serialize};

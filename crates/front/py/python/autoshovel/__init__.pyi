@@ -61,6 +61,7 @@ class Perception(Summary):
     total_ms: float
     volume_base_m: float
     volume_m3: float
+    warnings: list[str]
     @property
     def points(self) -> npt.NDArray[np.float32]: ...
     def surface_height(self, x: npt.ArrayLike, y: npt.ArrayLike) -> npt.NDArray[np.float64]: ...

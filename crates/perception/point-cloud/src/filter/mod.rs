@@ -32,19 +32,19 @@ mod common;
 mod exp;
 mod normals;
 mod pass_through;
-mod range;
 mod radius_outlier;
+mod range;
 mod statistical_outlier;
 mod voxel_grid;
 
 pub use bilateral::{bilateral_normal_smoothing, BilateralParams};
 pub use normals::{estimate_normals, Neighbourhood, NormalParams, Orientation};
 pub use pass_through::{pass_through, pass_through_indices, Axis, PassThroughParams};
-pub use range::{range_indices, Range, RangeLimits};
 pub use radius_outlier::{
     radius_outlier_removal, radius_outlier_removal_indices, radius_outlier_removal_then,
     RadiusKept, RadiusOutlierParams,
 };
+pub use range::{range_indices, Range, RangeLimits};
 pub use statistical_outlier::{
     mean_distances_and_reach, mean_distances_and_reach_at, statistical_outlier_removal,
     statistical_outlier_removal_indices, DistanceSums, OutlierCut, OutlierSides,

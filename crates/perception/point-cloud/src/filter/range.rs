@@ -42,8 +42,16 @@ pub struct Range {
 impl Range {
     /// Whether `v` passes this range (NaN never lies inside one).
     pub fn passes(&self, v: f64) -> bool {
-        let above = if self.lo_closed { v >= self.lo } else { v > self.lo };
-        let below = if self.hi_closed { v <= self.hi } else { v < self.hi };
+        let above = if self.lo_closed {
+            v >= self.lo
+        } else {
+            v > self.lo
+        };
+        let below = if self.hi_closed {
+            v <= self.hi
+        } else {
+            v < self.hi
+        };
         (above && below) != self.negate
     }
 }
@@ -306,15 +314,25 @@ mod tests {
         let e = range_indices(&cloud(), &RangeLimits::parse("GpsTime[0:1]").unwrap())
             .unwrap_err()
             .to_string();
-        assert!(e.contains("no dimension 'GpsTime'") && e.contains("Intensity"), "{e}");
-        let e = range_indices(&cloud(), &RangeLimits::parse("Classification[9:9]").unwrap())
-            .unwrap_err();
+        assert!(
+            e.contains("no dimension 'GpsTime'") && e.contains("Intensity"),
+            "{e}"
+        );
+        let e = range_indices(
+            &cloud(),
+            &RangeLimits::parse("Classification[9:9]").unwrap(),
+        )
+        .unwrap_err();
         assert!(matches!(e, CloudError::Emptied { input: 4, .. }), "{e}");
     }
 
     #[test]
     fn written_back_it_reads_the_same() {
-        for spec in ["Classification[2:2]", "Intensity!(20:40],Z[:100.5)", "X(1:]"] {
+        for spec in [
+            "Classification[2:2]",
+            "Intensity!(20:40],Z[:100.5)",
+            "X(1:]",
+        ] {
             let r = RangeLimits::parse(spec).unwrap();
             assert_eq!(r.to_string(), spec);
             assert_eq!(RangeLimits::parse(&r.to_string()).unwrap(), r);

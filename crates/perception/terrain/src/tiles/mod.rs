@@ -569,6 +569,16 @@ pub fn perceive_tiled_with(
             });
         }
     }
+    // The tiles are read as coordinates alone, so no dimension to select
+    // on: the range is refused, never ignored.
+    if let Some(limits) = &p.range.limits {
+        return Err(SurfaceError::NotWithTiles {
+            setting: format!("[range] limits = {limits:?}"),
+            instead:
+                "select first with `autoshovel filter --input IN --output OUT --range LIMITS` \
+                      for each file, or perceive without --tiles",
+        });
+    }
     let mut stages = Vec::new();
     // Pass 1: bounds, count, sample.
     let t0 = Instant::now();
