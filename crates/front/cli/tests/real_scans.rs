@@ -344,6 +344,78 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     );
 }
 
+/// Two surveys of the same BMX track, 2010 and 2023 (PDAL's change-detection
+/// data; metres across, US survey feet up, in one compound CRS): with the
+/// earlier as the base surface, the fill, cut and net volume agree with
+/// laspy + numpy's grid of the same definition, each axis in metres by
+/// pyproj. Had z stayed in feet, every volume would be 3.28 times too big.
+#[test]
+fn the_change_between_two_surveys_agrees_with_laspy_and_numpy() {
+    let Some(py) = python() else { return };
+    let tmp = TempDir::new("real-change");
+    let (later, earlier) = (
+        data("pdal_autzen-bmx-2023.las"),
+        data("pdal_autzen-bmx-2010.las"),
+    );
+    let config = tmp.write(
+        "change.toml",
+        format!(
+            "[ground]\nmode = \"surface\"\nsurface = {:?}\n\
+             [radius]\nenabled = false\n[statistical]\nenabled = false\n[voxel]\nenabled = false\n\
+             [smooth]\nenabled = false\n[fit]\ncell_spacings = 3\n",
+            earlier.display().to_string()
+        ),
+    );
+    let v = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        later.as_os_str(),
+        "--config".as_ref(),
+        config.as_os_str(),
+        "--json".as_ref(),
+    ])
+    .ok()
+    .json();
+    assert_eq!(v["ground_mode"], "surface");
+    assert_eq!(v["level_mode"], "none", "a survey is level");
+    let ours = &v["change"];
+    let theirs = peer(&py, &[&later, &earlier, Path::new("3")], "change");
+    assert_eq!(
+        ours["cells_compared"], theirs["cells_compared"],
+        "{ours} {theirs}"
+    );
+    for key in ["fill_m3", "cut_m3", "net_m3"] {
+        let (a, b) = (ours[key].as_f64().unwrap(), theirs[key].as_f64().unwrap());
+        assert!(b.abs() > 10.0, "{key}: a real volume, {b}");
+        assert!(
+            (a - b).abs() <= 0.01 * b.abs(),
+            "{key}: ours {a} m³, laspy + numpy {b} m³"
+        );
+    }
+    assert_eq!(v["volume_m3"], ours["fill_m3"]);
+    // A base in another CRS is refused, naming both.
+    let other = tmp.write(
+        "other.toml",
+        format!(
+            "[ground]\nmode = \"surface\"\nsurface = {:?}\n",
+            data("4_6_crop.las").display().to_string()
+        ),
+    );
+    let refused = run(&[
+        "perceive".as_ref(),
+        "--input".as_ref(),
+        later.as_os_str(),
+        "--config".as_ref(),
+        other.as_os_str(),
+    ])
+    .fails();
+    let m = refused.error_message();
+    assert!(
+        m.contains("4_6_crop.las") && m.contains("EPSG:2903") && m.contains("same frame"),
+        "{m}"
+    );
+}
+
 /// With no settings at all, a survey perceives, naming what the level and
 /// ground stages chose; a longitude–latitude cloud is refused naming its
 /// CRS and what to do.

@@ -15,6 +15,8 @@ const PROJECTED_CS_TYPE: u16 = 3072;
 const PROJ_LINEAR_UNITS: u16 = 3076;
 /// GeoTIFF key: the geographic CRS's angular unit.
 const GEOG_ANGULAR_UNITS: u16 = 2054;
+/// GeoTIFF key: the vertical CRS's linear unit (EPSG unit code).
+const VERTICAL_UNITS: u16 = 4099;
 /// GeoTIFF model type of a geographic (degree) CRS.
 const MODEL_GEOGRAPHIC: u16 = 2;
 /// GeoTIFF "user-defined" code: no EPSG code.
@@ -58,6 +60,34 @@ impl Unit {
         }
     }
 
+    /// The units a WKT string names for x and y, and for z: a compound
+    /// CRS (`COMPD_CS`, `COMPOUNDCRS`) gives its horizontal part's unit and
+    /// its vertical part's (`VERT_CS`, `VERTCRS`); any other gives
+    /// [`Unit::from_wkt`] and an unknown vertical unit.
+    pub fn from_wkt_xyz(wkt: &str) -> (Unit, Unit) {
+        let upper = wkt.trim_start().to_ascii_uppercase();
+        if !(upper.starts_with("COMPD_CS") || upper.starts_with("COMPOUNDCRS")) {
+            return (Unit::from_wkt(wkt), Unit::Unknown);
+        }
+        let vertical_at = upper.find("VERT_CS[").or_else(|| upper.find("VERTCRS["));
+        let horizontal_at = ["PROJCS[", "PROJCRS[", "GEOGCS[", "GEOGCRS["]
+            .iter()
+            .filter_map(|k| upper.find(k))
+            .min();
+        let horizontal = match (horizontal_at, vertical_at) {
+            (Some(h), Some(v)) if h < v => Unit::from_wkt(&upper[h..v]),
+            (Some(h), _) => Unit::from_wkt(&upper[h..]),
+            _ => Unit::Unknown,
+        };
+        let vertical = vertical_at.map_or(Unit::Unknown, |v| {
+            let part = &upper[v..];
+            part.find("UNIT[").map_or(Unit::Unknown, |at| {
+                Unit::named(part[at..].split('"').nth(1).unwrap_or(""))
+            })
+        });
+        (horizontal, vertical)
+    }
+
     /// The unit a WKT string names for its axes: the last `UNIT[...]` of a
     /// projected CRS's own (outside its base geographic CRS), or degrees
     /// for a geographic CRS.
@@ -74,7 +104,11 @@ impl Unit {
         let Some(at) = upper.rfind("UNIT[").or_else(|| upper.rfind("LENGTHUNIT[")) else {
             return Unit::Unknown;
         };
-        let name = upper[at..].split('"').nth(1).unwrap_or("");
+        Unit::named(upper[at..].split('"').nth(1).unwrap_or(""))
+    }
+
+    /// The unit a WKT `UNIT["NAME", ...]` names (upper case).
+    fn named(name: &str) -> Unit {
         match name {
             "METRE" | "METER" | "METRES" | "METERS" => Unit::Metre,
             "US SURVEY FOOT" | "FOOT_US" | "US_SURVEY_FOOT" | "U.S. SURVEY FOOT" => {
@@ -106,12 +140,25 @@ pub struct Crs {
     pub wkt: Option<String>,
     /// The linear unit of x and y.
     pub unit: Unit,
+    /// The linear unit of z where the file states one of its own (a
+    /// compound CRS's vertical part, or GeoTIFF's vertical unit key);
+    /// unknown where it does not, and z is then taken in `unit`
+    /// ([`Crs::z_unit`]).
+    pub vertical: Unit,
 }
 
 impl Crs {
     /// Whether the file states no CRS at all.
     pub fn is_unknown(&self) -> bool {
         self.epsg.is_none() && self.wkt.is_none() && self.unit == Unit::Unknown
+    }
+
+    /// The unit of z: the vertical unit stated, else that of x and y.
+    pub fn z_unit(&self) -> Unit {
+        match self.vertical {
+            Unit::Unknown => self.unit,
+            v => v,
+        }
     }
 
     /// Whether x and y are degrees of longitude and latitude.
@@ -121,12 +168,17 @@ impl Crs {
 }
 
 impl fmt::Display for Crs {
-    /// `EPSG:26910 (metre)`, `WKT (US survey foot)` or `none stated`.
+    /// `EPSG:26910 (metre)`, `WKT (US survey foot)`, `WKT (metre, z in US
+    /// survey foot)` or `none stated`.
     fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        let z = match self.z_unit() {
+            z if z == self.unit => String::new(),
+            z => format!(", z in {}", z.name()),
+        };
         match (self.epsg, &self.wkt) {
-            (Some(code), _) => write!(f, "EPSG:{code} ({})", self.unit.name()),
-            (None, Some(_)) => write!(f, "WKT ({})", self.unit.name()),
-            (None, None) if self.unit != Unit::Unknown => write!(f, "{}", self.unit.name()),
+            (Some(code), _) => write!(f, "EPSG:{code} ({}{z})", self.unit.name()),
+            (None, Some(_)) => write!(f, "WKT ({}{z})", self.unit.name()),
+            (None, None) if self.unit != Unit::Unknown => write!(f, "{}{z}", self.unit.name()),
             (None, None) => f.write_str("none stated"),
         }
     }
@@ -177,7 +229,7 @@ pub(crate) fn las_crs(h: &las::Header) -> Crs {
         let text = String::from_utf8_lossy(bytes)
             .trim_end_matches('\0')
             .to_string();
-        crs.unit = Unit::from_wkt(&text);
+        (crs.unit, crs.vertical) = Unit::from_wkt_xyz(&text);
         crs.wkt = Some(text);
     }
     if let Ok(Some(keys)) = h.get_geotiff_crs() {
@@ -202,6 +254,9 @@ pub(crate) fn las_crs(h: &las::Header) -> Crs {
         };
         if crs.unit == Unit::Unknown {
             crs.unit = unit;
+        }
+        if crs.vertical == Unit::Unknown {
+            crs.vertical = key(VERTICAL_UNITS).map_or(Unit::Unknown, Unit::from_epsg);
         }
         // A projected EPSG code without a unit key: UTM zones are metres.
         if crs.unit == Unit::Unknown && projected.is_some_and(is_utm) {
@@ -234,5 +289,23 @@ mod tests {
             Unit::Degree
         );
         assert!((Unit::UsSurveyFoot.metres().unwrap() - 0.304_800_609_6).abs() < 1e-10);
+    }
+
+    #[test]
+    fn a_compound_crs_gives_its_horizontal_and_vertical_units() {
+        // PDAL's autzen-bmx-2010.las, shortened: metres, and z in US feet.
+        let wkt = r#"COMPD_CS["NAD83 / Oregon LCC (m) + NAVD88 height (ftUS)",PROJCS["NAD83 / Oregon LCC (m)",GEOGCS["NAD83",UNIT["degree",0.0174532925199433]],PROJECTION["Lambert_Conformal_Conic_2SP"],UNIT["metre",1],AXIS["Easting",EAST]],VERT_CS["NAVD88 height (ftUS)",VERT_DATUM["North American Vertical Datum 1988",2005],UNIT["US survey foot",0.304800609601219],AXIS["Gravity-related height",UP]]]"#;
+        assert_eq!(Unit::from_wkt_xyz(wkt), (Unit::Metre, Unit::UsSurveyFoot));
+        let crs = Crs {
+            epsg: None,
+            wkt: Some(wkt.into()),
+            unit: Unit::Metre,
+            vertical: Unit::UsSurveyFoot,
+        };
+        assert_eq!(crs.to_string(), "WKT (metre, z in US survey foot)");
+        assert_eq!(crs.z_unit(), Unit::UsSurveyFoot);
+        // Not compound: z in the horizontal unit.
+        let utm = r#"PROJCS["UTM",GEOGCS["NAD83",UNIT["degree",0.01745]],UNIT["metre",1]]"#;
+        assert_eq!(Unit::from_wkt_xyz(utm), (Unit::Metre, Unit::Unknown));
     }
 }

@@ -286,12 +286,22 @@ impl Stage {
     /// in the cloud's own unit (a foot or a US survey foot where its CRS
     /// says so); coordinates (--pass) are the file's own already.
     fn in_file_units(&self, cloud: &PointCloud) -> Stage {
-        let Some(unit_m) = cloud.georef.crs.unit.metres().filter(|&u| u != 1.0) else {
+        let crs = &cloud.georef.crs;
+        let Some(unit_m) = crs.unit.metres() else {
             return self.clone();
         };
+        let z_m = crs.z_unit().metres().unwrap_or(unit_m);
+        if unit_m == 1.0 && z_m == 1.0 {
+            return self.clone();
+        }
         match self {
+            // A leaf's z in z's own unit (a compound CRS's vertical one).
             Stage::Voxel(p) => Stage::Voxel(VoxelGridParams {
-                leaf_m: p.leaf_m.map(|l| l / unit_m),
+                leaf_m: [
+                    p.leaf_m[0] / unit_m,
+                    p.leaf_m[1] / unit_m,
+                    p.leaf_m[2] / z_m,
+                ],
             }),
             Stage::Radius(p) => Stage::Radius(RadiusOutlierParams {
                 radius_m: p.radius_m / unit_m,

@@ -16,6 +16,7 @@
 //! | `floor` | the floor found by RANSAC ([`crate::estimate_tilt`]), cut `margin_m` above it |
 //! | `height` | the plane z = `height_m` (the file's frame), cut `margin_m` above it |
 //! | `none` | no cut; the volume's base is the lowest cleaned point |
+//! | `surface` | no cut; the base is another scan of the same place (`surface`, a file): the empty bin, the pad before the stockpile, last month's survey; the volume is the fill above it, and the change (fill, cut, net) is reported |
 //!
 //! What ran is named in the summary (`level_mode`, `ground_mode`) with the
 //! reason when `auto` chose, and the advice of a refusal names the modes
@@ -41,6 +42,8 @@ pub enum GroundMode {
     Height,
     /// No ground cut.
     None,
+    /// Another scan's surface as the base, no cut.
+    Surface,
 }
 
 impl GroundMode {
@@ -51,6 +54,7 @@ impl GroundMode {
             GroundMode::Floor => "floor",
             GroundMode::Height => "height",
             GroundMode::None => "none",
+            GroundMode::Surface => "surface",
         }
     }
 }
@@ -220,6 +224,7 @@ pub(crate) fn level_and_ground(
             (no_floor_found(h, n), "height", None)
         }
         GroundMode::None => (no_floor_found(lowest(), n), "none", None),
+        GroundMode::Surface => (no_floor_found(lowest(), n), "surface", None),
         GroundMode::Auto => match found.map_or_else(|| estimate_tilt(&levelled, tilt), Ok) {
             Ok(f) => (f, "floor", None),
             Err(SurfaceError::NoFloor { inliers, .. }) => (
@@ -233,7 +238,8 @@ pub(crate) fn level_and_ground(
             Err(e) => return Err(stage("finding the floor", e)),
         },
     };
-    let cut_at = (ground_mode != "none").then_some(floor.floor_height_m + a.margin);
+    let cut_at =
+        (!matches!(ground_mode, "none" | "surface")).then_some(floor.floor_height_m + a.margin);
     let note = match (level_note, ground_note) {
         (Some(l), Some(g)) => Some(format!("{l}; {g}")),
         (l, g) => l.or(g),

@@ -45,7 +45,7 @@ use autoshovel_point_cloud::{CloudError, PointCloud};
 use serde::{Deserialize, Serialize};
 
 use crate::calibrate::level;
-use crate::dem::{GridSummary, HeightGrid};
+use crate::dem::{Change, GridSummary, HeightGrid};
 use crate::error::{Result, SurfaceError};
 use crate::fit::{fit_surface, FitParams, SurfaceFit, Term};
 use crate::floor::{TiltEstimate, TiltParams};
@@ -183,6 +183,10 @@ pub struct GroundStage {
     pub mode: GroundMode,
     /// The base's height for mode "height" (the file's frame).
     pub height_m: Option<f64>,
+    /// The base's scan for mode "surface": a cloud file of the same place
+    /// in the same frame (CRS, or sensor pose), read as `--input` is;
+    /// a relative path is from the working folder.
+    pub surface: Option<String>,
     /// Keep points this far above the floor and higher (m at scale 1).
     pub margin_m: f64,
 }
@@ -316,6 +320,7 @@ impl Default for GroundStage {
         Self {
             mode: GroundMode::Auto,
             height_m: None,
+            surface: None,
             margin_m: 0.2,
         }
     }
@@ -381,6 +386,23 @@ impl TomlFile for PerceptionParams {
 
     /// Every number in range, named by its TOML key.
     fn check(&self, text: &str, file: &str) -> Result<()> {
+        let surface_mode = self.ground.mode == GroundMode::Surface;
+        if surface_mode != self.ground.surface.is_some() {
+            let (key, value, expected) = if surface_mode {
+                (
+                    "mode",
+                    "\"surface\"".to_string(),
+                    "a surface file too: [ground] surface = \"before.laz\"",
+                )
+            } else {
+                (
+                    "surface",
+                    format!("{:?}", self.ground.surface.as_deref().unwrap_or_default()),
+                    "set only with [ground] mode = \"surface\"",
+                )
+            };
+            return Err(config::invalid(text, file, ("ground", 0), key, value, expected).into());
+        }
         if let Some(spec) = &self.range.limits {
             if let Err(problem) = RangeLimits::parse(spec) {
                 return Err(config::invalid(
@@ -702,12 +724,32 @@ pub struct Model {
     pub base: f64,
     /// Volume between the model and the base.
     pub volume_m3: f64,
+    /// With `[ground] mode = "surface"`: fill, cut and net from the base
+    /// scan to this one, over the cells both saw.
+    pub change: Option<Change>,
 }
 
 impl Model {
-    fn of(cloud: &PointCloud, cell: f64, used: &GroundUsed, floor: &TiltEstimate) -> Result<Self> {
+    fn of(
+        cloud: &PointCloud,
+        cell: f64,
+        used: &GroundUsed,
+        floor: &TiltEstimate,
+        before: Option<&PointCloud>,
+    ) -> Result<Self> {
         let grid = HeightGrid::of(cloud, cell)?;
         let summary = grid.summary(cloud);
+        if let Some(before) = before {
+            let change = grid.change_from(&HeightGrid::like(before, &grid)?);
+            return Ok(Self {
+                volume_m3: change.fill_m3,
+                change: Some(change),
+                grid,
+                summary,
+                // No one height: the base is a surface.
+                base: f64::NAN,
+            });
+        }
         let base = match used.ground_mode {
             "none" => cloud.bounds().map_or(0.0, |(lo, _)| f64::from(lo[2])),
             _ => floor.floor_height_m,
@@ -717,6 +759,7 @@ impl Model {
             grid,
             summary,
             base,
+            change: None,
         })
     }
 }
@@ -1099,8 +1142,16 @@ pub fn perceive_after(
         ..FitParams::default()
     };
     let fit = fit_surface(&cloud, &fit_params).map_err(in_stage("fitting the surface"))?;
-    let model = Model::of(&cloud, p.fit.cell_spacings * spacing, &used, &floor)
-        .map_err(in_stage("making the height model"))?;
+    let before =
+        base_scan(p, given, &cloud, roll, pitch).map_err(in_stage("reading [ground] surface"))?;
+    let model = Model::of(
+        &cloud,
+        p.fit.cell_spacings * spacing,
+        &used,
+        &floor,
+        before.as_ref(),
+    )
+    .map_err(in_stage("making the height model"))?;
     stages.push(StageRecord {
         stage: "fit",
         points: fit.samples.len(),
@@ -1172,6 +1223,57 @@ fn surface_warnings(given: &PointCloud, model: &GridSummary, p: &PerceptionParam
     out
 }
 
+/// The base scan of `[ground] mode = "surface"` in `cloud`'s frame: read,
+/// put through the same `[range]`, in metres, about `cloud`'s origin and
+/// levelled by the same roll and pitch; `None` in any other mode. Its CRS
+/// must be `given`'s (the input's).
+fn base_scan(
+    p: &PerceptionParams,
+    given: &PointCloud,
+    cloud: &PointCloud,
+    roll: f64,
+    pitch: f64,
+) -> Result<Option<PointCloud>> {
+    let Some(path) = p
+        .ground
+        .surface
+        .as_deref()
+        .filter(|_| p.ground.mode == GroundMode::Surface)
+    else {
+        return Ok(None);
+    };
+    let read = autoshovel_point_cloud::io::read(Path::new(path), &mut |_, _| {})?.cloud;
+    let (theirs, ours) = (&read.georef.crs, &given.georef.crs);
+    if (theirs.epsg, theirs.unit, theirs.z_unit()) != (ours.epsg, ours.unit, ours.z_unit()) {
+        return Err(SurfaceError::Survey {
+            path: path.into(),
+            problem: format!(
+                "its CRS ({theirs}) is not the input's ({ours}): a base scan must be in the same frame"
+            ),
+        });
+    }
+    let ranged = select_range(&read, p)?;
+    let read = ranged.map_or(read, |(c, _)| c);
+    let read = in_metres(&read).unwrap_or(read);
+    // About the perceived cloud's origin, in f64 until the difference.
+    let points = (0..read.len())
+        .map(|i| {
+            let w = read.world(i);
+            [0, 1, 2].map(|a| (w[a] - cloud.origin[a]) as f32)
+        })
+        .collect();
+    let about = PointCloud {
+        points,
+        origin: cloud.origin,
+        ..PointCloud::default()
+    };
+    Ok(Some(if roll != 0.0 || pitch != 0.0 {
+        level(&about, roll, pitch)
+    } else {
+        about
+    }))
+}
+
 /// The rows of `cloud` that `[range] limits` keeps, and the stage's time
 /// (ms); `None` without limits.
 fn select_range(cloud: &PointCloud, p: &PerceptionParams) -> Result<Option<(PointCloud, f64)>> {
@@ -1211,11 +1313,19 @@ fn select_range(cloud: &PointCloud, p: &PerceptionParams) -> Result<Option<(Poin
 /// with no code (the file's CRS is in feet); `None` when it is metres or
 /// not stated.
 fn in_metres(cloud: &PointCloud) -> Option<PointCloud> {
-    let u = cloud.georef.crs.unit.metres().filter(|&u| u != 1.0)?;
+    let crs = &cloud.georef.crs;
+    let xy = crs.unit.metres()?;
+    // z in its own unit where a compound CRS states one.
+    let f = [xy, xy, crs.z_unit().metres().unwrap_or(xy)];
+    if f == [1.0; 3] {
+        return None;
+    }
     let mut c = cloud.clone();
-    let uf = u as f32;
-    c.points.iter_mut().for_each(|p| *p = p.map(|v| v * uf));
-    c.origin = c.origin.map(|o| o * u);
+    let ff = f.map(|v| v as f32);
+    c.points
+        .iter_mut()
+        .for_each(|p| *p = [p[0] * ff[0], p[1] * ff[1], p[2] * ff[2]]);
+    c.origin = [0, 1, 2].map(|a| c.origin[a] * f[a]);
     c.georef = autoshovel_point_cloud::Georef {
         crs: autoshovel_point_cloud::Crs {
             unit: autoshovel_point_cloud::Unit::Metre,
@@ -1377,6 +1487,10 @@ pub struct PerceiveSummary {
     pub volume_base_m: f64,
     /// The f64 origin the points were held about.
     pub origin: [f64; 3],
+    /// With `[ground] mode = "surface"`: fill, cut and net volume from
+    /// the base scan to this one over the cells both saw (`volume_m3` is
+    /// the fill; `volume_base_m` is then null, the base being a surface).
+    pub change: Option<Change>,
     /// Wall time of each stage (ms).
     pub timings_ms: BTreeMap<&'static str, f64>,
     /// Wall time of all stages (ms).
@@ -1419,6 +1533,7 @@ impl PerceiveSummary {
             height_model: got.model.summary.clone(),
             volume_m3: got.model.volume_m3,
             volume_base_m: got.model.base + got.cloud.origin[2],
+            change: got.model.change,
             origin: got.cloud.origin,
             timings_ms: got.stages.iter().map(|s| (s.stage, s.ms)).collect(),
             total_ms: got.total_ms(),

@@ -18,6 +18,11 @@
   las_peer.py range IN OUT CLASS ZMIN
                                OUT is exactly IN's rows of classification CLASS
                                with z >= ZMIN, in order (filter --range)
+  las_peer.py change LATER EARLIER CELLS
+                               fill, cut and net volume from EARLIER to LATER
+                               on LATER's mean-height grid of CELLS point
+                               spacings, each axis in metres by pyproj (a
+                               compound CRS's z in its vertical unit)
   las_peer.py volume IN BASE CELLS [CLASS]
                                the volume above z = BASE (m) of IN's mean-height
                                grid, cells CELLS point spacings wide, the points
@@ -176,6 +181,42 @@ def volume(src, base, cells, klass=None):
                       "kept": int(keep.sum())}))
 
 
+def metres(a):
+    """x, y, z of a LAS file in metres, each axis by pyproj's unit for it
+    (a compound CRS's vertical unit for z)."""
+    crs = a.header.parse_crs()
+    axes = crs.axis_info if crs is not None else []
+    unit = [ax.unit_conversion_factor for ax in axes] or [1.0]
+    f = [unit[0], unit[min(1, len(unit) - 1)], unit[2] if len(unit) > 2 else unit[0]]
+    return [np.asarray(getattr(a, ax), dtype=np.float64) * k for ax, k in zip("xyz", f)]
+
+
+def change(later, earlier, cells):
+    """Fill, cut and net from EARLIER to LATER on LATER's mean-height grid."""
+    x, y, z = metres(laspy.read(later))
+    ex, ey, ez = metres(laspy.read(earlier))
+    spacing = np.sqrt((x.max() - x.min()) * (y.max() - y.min()) / len(x))
+    cell = float(cells) * spacing
+    nx = int(np.floor((x.max() - x.min()) / cell)) + 1
+    ny = int(np.floor((y.max() - y.min()) / cell)) + 1
+
+    def grid(px, py, pz):
+        ix = np.floor((px - x.min()) / cell).astype(np.int64)
+        iy = np.floor((py - y.min()) / cell).astype(np.int64)
+        inside = (ix >= 0) & (ix < nx) & (iy >= 0) & (iy < ny)
+        flat = (iy * nx + ix)[inside]
+        sums = np.bincount(flat, weights=pz[inside], minlength=nx * ny)
+        counts = np.bincount(flat, minlength=nx * ny)
+        with np.errstate(invalid="ignore", divide="ignore"):
+            return np.where(counts > 0, sums / np.maximum(counts, 1), np.nan)
+
+    d = grid(x, y, z) - grid(ex, ey, ez)
+    d = d[np.isfinite(d)] * cell * cell
+    fill, cut = float(d[d > 0].sum()), float(-d[d < 0].sum())
+    print(json.dumps({"ok": True, "fill_m3": fill, "cut_m3": cut, "net_m3": fill - cut,
+                      "cells_compared": int(d.size)}))
+
+
 def copy(src, dst, shuffle=False):
     a = laspy.read(src)
     h = laspy.LasHeader(point_format=a.header.point_format.id, version="1.4")
@@ -193,6 +234,6 @@ def copy(src, dst, shuffle=False):
 
 if __name__ == "__main__":
     modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume, "values": values,
-             "range": ranged,
+             "range": ranged, "change": change,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

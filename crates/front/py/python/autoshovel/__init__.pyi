@@ -31,6 +31,7 @@ class Summary(Mapping[str, Any]):
 
 class Perception(Summary):
     """What perceive() made: `autoshovel perceive --json`'s fields, the points and the surface."""
+    change: Optional[Summary]
     fit: Summary
     floor_height_m: float
     floor_points: int
@@ -59,7 +60,7 @@ class Perception(Summary):
     success: bool
     timings_ms: Summary
     total_ms: float
-    volume_base_m: float
+    volume_base_m: Optional[float]
     volume_m3: float
     warnings: list[str]
     @property
