@@ -289,9 +289,17 @@ impl<'s> Points<'s> {
     /// non-finite one.
     #[inline]
     pub(crate) fn push_f64(&mut self, x: f64, y: f64, z: f64) -> bool {
-        if self.origin_from_first && x.is_finite() && y.is_finite() && z.is_finite() {
-            // The first point's whole units where they are far from zero.
-            self.origin = [x, y, z].map(|v| {
+        self.origin_from([x, y, z]);
+        let o = self.origin;
+        self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32])
+    }
+
+    /// With [`Points::origin_from_first`] set and `p` finite, sets the
+    /// origin from `p`: its whole units on each axis far from zero, zero
+    /// on the others.
+    pub(crate) fn origin_from(&mut self, p: [f64; 3]) {
+        if self.origin_from_first && p.iter().all(|v| v.is_finite()) {
+            self.origin = p.map(|v| {
                 if v.abs() > ORIGIN_FREE {
                     v.round()
                 } else {
@@ -300,8 +308,6 @@ impl<'s> Points<'s> {
             });
             self.origin_from_first = false;
         }
-        let o = self.origin;
-        self.push([(x - o[0]) as f32, (y - o[1]) as f32, (z - o[2]) as f32])
     }
 
     /// Drops the non-finite points from position `base` on (counting

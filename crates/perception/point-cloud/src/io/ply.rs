@@ -18,7 +18,6 @@ use super::input::{line_str, Input, Points};
 use super::scalar::Scalar;
 use super::text;
 use super::Encoding;
-use crate::Point;
 
 /// Longest header or ASCII data line accepted (bytes).
 const MAX_LINE: usize = 1 << 20;
@@ -154,6 +153,25 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     })
 }
 
+/// Whether coordinates of type `ty` need f64 to keep them: doubles, and
+/// integers past f32's 24-bit mantissa.
+fn wide_coordinate(ty: Scalar) -> bool {
+    matches!(
+        ty,
+        Scalar::F64 | Scalar::I32 | Scalar::U32 | Scalar::I64 | Scalar::U64
+    )
+}
+
+/// Keeps one vertex read as f64: about the origin when the file's
+/// coordinates are wide, else as the f32 values a float file holds.
+fn push_vertex(out: &mut Points<'_>, axes: &[(usize, Scalar); 3], p: [f64; 3]) {
+    if axes.iter().any(|(_, ty)| wide_coordinate(*ty)) {
+        out.push_f64(p[0], p[1], p[2]);
+    } else {
+        out.push(p.map(|v| v as f32));
+    }
+}
+
 /// x, y, z of the vertex element: the property index and type of each.
 fn vertex_axes<R: BufRead>(
     input: &Input<'_, R>,
@@ -198,6 +216,10 @@ pub(crate) fn read<R: BufRead>(
         return Err(input.format_err("no vertex element in the header"));
     };
     let axes = vertex_axes(input, &h.elements[vertex])?;
+    // Doubles and wide integers (a georeferenced PLY) are read in f64
+    // about an origin; float coordinates stay the f32 values the file holds.
+    let wide = axes.iter().any(|(_, ty)| wide_coordinate(*ty));
+    out.origin_from_first = wide;
     match h.body {
         Body::Ascii => {
             read_ascii(input, &h, vertex, axes, out)?;
@@ -271,11 +293,16 @@ fn read_binary_element<R: BufRead>(
             let chunk = &mut buf[..k * size];
             input.read_exact_or(chunk, "vertex data")?;
             for rec in chunk.chunks_exact(size) {
-                out.push([
-                    axes[0].1.to_f32(&rec[at[0]..], big),
-                    axes[1].1.to_f32(&rec[at[1]..], big),
-                    axes[2].1.to_f32(&rec[at[2]..], big),
-                ]);
+                let get = |a: usize| axes[a].1.to_f64(&rec[at[a]..], big);
+                if out.origin_from_first || out.origin != [0.0; 3] {
+                    out.push_f64(get(0), get(1), get(2));
+                } else {
+                    out.push([
+                        axes[0].1.to_f32(&rec[at[0]..], big),
+                        axes[1].1.to_f32(&rec[at[1]..], big),
+                        axes[2].1.to_f32(&rec[at[2]..], big),
+                    ]);
+                }
             }
             left -= k as u64;
         }
@@ -289,7 +316,7 @@ fn read_binary_element<R: BufRead>(
     }
     let mut scratch = [0u8; 8];
     for i in 0..el.count {
-        let mut p: Point = [0.0; 3];
+        let mut p = [0.0f64; 3];
         for (k, prop) in el.props.iter().enumerate() {
             match prop {
                 Prop::Scalar { ty, .. } => {
@@ -298,7 +325,7 @@ fn read_binary_element<R: BufRead>(
                     if let Some((axes, _)) = &vertex {
                         for (a, (idx, _)) in axes.iter().enumerate() {
                             if *idx == k {
-                                p[a] = ty.to_f32(b, big);
+                                p[a] = ty.to_f64(b, big);
                             }
                         }
                     }
@@ -326,8 +353,8 @@ fn read_binary_element<R: BufRead>(
                 }
             }
         }
-        if let Some((_, out)) = vertex.as_mut() {
-            out.push(p);
+        if let Some((axes, out)) = vertex.as_mut() {
+            push_vertex(out, axes, p);
         }
     }
     Ok(())
@@ -364,7 +391,7 @@ fn read_ascii<R: BufRead>(
             if words.peek().is_none() {
                 continue;
             }
-            let mut p: Point = [0.0; 3];
+            let mut p = [0.0f64; 3];
             for (pk, prop) in el.props.iter().enumerate() {
                 let missing = || {
                     input.format_err(format!(
@@ -378,7 +405,14 @@ fn read_ascii<R: BufRead>(
                         let word = words.next().ok_or_else(missing)?;
                         let is_axis = is_vertex && axes.iter().any(|(idx, _)| *idx == pk);
                         if is_axis {
-                            let v = ty.parse_f32(word).map_err(|why| {
+                            // A float file's words parse to f32 directly (no
+                            // double rounding through f64).
+                            let v = if wide_coordinate(*ty) {
+                                ty.parse_f64(word)
+                            } else {
+                                ty.parse_f32(word).map(f64::from)
+                            };
+                            let v = v.map_err(|why| {
                                 input.format_err(format!(
                                     "line {line_no}: {word:?} is not a valid {name} ({why})"
                                 ))
@@ -415,7 +449,7 @@ fn read_ascii<R: BufRead>(
                 )));
             }
             if is_vertex {
-                out.push(p);
+                push_vertex(out, &axes, p);
             }
             i += 1;
         }
@@ -431,10 +465,12 @@ fn read_ascii<R: BufRead>(
     }
 }
 
-/// Writes `points` as PLY with one vertex element of float x, y, z.
+/// Writes `cloud` as PLY with one vertex element: float x, y, z about a
+/// zero origin; about another, the file's coordinates (origin added) as
+/// double x, y, z, as PDAL writes its X, Y and Z.
 pub(crate) fn write<W: Write>(
     w: &mut W,
-    points: &[Point],
+    cloud: &crate::PointCloud,
     encoding: Encoding,
 ) -> std::io::Result<()> {
     let format = match encoding {
@@ -445,35 +481,49 @@ pub(crate) fn write<W: Write>(
             return Err(std::io::Error::other("PLY has no compressed encoding"))
         }
     };
+    let points = &cloud.points;
+    let printed = text::Printed::of(cloud);
+    let ty = if printed.is_plain() {
+        "float"
+    } else {
+        "double"
+    };
     write!(
         w,
-        "ply\nformat {format} 1.0\ncomment written by autoshovel\nelement vertex {}\nproperty float x\nproperty float y\nproperty float z\nend_header\n",
+        "ply\nformat {format} 1.0\ncomment written by autoshovel\nelement vertex {}\nproperty {ty} x\nproperty {ty} y\nproperty {ty} z\nend_header\n",
         points.len()
     )?;
-    match encoding {
-        Encoding::Ascii => {
-            let mut line = Vec::with_capacity(48);
-            for p in points {
-                text::write_point(w, p, b' ', &mut line)?;
-            }
+    if encoding == Encoding::Ascii {
+        let mut line = Vec::with_capacity(48);
+        for p in points {
+            printed.write(w, p, b' ', &mut line)?;
         }
-        _ => {
-            let big = encoding == Encoding::BinaryBigEndian;
-            let mut buf = Vec::with_capacity(CHUNK);
-            for chunk in points.chunks(CHUNK / 12) {
-                buf.clear();
-                for p in chunk {
-                    for v in p {
-                        buf.extend_from_slice(&if big {
-                            v.to_be_bytes()
-                        } else {
-                            v.to_le_bytes()
-                        });
-                    }
+        return Ok(());
+    }
+    let big = encoding == Encoding::BinaryBigEndian;
+    let mut buf = Vec::with_capacity(CHUNK);
+    for (k, chunk) in points.chunks(CHUNK / 24).enumerate() {
+        buf.clear();
+        for (j, p) in chunk.iter().enumerate() {
+            if printed.is_plain() {
+                for v in p {
+                    buf.extend_from_slice(&if big {
+                        v.to_be_bytes()
+                    } else {
+                        v.to_le_bytes()
+                    });
                 }
-                w.write_all(&buf)?;
+            } else {
+                for v in cloud.world(k * (CHUNK / 24) + j) {
+                    buf.extend_from_slice(&if big {
+                        v.to_be_bytes()
+                    } else {
+                        v.to_le_bytes()
+                    });
+                }
             }
         }
+        w.write_all(&buf)?;
     }
     Ok(())
 }

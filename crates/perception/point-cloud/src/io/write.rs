@@ -83,7 +83,6 @@ pub fn write_named(
         source,
     };
     let (file, guard) = create_temp(dest).map_err(io)?.into_parts();
-    let points = &cloud.points;
     let mut w = BufWriter::with_capacity(BUFFER, file);
     let file = match format {
         Format::Las | Format::Laz => {
@@ -94,9 +93,9 @@ pub fn write_named(
         _ => {
             let r = match format {
                 Format::Pcd => pcd::write_cloud(&mut w, cloud, encoding),
-                Format::Ply => ply::write(&mut w, points, encoding),
-                Format::Csv => xyz::write(&mut w, points, b',', Some("x,y,z")),
-                _ => xyz::write(&mut w, points, b' ', None),
+                Format::Ply => ply::write(&mut w, cloud, encoding),
+                Format::Csv => xyz::write(&mut w, cloud, b',', Some("x,y,z")),
+                _ => xyz::write(&mut w, cloud, b' ', None),
             };
             match r {
                 Ok(()) => {}

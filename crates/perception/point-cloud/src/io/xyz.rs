@@ -9,7 +9,6 @@ use std::io::{BufRead, Write};
 
 use super::input::{line_str, Input, Points};
 use super::text;
-use crate::Point;
 
 /// Longest line accepted (bytes).
 const MAX_LINE: usize = 1 << 16;
@@ -97,8 +96,8 @@ fn header_layout(fields: &[&str], sep: Separator, full: &str) -> Result<(Layout,
     Ok((Layout { sep, xyz }, names.len() - 3))
 }
 
-fn parse_field(s: &str, sep: Separator) -> Result<f32, String> {
-    s.parse::<f32>().map_err(|_| {
+fn parse_field(s: &str, sep: Separator) -> Result<f64, String> {
+    s.parse::<f64>().map_err(|_| {
         if sep == Separator::Semicolon
             && s.contains(',')
             && s.replace(',', ".").parse::<f32>().is_ok()
@@ -113,11 +112,30 @@ fn parse_field(s: &str, sep: Separator) -> Result<f32, String> {
     })
 }
 
+/// The origin an axis is held about, from its first value `v` (the word
+/// read in f64) and `f` (the same word in f32): its whole units when the
+/// word says more than its f32 holds and it is far from zero (a survey's
+/// easting), else zero (every f32 a file of f32 values names is kept bit
+/// for bit).
+fn origin_for(v: f64, f: f32) -> f64 {
+    let f32_holds_it = format!("{f}").parse::<f64>().is_ok_and(|back| back == v);
+    if f32_holds_it || v.abs() <= super::input::ORIGIN_FREE {
+        0.0
+    } else {
+        v.round()
+    }
+}
+
 /// Reads a text cloud into `out`: a header line of column names, if there
 /// is one, picks x, y and z by name; without one the first three fields are
 /// x, y, z. The separator (whitespace, `,` or `;`) is taken from the first
 /// line and must hold for every line; decimal commas are refused.
+///
+/// Coordinates far from zero (a survey's eastings and northings) are read
+/// in f64 about an origin taken from the first point; near zero, each is
+/// the f32 its word names.
 pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> crate::Result<()> {
+    out.origin_from_first = true;
     let mut line = Vec::new();
     let mut line_no = 0u64;
     let mut data_lines = 0usize;
@@ -184,7 +202,7 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
             }
         };
         let fields = lay.sep.split(text);
-        let mut p = [0f32; 3];
+        let mut p = [0f64; 3];
         for (a, &col) in lay.xyz.iter().enumerate() {
             let Some(f) = fields.get(col) else {
                 return Err(input.format_err(format!(
@@ -201,7 +219,17 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
             p[a] = parse_field(f, lay.sep)
                 .map_err(|e| input.format_err(format!("line {line_no}: {e}")))?;
         }
-        out.push(p);
+        // The f32 each word names, not f64 rounded again.
+        let word = |a: usize| fields[lay.xyz[a]].parse::<f32>().unwrap_or(f32::NAN);
+        if out.origin_from_first && p.iter().all(|v| v.is_finite()) {
+            out.origin = [0, 1, 2].map(|a| origin_for(p[a], word(a)));
+            out.origin_from_first = false;
+        }
+        if out.origin == [0.0; 3] {
+            out.push([word(0), word(1), word(2)]);
+        } else {
+            out.push_f64(p[0], p[1], p[2]);
+        }
         data_lines += 1;
         if !sized && data_lines == SAMPLE_LINES {
             // Size the vector once from the bytes per line so far,
@@ -219,19 +247,21 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
 }
 
 /// Writes `points` one per line, separated by `sep`, after an optional
-/// header line.
+/// header line: the file's coordinates, the cloud's origin added
+/// ([`text::Printed`]).
 pub(crate) fn write<W: Write>(
     w: &mut W,
-    points: &[Point],
+    cloud: &crate::PointCloud,
     sep: u8,
     header: Option<&str>,
 ) -> std::io::Result<()> {
     if let Some(h) = header {
         writeln!(w, "{h}")?;
     }
+    let printed = text::Printed::of(cloud);
     let mut line = Vec::with_capacity(48);
-    for p in points {
-        text::write_point(w, p, sep, &mut line)?;
+    for p in &cloud.points {
+        printed.write(w, p, sep, &mut line)?;
     }
     Ok(())
 }
