@@ -254,7 +254,8 @@ fn encodings_parse_and_default_by_extension() {
 }
 
 /// A survey in UTM (PDAL's Autzen, northings near 4.88 M m, 1 cm steps)
-/// written as PLY (every encoding) and text, and read back, keeps every
+/// written as PLY (every encoding, with every attribute) and text, and
+/// read back, keeps every
 /// coordinate of the file's frame to within a tenth of the file's 1 cm
 /// step (f32 about the first point's whole metres, 0.07 mm 700 m away):
 /// the writers add the origin back (PLY as doubles, text to the file's 2
@@ -285,6 +286,10 @@ fn a_survey_written_as_ply_or_text_keeps_its_coordinates() {
             })
             .fold(0.0, f64::max);
         assert!(worst < 1e-3, "{ext} {enc}: a coordinate moved by {worst} m");
+        if ext == "ply" {
+            // Every attribute, row for row, in its own type and name.
+            assert_eq!(back.attributes, las.attributes, "{ext} {enc}");
+        }
     }
     let text = std::fs::read_to_string(dir.0.join("s-ascii.xyz")).unwrap();
     assert!(

@@ -2,9 +2,15 @@
 //! elements and their properties, then the data in ASCII or binary of
 //! either byte order. Points are the `vertex` element's x, y, z, of any
 //! scalar type (char uchar short ushort int uint float double and the
-//! int8 ... float64 spellings); other vertex properties are skipped, other
-//! elements (faces with list properties, edges, materials) are read past
-//! so that a truncated or inconsistent file is still noticed.
+//! int8 ... float64 spellings); the vertex element's other scalar
+//! properties are columns ([`crate::Attributes`]), named as PDAL names its
+//! dimensions where PDAL has one (`red` → `Red`, `intensity` →
+//! `Intensity`; any case), else as the file names them; other elements
+//! (faces with list properties, edges, materials) are read past so that a
+//! truncated or inconsistent file is still noticed. Writing, the columns
+//! follow x, y, z as properties of their own type (colour as `red`,
+//! `green`, `blue`, as viewers read it; an extra-bytes column as one
+//! `uchar` a byte, `NAME_0` …).
 //!
 //! Hand-written rather than taken from the `ply-rs` crate: that crate is
 //! unmaintained and has a security advisory, it builds every element into
@@ -153,6 +159,68 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     })
 }
 
+/// PDAL's dimension names that a PLY property may spell in another case.
+const PDAL_NAMES: [&str; 12] = [
+    "Intensity",
+    "Red",
+    "Green",
+    "Blue",
+    "Alpha",
+    "Classification",
+    "ReturnNumber",
+    "NumberOfReturns",
+    "GpsTime",
+    "PointSourceId",
+    "UserData",
+    "ScanAngleRank",
+];
+
+/// A vertex property's column name: PDAL's where it has one.
+fn column_name(ply: &str) -> String {
+    PDAL_NAMES
+        .iter()
+        .find(|n| n.eq_ignore_ascii_case(ply))
+        .map_or_else(|| ply.to_string(), |n| (*n).to_string())
+}
+
+/// A column's PLY property name: colour in lower case, as viewers read it.
+fn property_name(column: &str) -> String {
+    match column {
+        "Red" | "Green" | "Blue" | "Alpha" => column.to_ascii_lowercase(),
+        other => other.to_string(),
+    }
+}
+
+/// The columns being read: each non-coordinate scalar vertex property's
+/// index and rows (none while streaming: the points go on without them).
+struct Columns {
+    cols: Vec<(usize, String, crate::Values)>,
+}
+
+impl Columns {
+    fn of(el: &Element, axes: &[(usize, Scalar); 3], streaming: bool) -> Self {
+        let cols = el
+            .props
+            .iter()
+            .enumerate()
+            .filter(|(k, _)| !streaming && !axes.iter().any(|(a, _)| a == k))
+            .filter_map(|(k, p)| match p {
+                Prop::Scalar { name, ty } => crate::Values::for_pcd(ty.pcd_kind(), ty.size(), 1)
+                    .map(|v| (k, column_name(name), v)),
+                Prop::List { .. } => None,
+            })
+            .collect();
+        Self { cols }
+    }
+
+    /// Hands the columns to `out` (each as long as its points).
+    fn finish(self, out: &mut Points<'_>) {
+        for (_, name, values) in self.cols {
+            out.attributes.insert(name, values);
+        }
+    }
+}
+
 /// Whether coordinates of type `ty` need f64 to keep them: doubles, and
 /// integers past f32's 24-bit mantissa.
 fn wide_coordinate(ty: Scalar) -> bool {
@@ -164,11 +232,11 @@ fn wide_coordinate(ty: Scalar) -> bool {
 
 /// Keeps one vertex read as f64: about the origin when the file's
 /// coordinates are wide, else as the f32 values a float file holds.
-fn push_vertex(out: &mut Points<'_>, axes: &[(usize, Scalar); 3], p: [f64; 3]) {
+fn push_vertex(out: &mut Points<'_>, axes: &[(usize, Scalar); 3], p: [f64; 3]) -> bool {
     if axes.iter().any(|(_, ty)| wide_coordinate(*ty)) {
-        out.push_f64(p[0], p[1], p[2]);
+        out.push_f64(p[0], p[1], p[2])
     } else {
-        out.push(p.map(|v| v as f32));
+        out.push(p.map(|v| v as f32))
     }
 }
 
@@ -284,6 +352,7 @@ fn read_binary_element<R: BufRead>(
             })
             .collect();
         let at = [offsets[axes[0].0], offsets[axes[1].0], offsets[axes[2].0]];
+        let mut columns = Columns::of(el, &axes, out.is_streaming());
         out.reserve_bounded(el.count, input.remaining(), size as u64);
         let per_chunk = (CHUNK / size).max(1) as u64;
         let mut buf = vec![0u8; per_chunk.min(el.count) as usize * size];
@@ -294,27 +363,37 @@ fn read_binary_element<R: BufRead>(
             input.read_exact_or(chunk, "vertex data")?;
             for rec in chunk.chunks_exact(size) {
                 let get = |a: usize| axes[a].1.to_f64(&rec[at[a]..], big);
-                if out.origin_from_first || out.origin != [0.0; 3] {
-                    out.push_f64(get(0), get(1), get(2));
+                let kept = if out.origin_from_first || out.origin != [0.0; 3] {
+                    out.push_f64(get(0), get(1), get(2))
                 } else {
                     out.push([
                         axes[0].1.to_f32(&rec[at[0]..], big),
                         axes[1].1.to_f32(&rec[at[1]..], big),
                         axes[2].1.to_f32(&rec[at[2]..], big),
-                    ]);
+                    ])
+                };
+                if kept {
+                    for (k, _, col) in &mut columns.cols {
+                        col.push_bytes(&rec[offsets[*k]..], big);
+                    }
                 }
             }
             left -= k as u64;
         }
+        columns.finish(out);
         return Ok(());
     }
     // Elements with list properties: instance by instance. Every instance
     // holds at least one list count, so the loop ends with the file.
     let mut vertex = vertex;
-    if let Some((_, out)) = vertex.as_mut() {
+    let mut columns = None;
+    if let Some((axes, out)) = vertex.as_mut() {
         out.reserve_bounded(el.count, input.remaining(), 1);
+        columns = Some(Columns::of(el, axes, out.is_streaming()));
     }
     let mut scratch = [0u8; 8];
+    // Each scalar property's bytes of the instance, for the columns.
+    let mut held = vec![[0u8; 8]; el.props.len()];
     for i in 0..el.count {
         let mut p = [0.0f64; 3];
         for (k, prop) in el.props.iter().enumerate() {
@@ -322,6 +401,7 @@ fn read_binary_element<R: BufRead>(
                 Prop::Scalar { ty, .. } => {
                     let b = &mut scratch[..ty.size()];
                     input.read_exact_or(b, "element data")?;
+                    held[k][..b.len()].copy_from_slice(b);
                     if let Some((axes, _)) = &vertex {
                         for (a, (idx, _)) in axes.iter().enumerate() {
                             if *idx == k {
@@ -353,9 +433,16 @@ fn read_binary_element<R: BufRead>(
                 }
             }
         }
-        if let Some((axes, out)) = vertex.as_mut() {
-            push_vertex(out, axes, p);
+        if let (Some((axes, out)), Some(columns)) = (vertex.as_mut(), columns.as_mut()) {
+            if push_vertex(out, axes, p) {
+                for (k, _, col) in &mut columns.cols {
+                    col.push_bytes(&held[*k], big);
+                }
+            }
         }
+    }
+    if let (Some((_, out)), Some(columns)) = (vertex, columns) {
+        columns.finish(out);
     }
     Ok(())
 }
@@ -377,6 +464,7 @@ fn read_ascii<R: BufRead>(
         if is_vertex {
             out.reserve_bounded(el.count, input.remaining(), 2 * el.props.len() as u64);
         }
+        let mut columns = Columns::of(el, &axes, !is_vertex || out.is_streaming());
         let mut i = 0u64;
         while i < el.count {
             line_no += 1;
@@ -392,6 +480,7 @@ fn read_ascii<R: BufRead>(
                 continue;
             }
             let mut p = [0.0f64; 3];
+            let mut words_of: Vec<&str> = Vec::with_capacity(el.props.len());
             for (pk, prop) in el.props.iter().enumerate() {
                 let missing = || {
                     input.format_err(format!(
@@ -403,6 +492,7 @@ fn read_ascii<R: BufRead>(
                 match prop {
                     Prop::Scalar { ty, name } => {
                         let word = words.next().ok_or_else(missing)?;
+                        words_of.push(word);
                         let is_axis = is_vertex && axes.iter().any(|(idx, _)| *idx == pk);
                         if is_axis {
                             // A float file's words parse to f32 directly (no
@@ -426,6 +516,7 @@ fn read_ascii<R: BufRead>(
                     }
                     Prop::List { count, name, .. } => {
                         let word = words.next().ok_or_else(missing)?;
+                        words_of.push("");
                         let n = count.parse_count(word).ok_or_else(|| {
                             input.format_err(format!(
                                 "line {line_no}: list length {word:?} of {name} is not a count"
@@ -448,11 +539,16 @@ fn read_ascii<R: BufRead>(
                     el.name
                 )));
             }
-            if is_vertex {
-                push_vertex(out, &axes, p);
+            if is_vertex && push_vertex(out, &axes, p) {
+                for (k, name, col) in &mut columns.cols {
+                    col.push_text(&[words_of[*k]]).map_err(|why| {
+                        input.format_err(format!("line {line_no}: property {name}: {why}"))
+                    })?;
+                }
             }
             i += 1;
         }
+        columns.finish(out);
     }
     loop {
         line_no += 1;
@@ -465,9 +561,58 @@ fn read_ascii<R: BufRead>(
     }
 }
 
+/// A column's PLY type name; `None` for extra bytes (one `uchar` a byte).
+fn ply_type(v: &crate::Values) -> Option<&'static str> {
+    use crate::Values as V;
+    Some(match v {
+        V::U8(_) => "uchar",
+        V::I8(_) => "char",
+        V::U16(_) => "ushort",
+        V::I16(_) => "short",
+        V::U32(_) => "uint",
+        V::I32(_) => "int",
+        V::F32(_) => "float",
+        // PLY has no 64-bit integers: double, as PDAL's writer does.
+        V::U64(_) | V::I64(_) | V::F64(_) => "double",
+        V::Bytes { .. } => return None,
+    })
+}
+
+/// The header lines of `cloud`'s columns.
+fn column_properties(cloud: &crate::PointCloud) -> String {
+    let mut out = String::new();
+    for c in cloud.attributes.columns() {
+        let name = property_name(&c.name);
+        match (ply_type(&c.values), &c.values) {
+            (Some(ty), _) => out += &format!("property {ty} {name}\n"),
+            (None, crate::Values::Bytes { width, .. }) => {
+                for k in 0..*width {
+                    out += &format!("property uchar {name}_{k}\n");
+                }
+            }
+            (None, _) => {}
+        }
+    }
+    out
+}
+
+/// Appends row `i` of column `v` in the byte order asked.
+fn column_bytes(v: &crate::Values, i: usize, big: bool, out: &mut Vec<u8>) {
+    use crate::Values as V;
+    let at = out.len();
+    match v {
+        V::U64(x) => out.extend_from_slice(&(x[i] as f64).to_le_bytes()),
+        V::I64(x) => out.extend_from_slice(&(x[i] as f64).to_le_bytes()),
+        other => other.le_bytes_at(i, out),
+    }
+    if big && !matches!(v, V::Bytes { .. }) {
+        out[at..].reverse();
+    }
+}
+
 /// Writes `cloud` as PLY with one vertex element: float x, y, z about a
 /// zero origin; about another, the file's coordinates (origin added) as
-/// double x, y, z, as PDAL writes its X, Y and Z.
+/// double x, y, z, as PDAL writes its X, Y and Z; then its columns.
 pub(crate) fn write<W: Write>(
     w: &mut W,
     cloud: &crate::PointCloud,
@@ -482,6 +627,7 @@ pub(crate) fn write<W: Write>(
         }
     };
     let points = &cloud.points;
+    let columns = cloud.attributes.columns();
     let printed = text::Printed::of(cloud);
     let ty = if printed.is_plain() {
         "float"
@@ -490,21 +636,33 @@ pub(crate) fn write<W: Write>(
     };
     write!(
         w,
-        "ply\nformat {format} 1.0\ncomment written by autoshovel\nelement vertex {}\nproperty {ty} x\nproperty {ty} y\nproperty {ty} z\nend_header\n",
-        points.len()
+        "ply\nformat {format} 1.0\ncomment written by autoshovel\nelement vertex {}\nproperty {ty} x\nproperty {ty} y\nproperty {ty} z\n{}end_header\n",
+        points.len(),
+        column_properties(cloud)
     )?;
     if encoding == Encoding::Ascii {
         let mut line = Vec::with_capacity(48);
-        for p in points {
-            printed.write(w, p, b' ', &mut line)?;
+        let mut words = String::new();
+        for (i, p) in points.iter().enumerate() {
+            printed.fill(p, b' ', &mut line);
+            words.clear();
+            for c in columns {
+                words.push(' ');
+                c.values.text_at(i, &mut words);
+            }
+            line.extend_from_slice(words.as_bytes());
+            line.push(b'\n');
+            w.write_all(&line)?;
         }
         return Ok(());
     }
     let big = encoding == Encoding::BinaryBigEndian;
     let mut buf = Vec::with_capacity(CHUNK);
-    for (k, chunk) in points.chunks(CHUNK / 24).enumerate() {
+    let per_chunk = CHUNK / 24;
+    for (k, chunk) in points.chunks(per_chunk).enumerate() {
         buf.clear();
         for (j, p) in chunk.iter().enumerate() {
+            let i = k * per_chunk + j;
             if printed.is_plain() {
                 for v in p {
                     buf.extend_from_slice(&if big {
@@ -514,13 +672,16 @@ pub(crate) fn write<W: Write>(
                     });
                 }
             } else {
-                for v in cloud.world(k * (CHUNK / 24) + j) {
+                for v in cloud.world(i) {
                     buf.extend_from_slice(&if big {
                         v.to_be_bytes()
                     } else {
                         v.to_le_bytes()
                     });
                 }
+            }
+            for c in columns {
+                column_bytes(&c.values, i, big, &mut buf);
             }
         }
         w.write_all(&buf)?;

@@ -68,6 +68,13 @@ impl Printed {
         sep: u8,
         line: &mut Vec<u8>,
     ) -> io::Result<()> {
+        self.fill(p, sep, line);
+        line.push(b'\n');
+        w.write_all(line)
+    }
+
+    /// Puts point `p` in `line` as `x<sep>y<sep>z`, no newline.
+    pub(crate) fn fill(&self, p: &Point, sep: u8, line: &mut Vec<u8>) {
         line.clear();
         for a in 0..3 {
             if a > 0 {
@@ -81,8 +88,6 @@ impl Printed {
                 }
             }
         }
-        line.push(b'\n');
-        w.write_all(line)
     }
 }
 
