@@ -271,6 +271,32 @@ impl Values {
     }
 }
 
+/// PDAL's dimension names that a PLY property or a text header may spell
+/// in another case.
+const PDAL_NAMES: [&str; 12] = [
+    "Intensity",
+    "Red",
+    "Green",
+    "Blue",
+    "Alpha",
+    "Classification",
+    "ReturnNumber",
+    "NumberOfReturns",
+    "GpsTime",
+    "PointSourceId",
+    "UserData",
+    "ScanAngleRank",
+];
+
+/// A column's name as PDAL names the dimension (`red` → `Red`, any case);
+/// a name PDAL has no dimension for is kept as given.
+pub(crate) fn pdal_name(name: &str) -> String {
+    PDAL_NAMES
+        .iter()
+        .find(|n| n.eq_ignore_ascii_case(name))
+        .map_or_else(|| name.to_string(), |n| (*n).to_string())
+}
+
 /// One named column.
 #[derive(Debug, Clone, PartialEq)]
 pub struct Column {

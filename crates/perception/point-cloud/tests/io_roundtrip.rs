@@ -254,8 +254,8 @@ fn encodings_parse_and_default_by_extension() {
 }
 
 /// A survey in UTM (PDAL's Autzen, northings near 4.88 M m, 1 cm steps)
-/// written as PLY (every encoding, with every attribute) and text, and
-/// read back, keeps every
+/// written as PLY (every encoding) and text, and read back, keeps every
+/// attribute (PLY in its own type, text as numbers) and every
 /// coordinate of the file's frame to within a tenth of the file's 1 cm
 /// step (f32 about the first point's whole metres, 0.07 mm 700 m away):
 /// the writers add the origin back (PLY as doubles, text to the file's 2
@@ -289,12 +289,29 @@ fn a_survey_written_as_ply_or_text_keeps_its_coordinates() {
         if ext == "ply" {
             // Every attribute, row for row, in its own type and name.
             assert_eq!(back.attributes, las.attributes, "{ext} {enc}");
+        } else {
+            // Text: every attribute by name, its values as numbers.
+            for c in las.attributes.columns() {
+                let got = back
+                    .attributes
+                    .get(&c.name)
+                    .unwrap_or_else(|| panic!("{ext}: no {}", c.name));
+                for i in 0..las.len() {
+                    assert_eq!(
+                        got.f64_at(i),
+                        c.values.f64_at(i),
+                        "{ext} {} row {i}",
+                        c.name
+                    );
+                }
+            }
         }
     }
     let text = std::fs::read_to_string(dir.0.join("s-ascii.xyz")).unwrap();
+    let first = text.lines().nth(1).unwrap_or_default();
+    assert!(text.starts_with("x y z Intensity "), "{}", &text[..60]);
     assert!(
-        text.starts_with("494428.61 4877455.58 131.57\n"),
-        "{}",
-        &text[..60]
+        first.starts_with("494428.61 4877455.58 131.57 143 "),
+        "{first}"
     );
 }

@@ -1,5 +1,6 @@
 //! Text clouds read columns by name (issue 11): a header line picks x, y and
-//! z in any case and order, other columns are ignored and counted; missing
+//! z in any case and order, other columns are attributes (issue 46) unless
+//! one holds a value that is not a number, which is ignored and counted; missing
 //! or repeated axes, decimal commas and mixed separators are refused with
 //! the line at fault; headerless files stay positional.
 
@@ -18,7 +19,7 @@ fn a_header_picks_the_axes_by_name_in_any_order() {
     assert_eq!(ignored, 0);
     let (p, ignored) = read("Intensity;X;Y;Z;Ring\n9;1.5;2.5;3.5;7\n").unwrap();
     assert_eq!(p, vec![[1.5, 2.5, 3.5]]);
-    assert_eq!(ignored, 2);
+    assert_eq!(ignored, 0);
     let (p, _) = read("\"z\" \"x\" \"y\"\n3 1 2\n").unwrap();
     assert_eq!(p, vec![[1.0, 2.0, 3.0]]);
 }
@@ -59,4 +60,25 @@ fn decimal_commas_and_mixed_separators_are_refused_not_guessed() {
 fn a_short_row_names_its_line_and_the_columns_needed() {
     let e = read("intensity,x,y,z\n1,2,3\n").unwrap_err();
     assert!(e.contains("line 2") && e.contains("needs 4 fields"), "{e}");
+}
+
+#[test]
+fn other_header_columns_are_attributes_and_a_column_of_words_is_counted() {
+    let r = read_from_bytes(
+        Format::Csv,
+        b"intensity,x,y,z,ring,label\n9,1,2,3,7,rock\n10,4,5,6,8,ore\n",
+    )
+    .unwrap();
+    let a = &r.cloud.attributes;
+    // PDAL's name where it has the dimension, the file's otherwise.
+    assert_eq!(
+        a.get("Intensity").map(|v| (v.f64_at(0), v.f64_at(1))),
+        Some((9.0, 10.0))
+    );
+    assert_eq!(
+        a.get("ring").map(|v| (v.f64_at(0), v.f64_at(1))),
+        Some((7.0, 8.0))
+    );
+    assert!(a.get("label").is_none());
+    assert_eq!(r.ignored_columns, 1, "the words' column");
 }

@@ -159,28 +159,9 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     })
 }
 
-/// PDAL's dimension names that a PLY property may spell in another case.
-const PDAL_NAMES: [&str; 12] = [
-    "Intensity",
-    "Red",
-    "Green",
-    "Blue",
-    "Alpha",
-    "Classification",
-    "ReturnNumber",
-    "NumberOfReturns",
-    "GpsTime",
-    "PointSourceId",
-    "UserData",
-    "ScanAngleRank",
-];
-
 /// A vertex property's column name: PDAL's where it has one.
 fn column_name(ply: &str) -> String {
-    PDAL_NAMES
-        .iter()
-        .find(|n| n.eq_ignore_ascii_case(ply))
-        .map_or_else(|| ply.to_string(), |n| (*n).to_string())
+    crate::attributes::pdal_name(ply)
 }
 
 /// A column's PLY property name: colour in lower case, as viewers read it.

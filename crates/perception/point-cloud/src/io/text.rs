@@ -60,19 +60,6 @@ impl Printed {
         self.origin == [0.0; 3]
     }
 
-    /// Writes point `p` as `x<sep>y<sep>z\n`, using `line` as scratch.
-    pub(crate) fn write<W: Write>(
-        &self,
-        w: &mut W,
-        p: &Point,
-        sep: u8,
-        line: &mut Vec<u8>,
-    ) -> io::Result<()> {
-        self.fill(p, sep, line);
-        line.push(b'\n');
-        w.write_all(line)
-    }
-
     /// Puts point `p` in `line` as `x<sep>y<sep>z`, no newline.
     pub(crate) fn fill(&self, p: &Point, sep: u8, line: &mut Vec<u8>) {
         line.clear();
@@ -145,7 +132,9 @@ mod tests {
         let mut out = Vec::new();
         let mut line = Vec::new();
         for p in &c.points {
-            printed.write(&mut out, p, b' ', &mut line).unwrap();
+            printed.fill(p, b' ', &mut line);
+            line.push(b'\n');
+            out.extend_from_slice(&line);
         }
         let text = String::from_utf8(out).unwrap();
         for (i, row) in text.lines().enumerate() {

@@ -1,9 +1,13 @@
 //! Plain text clouds (`.xyz`, `.csv`, `.txt`): one point per line, fields
 //! separated by whitespace, commas or semicolons (one separator for the
 //! whole file). A header line of column names, if present, picks x, y and z
-//! by name in any case and order (other columns are ignored and counted);
-//! without one the first three fields are x, y, z. `#` starts a comment.
-//! Decimal commas and mixed separators are refused, not guessed.
+//! by name in any case and order; its other columns are attributes (f64,
+//! named as PDAL names the dimension where it has one, `intensity` →
+//! `Intensity`), except one with a value that is not a number, which is
+//! ignored and counted. Without a header the first three fields are x, y,
+//! z and any others are read past. `#` starts a comment.
+//! Decimal commas and mixed separators are refused, not guessed. Written
+//! with attributes, a file gets a header line naming them.
 
 use std::io::{BufRead, Write};
 
@@ -62,16 +66,23 @@ struct Layout {
     xyz: [usize; 3],
 }
 
+/// An attribute column of a text file: its field and rows; `None` once
+/// a value was not a number (then the column is dropped and counted).
+type TextColumn = (usize, String, Option<Vec<f64>>);
+
 /// The columns of a header line: x, y and z by name (any case, any order,
-/// quotes stripped); other columns are ignored and counted.
-fn header_layout(fields: &[&str], sep: Separator, full: &str) -> Result<(Layout, usize), String> {
-    let names: Vec<String> = fields
+/// quotes stripped), and the others by field and name (a repeated name
+/// after its first is left out).
+fn header_layout(
+    fields: &[&str],
+    sep: Separator,
+    full: &str,
+) -> Result<(Layout, Vec<TextColumn>), String> {
+    let given: Vec<&str> = fields
         .iter()
-        .map(|f| {
-            f.trim_matches(|c| c == '"' || c == '\'')
-                .to_ascii_lowercase()
-        })
+        .map(|f| f.trim_matches(|c| c == '"' || c == '\''))
         .collect();
+    let names: Vec<String> = given.iter().map(|f| f.to_ascii_lowercase()).collect();
     let mut xyz = [0usize; 3];
     for (a, axis) in ["x", "y", "z"].into_iter().enumerate() {
         let at: Vec<usize> = (0..names.len()).filter(|&i| names[i] == axis).collect();
@@ -93,7 +104,14 @@ fn header_layout(fields: &[&str], sep: Separator, full: &str) -> Result<(Layout,
             }
         }
     }
-    Ok((Layout { sep, xyz }, names.len() - 3))
+    let mut columns: Vec<TextColumn> = Vec::new();
+    for (i, name) in given.iter().enumerate() {
+        let name = crate::attributes::pdal_name(name);
+        if !xyz.contains(&i) && !columns.iter().any(|(_, n, _)| *n == name) {
+            columns.push((i, name, Some(Vec::new())));
+        }
+    }
+    Ok((Layout { sep, xyz }, columns))
 }
 
 fn parse_field(s: &str, sep: Separator) -> Result<f64, String> {
@@ -140,6 +158,7 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
     let mut line_no = 0u64;
     let mut data_lines = 0usize;
     let mut layout: Option<Layout> = None;
+    let mut columns: Vec<TextColumn> = Vec::new();
     let mut sized = false;
     while input.read_line(&mut line, MAX_LINE, line_no + 1)? {
         line_no += 1;
@@ -171,10 +190,14 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
                         .take(3)
                         .any(|f| f.replace(',', ".").parse::<f32>().is_ok())
                 {
-                    let (l, ignored) = header_layout(&fields, sep, full).map_err(|what| {
+                    let (l, cols) = header_layout(&fields, sep, full).map_err(|what| {
                         input.format_err(what.replacen("line 1", &format!("line {line_no}"), 1))
                     })?;
-                    out.ignored_columns = ignored;
+                    // Streaming, the points go on without their columns.
+                    out.ignored_columns = if out.is_streaming() { cols.len() } else { 0 };
+                    if !out.is_streaming() {
+                        columns = cols;
+                    }
                     layout = Some(l);
                     continue;
                 } else {
@@ -225,10 +248,19 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
             out.origin = [0, 1, 2].map(|a| origin_for(p[a], word(a)));
             out.origin_from_first = false;
         }
-        if out.origin == [0.0; 3] {
-            out.push([word(0), word(1), word(2)]);
+        let kept = if out.origin == [0.0; 3] {
+            out.push([word(0), word(1), word(2)])
         } else {
-            out.push_f64(p[0], p[1], p[2]);
+            out.push_f64(p[0], p[1], p[2])
+        };
+        if kept {
+            for (field, _, rows) in &mut columns {
+                let v = fields.get(*field).and_then(|f| f.parse::<f64>().ok());
+                match (v, rows.as_mut()) {
+                    (Some(v), Some(r)) => r.push(v),
+                    _ => *rows = None,
+                }
+            }
         }
         data_lines += 1;
         if !sized && data_lines == SAMPLE_LINES {
@@ -243,6 +275,12 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
             );
         }
     }
+    for (_, name, rows) in columns {
+        match rows {
+            Some(rows) => out.attributes.insert(name, crate::Values::F64(rows)),
+            None => out.ignored_columns += 1,
+        }
+    }
     Ok(())
 }
 
@@ -255,13 +293,39 @@ pub(crate) fn write<W: Write>(
     sep: u8,
     header: Option<&str>,
 ) -> std::io::Result<()> {
-    if let Some(h) = header {
-        writeln!(w, "{h}")?;
+    let columns = cloud.attributes.columns();
+    let s = char::from(sep);
+    if columns.is_empty() {
+        if let Some(h) = header {
+            writeln!(w, "{h}")?;
+        }
+    } else {
+        // x, y, z and the columns by name; a column of extra bytes as one
+        // field a byte (NAME_0 …).
+        let mut names = vec!["x".to_string(), "y".into(), "z".into()];
+        for c in columns {
+            match &c.values {
+                crate::Values::Bytes { width, .. } => {
+                    names.extend((0..*width).map(|k| format!("{}_{k}", c.name)));
+                }
+                _ => names.push(c.name.clone()),
+            }
+        }
+        writeln!(w, "{}", names.join(&s.to_string()))?;
     }
     let printed = text::Printed::of(cloud);
     let mut line = Vec::with_capacity(48);
-    for p in &cloud.points {
-        printed.write(w, p, sep, &mut line)?;
+    let mut words = String::new();
+    for (i, p) in cloud.points.iter().enumerate() {
+        printed.fill(p, sep, &mut line);
+        for c in columns {
+            words.clear();
+            c.values.text_at(i, &mut words);
+            line.push(sep);
+            line.extend_from_slice(words.replace(' ', &s.to_string()).as_bytes());
+        }
+        line.push(b'\n');
+        w.write_all(&line)?;
     }
     Ok(())
 }
