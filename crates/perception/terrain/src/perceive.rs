@@ -954,6 +954,89 @@ pub fn perceive_after(
         Some(prior) => (prior.scale, prior.spacing_m),
         None => scale_and_spacing(cloud, p)?,
     };
+    check_work_on(cloud, p, spacing)?;
+    p.check_work(1.0, input_points)?;
+    let mut stages: Vec<StageRecord> = Vec::new();
+    if let Some((c, ms)) = &ranged {
+        stages.push(StageRecord {
+            stage: "range",
+            points: c.len(),
+            ms: *ms,
+        });
+    }
+    let in_stage = |stage: &'static str| {
+        move |source: SurfaceError| SurfaceError::Stage {
+            stage,
+            source: Box::new(source),
+        }
+    };
+    // Level [RS eq. 11]–[RS eq. 12], and the ground (ground.rs).
+    on_stage("level");
+    let t = Instant::now();
+    let levelled = level_stage(cloud, p, prior, scale)?;
+    let Levelled {
+        cloud,
+        roll,
+        pitch,
+        floor,
+        used,
+    } = levelled;
+    stages.push(StageRecord {
+        stage: "level",
+        points: cloud.len(),
+        ms: elapsed_ms(t),
+    });
+    let cloud = run_filters(cloud, p, &used, (scale, spacing), &mut stages, on_stage)?;
+    // Fit [RS eq. 21].
+    on_stage("fit");
+    let t = Instant::now();
+    let gate = p.fit.model == SurfaceModel::Polynomial && p.fit.r2_threshold > 0.0;
+    let fit_params = FitParams {
+        max_degree: p.fit.max_degree,
+        r2_threshold: gate.then_some(p.fit.r2_threshold),
+        ..FitParams::default()
+    };
+    let fit = fit_surface(&cloud, &fit_params).map_err(in_stage("fitting the surface"))?;
+    let before =
+        base_scan(p, given, &cloud, roll, pitch).map_err(in_stage("reading [ground] surface"))?;
+    let model = Model::of(
+        &cloud,
+        p.fit.cell_spacings * spacing,
+        &used,
+        &floor,
+        before.as_ref(),
+    )
+    .map_err(in_stage("making the height model"))?;
+    stages.push(StageRecord {
+        stage: "fit",
+        points: fit.samples.len(),
+        ms: elapsed_ms(t),
+    });
+    let warnings = surface_warnings(given, &model.summary, p);
+    Ok(Perceived {
+        cloud,
+        fit,
+        floor_height_m: model.base,
+        model,
+        used,
+        floor,
+        roll_rad: roll,
+        pitch_rad: pitch,
+        scale,
+        spacing_m: spacing,
+        stages,
+        input_points,
+        format: None,
+        non_finite_dropped: 0,
+        warnings,
+    })
+}
+
+/// Refuses, before any work, filter settings whose neighbour searches
+/// pass the ceiling on `cloud`: with a spacing given as a number, the
+/// cloud's own may be much finer, and then the spacing is what is named.
+fn check_work_on(cloud: &PointCloud, p: &PerceptionParams, spacing: f64) -> Result<()> {
+    let input_points = cloud.len();
     // The work the filters imply on this cloud, before doing it: with a
     // spacing given as a number, the cloud's own may be much finer.
     if let (Some((lo, hi)), ScaleSetting::Factor(_)) = (cloud.bounds(), p.spacing) {
@@ -984,27 +1067,20 @@ pub fn perceive_after(
             }
         }
     }
-    p.check_work(1.0, input_points)?;
-    let mut stages: Vec<StageRecord> = Vec::new();
-    if let Some((c, ms)) = &ranged {
-        stages.push(StageRecord {
-            stage: "range",
-            points: c.len(),
-            ms: *ms,
-        });
-    }
-    let in_stage = |stage: &'static str| {
-        move |source: SurfaceError| SurfaceError::Stage {
-            stage,
-            source: Box::new(source),
-        }
-    };
-    // Level [RS eq. 11]–[RS eq. 12], and the ground (ground.rs).
-    on_stage("level");
-    let t = Instant::now();
+    Ok(())
+}
+
+/// Level [RS eq. 11]–[RS eq. 12] and take the ground (ground.rs); with a
+/// prior, its angles and floor, no search.
+fn level_stage(
+    cloud: &PointCloud,
+    p: &PerceptionParams,
+    prior: Option<&Prior>,
+    scale: f64,
+) -> Result<Levelled> {
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
-    let levelled = match prior {
+    Ok(match prior {
         // A prior's angles and floor, no search.
         Some(prior) => {
             let c = PointCloud {
@@ -1027,19 +1103,20 @@ pub fn perceive_after(
             }
         }
         None => level_and_ground(cloud, &p.level_asked(scale), &tilt_params)?,
-    };
-    let Levelled {
-        cloud,
-        roll,
-        pitch,
-        floor,
-        used,
-    } = levelled;
-    stages.push(StageRecord {
-        stage: "level",
-        points: cloud.len(),
-        ms: elapsed_ms(t),
-    });
+    })
+}
+
+/// The filter stages after levelling, in the paper's order, each timed,
+/// counted in `stages` and announced to `on_stage`. The radius stage
+/// hands its neighbour index to the statistical one.
+fn run_filters(
+    cloud: PointCloud,
+    p: &PerceptionParams,
+    used: &GroundUsed,
+    (scale, spacing): (f64, f64),
+    stages: &mut Vec<StageRecord>,
+    on_stage: &mut dyn FnMut(&'static str),
+) -> Result<PointCloud> {
     // The filter stages, in the paper's order; each timed and counted. The
     // radius stage hands its neighbour index to the statistical one.
     type Filter<'a> = Box<dyn Fn(&PointCloud) -> autoshovel_point_cloud::Result<PointCloud> + 'a>;
@@ -1132,49 +1209,7 @@ pub fn perceive_after(
             });
         }
     }
-    // Fit [RS eq. 21].
-    on_stage("fit");
-    let t = Instant::now();
-    let gate = p.fit.model == SurfaceModel::Polynomial && p.fit.r2_threshold > 0.0;
-    let fit_params = FitParams {
-        max_degree: p.fit.max_degree,
-        r2_threshold: gate.then_some(p.fit.r2_threshold),
-        ..FitParams::default()
-    };
-    let fit = fit_surface(&cloud, &fit_params).map_err(in_stage("fitting the surface"))?;
-    let before =
-        base_scan(p, given, &cloud, roll, pitch).map_err(in_stage("reading [ground] surface"))?;
-    let model = Model::of(
-        &cloud,
-        p.fit.cell_spacings * spacing,
-        &used,
-        &floor,
-        before.as_ref(),
-    )
-    .map_err(in_stage("making the height model"))?;
-    stages.push(StageRecord {
-        stage: "fit",
-        points: fit.samples.len(),
-        ms: elapsed_ms(t),
-    });
-    let warnings = surface_warnings(given, &model.summary, p);
-    Ok(Perceived {
-        cloud,
-        fit,
-        floor_height_m: model.base,
-        model,
-        used,
-        floor,
-        roll_rad: roll,
-        pitch_rad: pitch,
-        scale,
-        spacing_m: spacing,
-        stages,
-        input_points,
-        format: None,
-        non_finite_dropped: 0,
-        warnings,
-    })
+    Ok(cloud)
 }
 
 /// The height model's RMS residual, over its cell's edge, past which the

@@ -63,16 +63,19 @@ impl Printed {
     /// Puts point `p` in `line` as `x<sep>y<sep>z`, no newline.
     pub(crate) fn fill(&self, p: &Point, sep: u8, line: &mut Vec<u8>) {
         line.clear();
-        for a in 0..3 {
+        for (a, (&v, (&o, &d))) in p
+            .iter()
+            .zip(self.origin.iter().zip(&self.decimals))
+            .enumerate()
+        {
             if a > 0 {
                 line.push(sep);
             }
-            match self.origin[a] {
-                0.0 => push_f32(line, p[a]),
-                o => {
-                    // Writing to a Vec cannot fail.
-                    let _ = write!(line, "{:.*}", self.decimals[a], o + f64::from(p[a]));
-                }
+            if o == 0.0 {
+                push_f32(line, v);
+            } else {
+                // Writing to a Vec cannot fail.
+                let _ = write!(line, "{:.*}", d, o + f64::from(v));
             }
         }
     }
