@@ -220,6 +220,100 @@ pub struct Georef {
     pub crs: Crs,
     /// The LAS header read, for LAS and LAZ.
     pub las: Option<LasLayout>,
+    /// The sensor's pose a PCD file states (`VIEWPOINT`), where it is not
+    /// the identity: written back to PCD, turned with the cloud by a
+    /// levelling.
+    pub viewpoint: Option<Viewpoint>,
+}
+
+/// PCL's viewpoint: where the sensor was and how it was turned, in the
+/// cloud's frame (PCD's `VIEWPOINT tx ty tz qw qx qy qz`).
+#[derive(Debug, Clone, Copy, PartialEq)]
+pub struct Viewpoint {
+    /// Position (tx, ty, tz), the file's coordinates.
+    pub position: [f64; 3],
+    /// Orientation as a unit quaternion (qw, qx, qy, qz).
+    pub orientation: [f64; 4],
+}
+
+impl Viewpoint {
+    /// The identity pose PCL writes when it knows none.
+    pub const IDENTITY: Viewpoint = Viewpoint {
+        position: [0.0; 3],
+        orientation: [1.0, 0.0, 0.0, 0.0],
+    };
+
+    /// From PCD's seven numbers; `None` for the identity.
+    pub fn from_pcd(v: [f64; 7]) -> Option<Self> {
+        let vp = Viewpoint {
+            position: [v[0], v[1], v[2]],
+            orientation: [v[3], v[4], v[5], v[6]],
+        };
+        (vp != Self::IDENTITY).then_some(vp)
+    }
+
+    /// PCD's `VIEWPOINT` line's seven numbers.
+    pub fn pcd_words(&self) -> String {
+        let [tx, ty, tz] = self.position;
+        let [qw, qx, qy, qz] = self.orientation;
+        format!("{tx} {ty} {tz} {qw} {qx} {qy} {qz}")
+    }
+
+    /// The pose after the cloud is turned by the rotation matrix `r`
+    /// (rows) about `about` (the cloud's origin): the position turned, and
+    /// the orientation `r · q`.
+    pub fn turned(&self, r: [[f64; 3]; 3], about: [f64; 3]) -> Self {
+        let p: [f64; 3] = std::array::from_fn(|a| self.position[a] - about[a]);
+        let position =
+            std::array::from_fn(|i| about[i] + (0..3).map(|k| r[i][k] * p[k]).sum::<f64>());
+        // The rotation matrix as a quaternion (Shepperd's method, on the
+        // largest of the four diagonal sums for stability).
+        let t = r[0][0] + r[1][1] + r[2][2];
+        let rq = if t > 0.0 {
+            let s = (t + 1.0).sqrt() * 2.0;
+            [
+                s / 4.0,
+                (r[2][1] - r[1][2]) / s,
+                (r[0][2] - r[2][0]) / s,
+                (r[1][0] - r[0][1]) / s,
+            ]
+        } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
+            let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
+            [
+                (r[2][1] - r[1][2]) / s,
+                s / 4.0,
+                (r[0][1] + r[1][0]) / s,
+                (r[0][2] + r[2][0]) / s,
+            ]
+        } else if r[1][1] > r[2][2] {
+            let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
+            [
+                (r[0][2] - r[2][0]) / s,
+                (r[0][1] + r[1][0]) / s,
+                s / 4.0,
+                (r[1][2] + r[2][1]) / s,
+            ]
+        } else {
+            let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
+            [
+                (r[1][0] - r[0][1]) / s,
+                (r[0][2] + r[2][0]) / s,
+                (r[1][2] + r[2][1]) / s,
+                s / 4.0,
+            ]
+        };
+        let [aw, ax, ay, az] = rq;
+        let [bw, bx, by, bz] = self.orientation;
+        Viewpoint {
+            position,
+            orientation: [
+                aw * bw - ax * bx - ay * by - az * bz,
+                aw * bx + ax * bw + ay * bz - az * by,
+                aw * by - ax * bz + ay * bw + az * bx,
+                aw * bz + ax * by - ay * bx + az * bw,
+            ],
+        }
+    }
 }
 
 /// The CRS a LAS header states (GeoTIFF keys or WKT).
@@ -289,6 +383,31 @@ mod tests {
             Unit::Degree
         );
         assert!((Unit::UsSurveyFoot.metres().unwrap() - 0.304_800_609_6).abs() < 1e-10);
+    }
+
+    #[test]
+    fn a_viewpoint_turns_with_the_cloud() {
+        // A quarter turn about z: x goes to y.
+        let r = [[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]];
+        let vp = Viewpoint {
+            position: [12.0, 5.0, 3.0],
+            orientation: [1.0, 0.0, 0.0, 0.0],
+        };
+        let t = vp.turned(r, [10.0, 5.0, 0.0]);
+        let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-12);
+        assert!(close(&t.position, &[10.0, 7.0, 3.0]), "{t:?}");
+        let h = std::f64::consts::FRAC_1_SQRT_2;
+        assert!(close(&t.orientation, &[h, 0.0, 0.0, h]), "{t:?}");
+        // Turned back by the transpose: where it was.
+        let back = t.turned(
+            [[0.0, 1.0, 0.0], [-1.0, 0.0, 0.0], [0.0, 0.0, 1.0]],
+            [10.0, 5.0, 0.0],
+        );
+        assert!(close(&back.position, &vp.position) && close(&back.orientation, &vp.orientation));
+        assert_eq!(
+            Viewpoint::from_pcd([0.0, 0.0, 0.0, 1.0, 0.0, 0.0, 0.0]),
+            None
+        );
     }
 
     #[test]

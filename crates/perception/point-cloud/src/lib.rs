@@ -26,4 +26,4 @@ mod testing;
 pub use attributes::{Attributes, Column, Values};
 pub use cloud::{Point, PointCloud};
 pub use error::{CloudError, Result};
-pub use georef::{Crs, Georef, LasLayout, Unit};
+pub use georef::{Crs, Georef, LasLayout, Unit, Viewpoint};

@@ -348,9 +348,14 @@ impl Stage {
                 // About the origin: the sensor for a scan in its own frame,
                 // the middle of the data for a survey (the LAS reader's
                 // origin).
-                let turned = level(cloud, roll_deg.to_radians(), pitch_deg.to_radians());
+                let (roll, pitch) = (roll_deg.to_radians(), pitch_deg.to_radians());
+                let turned = level(cloud, roll, pitch);
                 let mut out = cloud.clone();
                 out.points = turned.points;
+                // The sensor's pose turns with its cloud.
+                let r = crate::calibrate::level_from_sensor(roll, pitch);
+                let rows = std::array::from_fn(|i| std::array::from_fn(|k| r[(i, k)]));
+                out.georef.viewpoint = cloud.georef.viewpoint.map(|v| v.turned(rows, cloud.origin));
                 return Ok(out);
             }
         };
@@ -575,6 +580,56 @@ mod tests {
     use autoshovel_point_cloud::filter::{
         pass_through_indices, radius_outlier_removal_indices, statistical_outlier_removal_indices,
     };
+
+    #[test]
+    fn a_pcd_viewpoint_is_kept_and_turned_with_the_cloud() {
+        // PCL's VIEWPOINT, through a file: a quarter turn about z at
+        // (1.5, 2, 3); a pass keeps it, levelling by a pitch of 90° turns
+        // it as the points turn (T(0, β) of [RS eq. 11]: (x, y, z) →
+        // (−z, y, x)).
+        let dir = std::env::temp_dir().join(format!("autoshovel-vp-{}", std::process::id()));
+        std::fs::create_dir_all(&dir).unwrap();
+        let path = dir.join("vp.pcd");
+        std::fs::write(
+            &path,
+            "VERSION 0.7\nFIELDS x y z\nSIZE 4 4 4\nTYPE F F F\nCOUNT 1 1 1\nWIDTH 2\nHEIGHT 1\n\
+             VIEWPOINT 1.5 2 3 0.5 0.5 0.5 0.5\nPOINTS 2\nDATA ascii\n1 2 3\n4 5 6\n",
+        )
+        .unwrap();
+        let read = |p: &std::path::Path| {
+            autoshovel_point_cloud::io::read(p, &mut |_, _| {})
+                .unwrap()
+                .cloud
+        };
+        let c = read(&path);
+        let vp = c.georef.viewpoint.expect("the file's viewpoint");
+        assert_eq!(vp.position, [1.5, 2.0, 3.0]);
+        let (kept, _) =
+            run_chain(&c, &[Stage::parse(StageKind::Pass, "z:-inf:inf").unwrap()]).unwrap();
+        let out = dir.join("out.pcd");
+        autoshovel_point_cloud::io::write(&out, &kept, autoshovel_point_cloud::io::Encoding::Ascii)
+            .unwrap();
+        assert_eq!(
+            read(&out).georef.viewpoint,
+            Some(vp),
+            "written back as read"
+        );
+        let (turned, _) =
+            run_chain(&c, &[Stage::parse(StageKind::Level, "0,90").unwrap()]).unwrap();
+        let t = turned.georef.viewpoint.unwrap();
+        let close = |a: &[f64], b: &[f64]| a.iter().zip(b).all(|(x, y)| (x - y).abs() < 1e-9);
+        assert!(close(&t.position, &[-3.0, 2.0, 1.5]), "{t:?}");
+        // The first point turned the same way.
+        let p = turned.points[0];
+        assert!(
+            close(
+                &[f64::from(p[0]), f64::from(p[1]), f64::from(p[2])],
+                &[-3.0, 2.0, 1.0]
+            ),
+            "{p:?}"
+        );
+        let _ = std::fs::remove_dir_all(&dir);
+    }
 
     fn cloud() -> PointCloud {
         // A jittered 40 × 40 grid with a few far points.

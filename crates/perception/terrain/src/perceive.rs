@@ -1367,6 +1367,7 @@ fn in_metres(cloud: &PointCloud) -> Option<PointCloud> {
             ..Default::default()
         },
         las: None,
+        viewpoint: None,
     };
     Some(c)
 }

@@ -228,6 +228,8 @@ pub(crate) struct Points<'s> {
     pub(crate) origin_from_first: bool,
     /// Columns besides x, y and z, a row for every point kept.
     pub(crate) attributes: crate::Attributes,
+    /// A PCD file's sensor pose, where not the identity.
+    pub(crate) viewpoint: Option<crate::Viewpoint>,
 }
 
 /// Coordinates within this distance of zero are held about a zero origin

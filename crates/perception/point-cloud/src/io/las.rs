@@ -598,6 +598,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             georef: Georef {
                 crs: las_crs(&header),
                 las: Some(LasLayout(header)),
+                viewpoint: None,
             },
             attributes: columns.map(LasColumns::into_attributes).unwrap_or_default(),
         })

@@ -82,6 +82,8 @@ struct Header {
     values_per_point: usize,
     /// Lines read so far (the DATA line is the last one).
     lines: u64,
+    /// The sensor pose `VIEWPOINT` states, where not the identity.
+    viewpoint: Option<crate::Viewpoint>,
 }
 
 fn parse_u64<R: BufRead>(
@@ -106,6 +108,7 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
     let mut types: Option<(Vec<char>, u64)> = None;
     let mut counts: Option<(Vec<usize>, u64)> = None;
     let mut width: Option<u64> = None;
+    let mut viewpoint = None;
     let mut height: Option<u64> = None;
     let mut points: Option<u64> = None;
     let data;
@@ -196,11 +199,18 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
             "HEIGHT" => height = Some(parse_u64(input, rest.first().copied(), "HEIGHT", line_no)?),
             "POINTS" => points = Some(parse_u64(input, rest.first().copied(), "POINTS", line_no)?),
             "VIEWPOINT" => {
-                if rest.len() != 7 || rest.iter().any(|s| s.parse::<f64>().is_err()) {
+                let v: Vec<f64> = rest.iter().filter_map(|s| s.parse::<f64>().ok()).collect();
+                let Ok(v) = <[f64; 7]>::try_from(v) else {
+                    return Err(input.format_err(format!(
+                        "line {line_no}: VIEWPOINT needs 7 numbers (tx ty tz qw qx qy qz): {text:?}"
+                    )));
+                };
+                if rest.len() != 7 {
                     return Err(input.format_err(format!(
                         "line {line_no}: VIEWPOINT needs 7 numbers (tx ty tz qw qx qy qz): {text:?}"
                     )));
                 }
+                viewpoint = crate::Viewpoint::from_pcd(v);
             }
             "DATA" => {
                 data = match rest.first().map(|s| s.to_ascii_lowercase()).as_deref() {
@@ -342,6 +352,7 @@ fn read_header<R: BufRead>(input: &mut Input<'_, R>) -> crate::Result<Header> {
         point_step: offset,
         values_per_point: value_index,
         lines: line_no,
+        viewpoint,
     })
 }
 
@@ -352,6 +363,7 @@ pub(crate) fn read<R: BufRead>(
 ) -> crate::Result<&'static str> {
     let h = read_header(input)?;
     out.origin_from_first = true;
+    out.viewpoint = h.viewpoint;
     let mut cols: Vec<Values> = h
         .extras
         .iter()
@@ -784,7 +796,7 @@ pub(crate) fn write_cloud<W: Write>(
     cloud: &crate::PointCloud,
     encoding: Encoding,
 ) -> std::io::Result<()> {
-    if cloud.origin == [0.0; 3] && cloud.attributes.is_empty() {
+    if cloud.origin == [0.0; 3] && cloud.attributes.is_empty() && cloud.georef.viewpoint.is_none() {
         write(w, &cloud.points, encoding)
     } else {
         write_fields(w, cloud, encoding)
@@ -794,7 +806,8 @@ pub(crate) fn write_cloud<W: Write>(
 /// A cloud about an origin, or with attributes, as PCD: x y z as F8 (the
 /// file's coordinates, origin added, as PDAL writes them) when the origin
 /// is not zero, then every column as a field of its own type (bytes as a
-/// U1 field of COUNT their width).
+/// U1 field of COUNT their width), and the sensor pose read, if any, as
+/// VIEWPOINT.
 fn write_fields<W: Write>(
     w: &mut W,
     cloud: &crate::PointCloud,
@@ -828,9 +841,14 @@ fn write_fields<W: Write>(
     }
     let join = |v: Vec<String>| v.join(" ");
     let n = cloud.len();
+    let viewpoint = cloud
+        .georef
+        .viewpoint
+        .unwrap_or(crate::Viewpoint::IDENTITY)
+        .pcd_words();
     write!(
         w,
-        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT 0 0 0 1 0 0 0\nPOINTS {n}\nDATA {data}\n",
+        "# .PCD v0.7 - Point Cloud Data file format\nVERSION 0.7\nFIELDS {}\nSIZE {}\nTYPE {}\nCOUNT {}\nWIDTH {n}\nHEIGHT 1\nVIEWPOINT {viewpoint}\nPOINTS {n}\nDATA {data}\n",
         join(names),
         join(types.iter().map(|t| t.1.to_string()).collect()),
         join(types.iter().map(|t| t.0.to_string()).collect()),

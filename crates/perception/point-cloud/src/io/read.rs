@@ -240,7 +240,10 @@ fn report(out: Points<'_>, got: las::LasRead) -> ReadReport {
             } else {
                 got.attributes
             },
-            georef: got.georef,
+            georef: crate::Georef {
+                viewpoint: out.viewpoint,
+                ..got.georef
+            },
         },
         non_finite_dropped: out.non_finite,
         ignored_columns: out.ignored_columns,
