@@ -130,8 +130,11 @@ fn removal_filters_keep_whole_rows_of_a_survey_13_km_across() {
 }
 
 /// The same scan levels the same from every container and in any point
-/// order: PDAL's Autzen sample as COPC and as point-wise LASzip (both in
-/// tests/data), and laspy's plain-LAS copy and shuffled copy of the COPC.
+/// order: PDAL's Autzen sample as COPC (in tests/data), and laspy's
+/// plain-LAS, point-wise LAZ (lazrs) and shuffled copies of it, each with
+/// its CRS (a compound one: metres across, US survey feet up). PDAL's
+/// point-wise LASzip copy of the same points is not among them: it states
+/// no CRS, so its z stays in feet and the scan is another shape.
 /// Before the floor search drew its points by their coordinates, the
 /// shuffled copy levelled differently (a floor of 9 points against 15).
 #[test]
@@ -139,25 +142,23 @@ fn the_same_scan_levels_the_same_from_las_laz_copc_and_shuffled() {
     let Some(py) = python() else { return };
     let tmp = TempDir::new("real-level");
     let copc = data("pdal_1.2-with-color.copc.laz");
-    let (plain, shuffled) = (
+    let (plain, laz, shuffled) = (
         tmp.path().join("plain.las"),
+        tmp.path().join("pointwise.laz"),
         tmp.path().join("shuffled.las"),
     );
     peer(&py, &[&copc, &plain], "copy");
+    peer(&py, &[&copc, &laz], "copy");
     peer(&py, &[&copc, &shuffled], "shuffle");
     // An airborne survey: its ground is a small share of the returns, and
-    // the fit's gate is off (this is about the levelling).
+    // the fit's gate is off (this is about the levelling). Estimated, not
+    // taken as level: by default a survey in a projected CRS is level.
     let config = tmp.write(
         "level.toml",
-        "[level]\nmin_floor_share = 0.005\n[fit]\nr2_threshold = 0\n",
+        "[level]\nmode = \"estimate\"\nmin_floor_share = 0.005\n[fit]\nr2_threshold = 0\n",
     );
     let mut angles = Vec::new();
-    for input in [
-        copc,
-        data("pdal_simple-laszip-compressor-version-1.2r0.laz"),
-        plain,
-        shuffled,
-    ] {
+    for input in [copc, plain, laz, shuffled] {
         let r = run(&[
             "perceive".as_ref(),
             "--input".as_ref(),
@@ -414,6 +415,38 @@ fn the_change_between_two_surveys_agrees_with_laspy_and_numpy() {
         m.contains("4_6_crop.las") && m.contains("EPSG:2903") && m.contains("same frame"),
         "{m}"
     );
+}
+
+/// The survey path's cleaned tiles are in the survey's own coordinates and
+/// CRS: before, they were written less the survey's kilometre origin and
+/// with no CRS (Autzen's eastings of 494 km came out as 428 m).
+#[test]
+fn survey_tiles_keep_the_surveys_coordinates_and_crs() {
+    let Some(py) = python() else { return };
+    let tmp = TempDir::new("real-tiles");
+    let input = data("autzen-utm.las");
+    let out = tmp.path().join("out");
+    run(&[
+        "perceive".as_ref(),
+        "--tiles".as_ref(),
+        "--tile-size".as_ref(),
+        "300".as_ref(),
+        "--input".as_ref(),
+        input.as_os_str(),
+        "--out".as_ref(),
+        out.as_os_str(),
+    ])
+    .ok();
+    let mut tiles: Vec<PathBuf> = std::fs::read_dir(out.join("tiles"))
+        .unwrap()
+        .map(|e| e.unwrap().path())
+        .collect();
+    tiles.sort();
+    assert!(tiles.len() > 1, "{tiles:?}");
+    let mut args: Vec<&Path> = vec![&input];
+    args.extend(tiles.iter().map(PathBuf::as_path));
+    let v = peer(&py, &args, "tiles");
+    assert!(v["points"].as_u64().unwrap() > 100, "{v}");
 }
 
 /// With no settings at all, a survey perceives, naming what the level and

@@ -135,6 +135,11 @@ pub fn write(dir: &Path, run: &FrameRun, written: &mut Written) -> Result<(), Fi
     )
 }
 
+/// Most cells a height map draws (one SVG rectangle each, some 85 bytes):
+/// a finer model is drawn in blocks (a 1 km² survey at 1 m cells, 10⁶
+/// cells, as 250 × 250 blocks of 4 × 4).
+pub const MAX_MAP_CELLS: usize = 65_536;
+
 /// Writes the height map of `m` as `name`.svg/png under `dir`.
 pub fn height_map(
     dir: &Path,
@@ -143,11 +148,44 @@ pub fn height_map(
     name: &str,
     written: &mut Written,
 ) -> Result<(), FiguresError> {
-    let xs: Vec<f64> = (0..m.size[0]).map(|i| m.centre(i)[0]).collect();
-    let ys: Vec<f64> = (0..m.size[1]).map(|j| m.centre(j * m.size[0])[1]).collect();
-    let z: Vec<Vec<f64>> = (0..m.size[1])
-        .map(|j| (0..m.size[0]).map(|i| m.z[j * m.size[0] + i]).collect())
+    // A model finer than the map can draw is drawn in blocks of k × k
+    // cells, each the mean of its cells with a height (the CSV keeps
+    // every cell).
+    let cells = m.size[0].saturating_mul(m.size[1]);
+    let k = (1..)
+        .find(|k: &usize| cells.div_ceil(k * k) <= MAX_MAP_CELLS)
+        .unwrap_or(1);
+    let [nx, ny] = [m.size[0].div_ceil(k), m.size[1].div_ceil(k)];
+    let block = |bi: usize, bj: usize| {
+        let (mut sum, mut n) = (0.0, 0u32);
+        for j in bj * k..((bj + 1) * k).min(m.size[1]) {
+            for i in bi * k..((bi + 1) * k).min(m.size[0]) {
+                let z = m.z[j * m.size[0] + i];
+                if z.is_finite() {
+                    sum += z;
+                    n += 1;
+                }
+            }
+        }
+        if n > 0 {
+            sum / f64::from(n)
+        } else {
+            f64::NAN
+        }
+    };
+    let x0 = m.centre(0)[0] - m.cell_m / 2.0;
+    let y0 = m.centre(0)[1] - m.cell_m / 2.0;
+    let side = m.cell_m * k as f64;
+    let xs: Vec<f64> = (0..nx).map(|i| x0 + (i as f64 + 0.5) * side).collect();
+    let ys: Vec<f64> = (0..ny).map(|j| y0 + (j as f64 + 0.5) * side).collect();
+    let z: Vec<Vec<f64>> = (0..ny)
+        .map(|j| (0..nx).map(|i| block(i, j)).collect())
         .collect();
+    let title = if k > 1 {
+        format!("{title} (drawn in blocks of {k} × {k} cells)")
+    } else {
+        title
+    };
     let hm = Heatmap::new(title, "x [m]", "y [m]", xs, ys, z)
         .z_label("height [m]")
         .equal_aspect();

@@ -23,6 +23,9 @@
                                on LATER's mean-height grid of CELLS point
                                spacings, each axis in metres by pyproj (a
                                compound CRS's z in its vertical unit)
+  las_peer.py tiles IN TILE...
+                               every TILE (perceive --tiles) is in IN's CRS
+                               and inside IN's bounds (give or take 5 m)
   las_peer.py volume IN BASE CELLS [CLASS]
                                the volume above z = BASE (m) of IN's mean-height
                                grid, cells CELLS point spacings wide, the points
@@ -217,6 +220,26 @@ def change(later, earlier, cells):
                       "cells_compared": int(d.size)}))
 
 
+def tiles(src, *outs):
+    """Every tile is in SRC's CRS and inside SRC's bounds, give or take the
+    5 m that smoothing may move a point (the survey's own coordinates, not
+    less an origin of hundreds of kilometres)."""
+    a = laspy.read(src)
+    crs = a.header.parse_crs()
+    lo, hi = a.header.mins, a.header.maxs
+    n = 0
+    for t in outs:
+        b = laspy.read(t)
+        if b.header.parse_crs() != crs:
+            fail(f"{t}: CRS {b.header.parse_crs()} is not the survey's {crs}")
+        for k, ax in enumerate("xyz"):
+            v = np.asarray(getattr(b, ax))
+            if v.min() < lo[k] - 5.0 or v.max() > hi[k] + 5.0:
+                fail(f"{t}: {ax} spans {v.min()}..{v.max()}, the survey {lo[k]}..{hi[k]}")
+        n += len(b.points)
+    print(json.dumps({"ok": True, "tiles": len(outs), "points": n}))
+
+
 def copy(src, dst, shuffle=False):
     a = laspy.read(src)
     h = laspy.LasHeader(point_format=a.header.point_format.id, version="1.4")
@@ -234,6 +257,6 @@ def copy(src, dst, shuffle=False):
 
 if __name__ == "__main__":
     modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume, "values": values,
-             "range": ranged, "change": change,
+             "range": ranged, "change": change, "tiles": tiles,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

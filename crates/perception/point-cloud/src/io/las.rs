@@ -626,6 +626,10 @@ pub struct LasHeader {
     /// 34735–34737, WKT 2111–2112), as (record id, bytes), in record-id
     /// order; empty when the file states none.
     pub crs: Vec<(u16, Vec<u8>)>,
+    /// The CRS and the header itself, as a cloud read from the file would
+    /// carry them: what a cloud made from the file's points (a survey's
+    /// cleaned tile) is written back with.
+    pub georef: crate::Georef,
 }
 
 /// Reads the header of the LAS or LAZ stream `src` of `total` bytes (after
@@ -654,6 +658,11 @@ pub(crate) fn header<R: Read + Seek + Send + Sync + 'static>(
         let h = reader.header();
         let t = h.transforms();
         let b = h.bounds();
+        let georef = Georef {
+            crs: las_crs(h),
+            las: Some(LasLayout(h.clone())),
+            viewpoint: None,
+        };
         let mut crs: Vec<(u16, Vec<u8>)> = h
             .all_vlrs()
             .filter(|v| v.user_id == "LASF_Projection")
@@ -668,6 +677,7 @@ pub(crate) fn header<R: Read + Seek + Send + Sync + 'static>(
             min: [b.min.x, b.min.y, b.min.z],
             max: [b.max.x, b.max.y, b.max.z],
             crs,
+            georef,
         })
     })
 }

@@ -291,7 +291,9 @@ pub struct TileOutput {
     pub tile: [usize; 2],
     /// The tile's box in the levelled (x, y) plane: min x, min y, max x, max y (m).
     pub bounds: [f64; 4],
-    /// The cleaned points whose first point lies in the tile (levelled frame), in survey order.
+    /// The cleaned points whose first point lies in the tile (levelled
+    /// frame), in survey order, about the survey's origin and with its
+    /// first file's CRS and header (a survey's files share their CRS).
     pub cloud: PointCloud,
 }
 
@@ -640,7 +642,18 @@ pub fn perceive_tiled_with(
     // Level [RS eq. 11]–[RS eq. 12], from the sample.
     let mut tilt_params = TiltParams::for_scale(scale);
     tilt_params.min_floor_share = p.level.min_floor_share;
-    let sample = PointCloud::new(sample);
+    // The sample with the survey's CRS: a survey in a projected CRS is
+    // level (ground.rs), as `perceive` of one file decides.
+    let sample = PointCloud {
+        points: sample,
+        origin,
+        attributes: Default::default(),
+        georef: survey
+            .headers
+            .first()
+            .map(|h| h.georef.clone())
+            .unwrap_or_default(),
+    };
     // The same level and ground decisions as a single scan (ground.rs).
     let crate::ground::Levelled {
         roll,
@@ -855,7 +868,18 @@ pub fn perceive_tiled_with(
         on_tile(&TileOutput {
             tile: [tile % grid.size[0], tile / grid.size[0]],
             bounds: grid.bounds(tile),
-            cloud: PointCloud::new(recs.iter().map(|r| r.p).collect()),
+            // About the survey's origin, with its first file's CRS and
+            // header: a tile written is in the survey's coordinates.
+            cloud: PointCloud {
+                points: recs.iter().map(|r| r.p).collect(),
+                origin,
+                attributes: Default::default(),
+                georef: survey
+                    .headers
+                    .first()
+                    .map(|h| h.georef.clone())
+                    .unwrap_or_default(),
+            },
         })?;
     }
     progress("writing", grid.tiles() as u64, grid.tiles() as u64);
