@@ -64,6 +64,15 @@ async fn start(
     (server, params)
 }
 
+/// Held by each test on the PLC's real-time clock, so that they run one
+/// at a time: the harness runs a binary's tests in parallel, and two
+/// real-time loops on a 2-core machine delay each other's cycles (a
+/// stale-pose zeroing was seen 1 ms late with the link-cut test beside it).
+fn real_time() -> std::sync::MutexGuard<'static, ()> {
+    static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
+    ONE.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+}
+
 fn rt() -> tokio::runtime::Runtime {
     tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -150,6 +159,7 @@ fn replay_of_the_drive_log_gives_the_drive_metrics() {
 
 #[test]
 fn real_time_drive_stays_within_a_centimetre_of_the_in_process_run() {
+    let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Rtk), 3).unwrap();
     let local = simulate(
         &sc.setup,
@@ -201,6 +211,7 @@ fn quantile(xs: &mut [f64], q: f64) -> f64 {
 
 #[test]
 fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowledged() {
+    let _one_at_a_time = real_time();
     let n = count("LINK_CUTS", 200);
     let setup = long_straight();
     let latencies = rt().block_on(async {
@@ -295,6 +306,7 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
 
 #[test]
 fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
+    let _one_at_a_time = real_time();
     let n = count("STALE_POSES", 50);
     let setup = long_straight();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
@@ -382,6 +394,7 @@ fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
 
 #[test]
 fn a_delay_fault_holds_the_plcs_replies_back_for_its_length() {
+    let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
     rt().block_on(async {
         let (server, params) = start(&sc.setup, Clock::Scaled(1.0), Vec::new()).await;
