@@ -47,7 +47,7 @@ pub struct Args {
     /// Pass-through (PCL PassThrough): AXIS:MIN:MAX keeps MIN ≤ v ≤ MAX; add :outside for the rest; -inf/inf for no limit.
     #[arg(long, value_name = "AXIS:MIN:MAX", allow_hyphen_values = true)]
     pub pass: Vec<String>,
-    /// Keep points by dimension ranges (PDAL filters.range): e.g. Classification[2:2] for a classified survey's ground; ranges of one dimension ORed, of different ones ANDed; X/Y/Z are the file's coordinates.
+    /// Keep points by dimension ranges (PDAL filters.range): e.g. `Classification[2:2]` for a classified survey's ground; ranges of one dimension ORed, of different ones ANDed; X/Y/Z are the file's coordinates.
     #[arg(long, value_name = "LIMITS", allow_hyphen_values = true)]
     pub range: Vec<String>,
     /// Level the sensor frame: ROLL,PITCH (deg).

@@ -70,7 +70,8 @@ async fn start(
 /// stale-pose zeroing was seen 1 ms late with the link-cut test beside it).
 fn real_time() -> std::sync::MutexGuard<'static, ()> {
     static ONE: std::sync::Mutex<()> = std::sync::Mutex::new(());
-    ONE.lock().unwrap_or_else(std::sync::PoisonError::into_inner)
+    ONE.lock()
+        .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
 fn rt() -> tokio::runtime::Runtime {

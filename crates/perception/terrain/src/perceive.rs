@@ -707,8 +707,10 @@ pub struct Perceived {
     pub model: Model,
     /// What the level and ground stages did.
     pub used: GroundUsed,
-    /// What the result does not hold well, with what to do
-    /// ([`surface_warnings`]).
+    /// What the result does not hold well, with what to do: a height
+    /// model whose residual passes [`LAYERED_RESIDUAL_PER_CELL`] cell
+    /// edges (points on several surfaces), with the setting that keeps a
+    /// classified file's ground.
     pub warnings: Vec<String>,
 }
 
