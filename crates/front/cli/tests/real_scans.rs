@@ -296,7 +296,9 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     );
     assert!(v["points"].as_u64().unwrap() > 1000, "{v}");
     // The survey path reads no dimensions: it refuses the range, saying to
-    // select first; done so, the selected file perceives by tiles.
+    // select first; done so, the selected file perceives by tiles (Autzen,
+    // in metres: the survey path does not convert feet).
+    let input = data("autzen-utm.las");
     let args = |f: &Path, c: Option<&Path>| {
         let mut a = vec![
             "perceive".into(),
@@ -318,6 +320,7 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     let ground_only = tmp.path().join("ground-only.las");
     filter(&input, &ground_only, &["--range", "Classification[2:2]"]);
     run(&args(&ground_only, None)).ok();
+    let input = data("4_6_crop.las");
 
     let base_m = 2160.0;
     let with_base = tmp.write(
@@ -473,10 +476,33 @@ fn surveys_perceive_with_no_settings_and_degrees_are_refused() {
         assert!(f64_field(&v, "volume_m3") > 0.0);
     }
     let input = data("epsg_4326.las");
-    let r = run(&["perceive".as_ref(), "--input".as_ref(), input.as_os_str()]).fails();
+    for tiles in [false, true] {
+        let mut args = vec!["perceive".as_ref(), "--input".as_ref(), input.as_os_str()];
+        if tiles {
+            args.push("--tiles".as_ref());
+        }
+        let r = run(&args).fails();
+        let m = r.error_message();
+        assert!(
+            m.contains("epsg_4326.las")
+                && m.contains("EPSG:4326")
+                && m.contains("project it first"),
+            "tiles {tiles}: {m}"
+        );
+    }
+    // The survey path works in metres and does not convert: a feet survey
+    // is refused naming its CRS, and the advice (no --tiles) works above.
+    let feet = data("4_6_crop.las");
+    let r = run(&[
+        "perceive".as_ref(),
+        "--tiles".as_ref(),
+        "--input".as_ref(),
+        feet.as_os_str(),
+    ])
+    .fails();
     let m = r.error_message();
     assert!(
-        m.contains("epsg_4326.las") && m.contains("EPSG:4326") && m.contains("project it first"),
+        m.contains("4_6_crop.las") && m.contains("US survey foot") && m.contains("without --tiles"),
         "{m}"
     );
 }

@@ -571,6 +571,32 @@ pub fn perceive_tiled_with(
             });
         }
     }
+    // Degrees are refused as by `perceive`; a length other than the metre
+    // too, since the survey path does not convert (settings are metres).
+    if let (Some(first), Some(h)) = (survey.files.first(), survey.headers.first()) {
+        let crs = &h.georef.crs;
+        if crs.is_geographic() {
+            return Err(SurfaceError::Survey {
+                path: first.clone(),
+                problem: SurfaceError::Geographic {
+                    crs: crs.to_string(),
+                }
+                .to_string(),
+            });
+        }
+        if [crs.unit, crs.z_unit()]
+            .iter()
+            .any(|u| u.metres().is_some_and(|m| m != 1.0))
+        {
+            return Err(SurfaceError::Survey {
+                path: first.clone(),
+                problem: format!(
+                    "its CRS is {crs}: --tiles works in metres and does not convert; perceive it \
+                     without --tiles (which converts to metres), or reproject it to a metre CRS first"
+                ),
+            });
+        }
+    }
     // The tiles are read as coordinates alone, so no dimension to select
     // on: the range is refused, never ignored.
     if let Some(limits) = &p.range.limits {
