@@ -114,8 +114,8 @@ fn header_layout(
     Ok((Layout { sep, xyz }, columns))
 }
 
-fn parse_field(s: &str, sep: Separator) -> Result<f64, String> {
-    s.parse::<f64>().map_err(|_| {
+fn parse_field<T: std::str::FromStr>(s: &str, sep: Separator) -> Result<T, String> {
+    s.parse::<T>().map_err(|_| {
         if sep == Separator::Semicolon
             && s.contains(',')
             && s.replace(',', ".").parse::<f32>().is_ok()
@@ -217,7 +217,7 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
                             .unwrap_or("");
                         format!(
                             "line {line_no}: {}",
-                            parse_field(bad, sep).err().unwrap_or_default()
+                            parse_field::<f64>(bad, sep).err().unwrap_or_default()
                         )
                     };
                     return Err(input.format_err(what));
@@ -225,7 +225,11 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
             }
         };
         let fields = lay.sep.split(text);
+        // Once the origin is known to be zero, each word is parsed as the
+        // f32 it names, once (the common case, and as fast as before).
+        let about_zero = !out.origin_from_first && out.origin == [0.0; 3];
         let mut p = [0f64; 3];
+        let mut q = [0f32; 3];
         for (a, &col) in lay.xyz.iter().enumerate() {
             let Some(f) = fields.get(col) else {
                 return Err(input.format_err(format!(
@@ -239,19 +243,27 @@ pub(crate) fn read<R: BufRead>(input: &mut Input<'_, R>, out: &mut Points) -> cr
                     full.trim()
                 )));
             };
-            p[a] = parse_field(f, lay.sep)
-                .map_err(|e| input.format_err(format!("line {line_no}: {e}")))?;
+            let bad = |e: String| input.format_err(format!("line {line_no}: {e}"));
+            if about_zero {
+                q[a] = parse_field(f, lay.sep).map_err(bad)?;
+            } else {
+                p[a] = parse_field(f, lay.sep).map_err(bad)?;
+            }
         }
-        // The f32 each word names, not f64 rounded again.
-        let word = |a: usize| fields[lay.xyz[a]].parse::<f32>().unwrap_or(f32::NAN);
-        if out.origin_from_first && p.iter().all(|v| v.is_finite()) {
-            out.origin = [0, 1, 2].map(|a| origin_for(p[a], word(a)));
-            out.origin_from_first = false;
-        }
-        let kept = if out.origin == [0.0; 3] {
-            out.push([word(0), word(1), word(2)])
+        let kept = if about_zero {
+            out.push(q)
         } else {
-            out.push_f64(p[0], p[1], p[2])
+            // The f32 each word names, not f64 rounded again.
+            let word = |a: usize| fields[lay.xyz[a]].parse::<f32>().unwrap_or(f32::NAN);
+            if out.origin_from_first && p.iter().all(|v| v.is_finite()) {
+                out.origin = [0, 1, 2].map(|a| origin_for(p[a], word(a)));
+                out.origin_from_first = false;
+            }
+            if out.origin == [0.0; 3] {
+                out.push([word(0), word(1), word(2)])
+            } else {
+                out.push_f64(p[0], p[1], p[2])
+            }
         };
         if kept {
             for (field, _, rows) in &mut columns {
