@@ -65,6 +65,17 @@ fn peer(py: &str, args: &[&Path], mode: &str) -> serde_json::Value {
     v
 }
 
+/// `autoshovel perceive --input INPUT [--config CONFIG] --json`, which
+/// must succeed: its summary.
+fn perceive_json(input: &Path, config: Option<&Path>) -> serde_json::Value {
+    let mut a = vec!["perceive".as_ref(), "--input".as_ref(), input.as_os_str()];
+    if let Some(c) = config {
+        a.extend(["--config".as_ref(), c.as_os_str()]);
+    }
+    a.push("--json".as_ref());
+    run(&a).ok().json()
+}
+
 fn filter(input: &Path, output: &Path, stages: &[&str]) {
     let mut a: Vec<String> = vec![
         "filter".into(),
@@ -159,16 +170,7 @@ fn the_same_scan_levels_the_same_from_las_laz_copc_and_shuffled() {
     );
     let mut angles = Vec::new();
     for input in [copc, plain, laz, shuffled] {
-        let r = run(&[
-            "perceive".as_ref(),
-            "--input".as_ref(),
-            input.as_os_str(),
-            "--config".as_ref(),
-            config.as_os_str(),
-            "--json".as_ref(),
-        ])
-        .ok();
-        let v = r.json();
+        let v = perceive_json(&input, Some(&config));
         angles.push((f64_field(&v, "roll_deg"), f64_field(&v, "pitch_deg")));
     }
     for (i, a) in angles.iter().enumerate() {
@@ -206,16 +208,7 @@ fn volume_above_a_given_base_agrees_with_laspy_and_numpy_in_metres() {
             ),
         );
         let input = data(file);
-        let v = run(&[
-            "perceive".as_ref(),
-            "--input".as_ref(),
-            input.as_os_str(),
-            "--config".as_ref(),
-            config.as_os_str(),
-            "--json".as_ref(),
-        ])
-        .ok()
-        .json();
+        let v = perceive_json(&input, Some(&config));
         assert_eq!(v["ground_mode"], "height", "{file}");
         let ours = f64_field(&v, "volume_m3");
         let base = f64_field(&v, "volume_base_m");
@@ -249,14 +242,7 @@ fn a_classified_slope_says_how_to_keep_its_ground_and_that_advice_works() {
     let Some(py) = python() else { return };
     let tmp = TempDir::new("real-classified");
     let input = data("4_6_crop.las");
-    let perceive = |config: Option<&Path>| {
-        let mut a = vec!["perceive".as_ref(), "--input".as_ref(), input.as_os_str()];
-        if let Some(c) = config {
-            a.extend(["--config".as_ref(), c.as_os_str()]);
-        }
-        a.push("--json".as_ref());
-        run(&a).ok().json()
-    };
+    let perceive = |config: Option<&Path>| perceive_json(&input, config);
     let rms = |v: &serde_json::Value| v["height_model"]["rms_residual_m"].as_f64().unwrap();
     let plain = perceive(None);
     assert!(
@@ -370,16 +356,7 @@ fn the_change_between_two_surveys_agrees_with_laspy_and_numpy() {
             earlier.display().to_string()
         ),
     );
-    let v = run(&[
-        "perceive".as_ref(),
-        "--input".as_ref(),
-        later.as_os_str(),
-        "--config".as_ref(),
-        config.as_os_str(),
-        "--json".as_ref(),
-    ])
-    .ok()
-    .json();
+    let v = perceive_json(&later, Some(&config));
     assert_eq!(v["ground_mode"], "surface");
     assert_eq!(v["level_mode"], "none", "a survey is level");
     let ours = &v["change"];
@@ -459,14 +436,7 @@ fn survey_tiles_keep_the_surveys_coordinates_and_crs() {
 fn surveys_perceive_with_no_settings_and_degrees_are_refused() {
     for file in ["autzen-utm.las", "4_6_crop.las", "mvk-thin.las"] {
         let input = data(file);
-        let v = run(&[
-            "perceive".as_ref(),
-            "--input".as_ref(),
-            input.as_os_str(),
-            "--json".as_ref(),
-        ])
-        .ok()
-        .json();
+        let v = perceive_json(&input, None);
         assert_eq!(v["level_mode"], "none", "{file}: a survey is level");
         assert!(
             v["ground_note"].as_str().unwrap_or("").contains("survey"),

@@ -263,55 +263,16 @@ impl Viewpoint {
     /// (rows) about `about` (the cloud's origin): the position turned, and
     /// the orientation `r · q`.
     pub fn turned(&self, r: [[f64; 3]; 3], about: [f64; 3]) -> Self {
-        let p: [f64; 3] = std::array::from_fn(|a| self.position[a] - about[a]);
-        let position =
-            std::array::from_fn(|i| about[i] + (0..3).map(|k| r[i][k] * p[k]).sum::<f64>());
-        // The rotation matrix as a quaternion (Shepperd's method, on the
-        // largest of the four diagonal sums for stability).
-        let t = r[0][0] + r[1][1] + r[2][2];
-        let rq = if t > 0.0 {
-            let s = (t + 1.0).sqrt() * 2.0;
-            [
-                s / 4.0,
-                (r[2][1] - r[1][2]) / s,
-                (r[0][2] - r[2][0]) / s,
-                (r[1][0] - r[0][1]) / s,
-            ]
-        } else if r[0][0] > r[1][1] && r[0][0] > r[2][2] {
-            let s = (1.0 + r[0][0] - r[1][1] - r[2][2]).sqrt() * 2.0;
-            [
-                (r[2][1] - r[1][2]) / s,
-                s / 4.0,
-                (r[0][1] + r[1][0]) / s,
-                (r[0][2] + r[2][0]) / s,
-            ]
-        } else if r[1][1] > r[2][2] {
-            let s = (1.0 + r[1][1] - r[0][0] - r[2][2]).sqrt() * 2.0;
-            [
-                (r[0][2] - r[2][0]) / s,
-                (r[0][1] + r[1][0]) / s,
-                s / 4.0,
-                (r[1][2] + r[2][1]) / s,
-            ]
-        } else {
-            let s = (1.0 + r[2][2] - r[0][0] - r[1][1]).sqrt() * 2.0;
-            [
-                (r[1][0] - r[0][1]) / s,
-                (r[0][2] + r[2][0]) / s,
-                (r[1][2] + r[2][1]) / s,
-                s / 4.0,
-            ]
-        };
-        let [aw, ax, ay, az] = rq;
-        let [bw, bx, by, bz] = self.orientation;
+        use nalgebra::{Matrix3, Quaternion, Rotation3, UnitQuaternion, Vector3};
+        let m = Matrix3::from_fn(|i, k| r[i][k]);
+        let o = Vector3::from(about);
+        let p = m * (Vector3::from(self.position) - o) + o;
+        let turn = UnitQuaternion::from_rotation_matrix(&Rotation3::from_matrix_unchecked(m));
+        let [w, x, y, z] = self.orientation;
+        let q = turn.quaternion() * Quaternion::new(w, x, y, z);
         Viewpoint {
-            position,
-            orientation: [
-                aw * bw - ax * bx - ay * by - az * bz,
-                aw * bx + ax * bw + ay * bz - az * by,
-                aw * by - ax * bz + ay * bw + az * bx,
-                aw * bz + ax * by - ay * bx + az * bw,
-            ],
+            position: [p.x, p.y, p.z],
+            orientation: [q.w, q.i, q.j, q.k],
         }
     }
 }

@@ -256,6 +256,21 @@ impl Survey {
         })
     }
 
+    /// `points` (about `origin`) as a cloud of this survey: its first
+    /// file's CRS and header, no attributes.
+    pub fn cloud(&self, points: Vec<Point>, origin: [f64; 3]) -> PointCloud {
+        PointCloud {
+            points,
+            origin,
+            attributes: Default::default(),
+            georef: self
+                .headers
+                .first()
+                .map(|h| h.georef.clone())
+                .unwrap_or_default(),
+        }
+    }
+
     /// Points the headers claim.
     pub fn header_points(&self) -> u64 {
         self.headers.iter().map(|h| h.points).sum()
@@ -670,16 +685,7 @@ pub fn perceive_tiled_with(
     tilt_params.min_floor_share = p.level.min_floor_share;
     // The sample with the survey's CRS: a survey in a projected CRS is
     // level (ground.rs), as `perceive` of one file decides.
-    let sample = PointCloud {
-        points: sample,
-        origin,
-        attributes: Default::default(),
-        georef: survey
-            .headers
-            .first()
-            .map(|h| h.georef.clone())
-            .unwrap_or_default(),
-    };
+    let sample = survey.cloud(sample, origin);
     // The same level and ground decisions as a single scan (ground.rs).
     let crate::ground::Levelled {
         roll,
@@ -896,16 +902,7 @@ pub fn perceive_tiled_with(
             bounds: grid.bounds(tile),
             // About the survey's origin, with its first file's CRS and
             // header: a tile written is in the survey's coordinates.
-            cloud: PointCloud {
-                points: recs.iter().map(|r| r.p).collect(),
-                origin,
-                attributes: Default::default(),
-                georef: survey
-                    .headers
-                    .first()
-                    .map(|h| h.georef.clone())
-                    .unwrap_or_default(),
-            },
+            cloud: survey.cloud(recs.iter().map(|r| r.p).collect(), origin),
         })?;
     }
     progress("writing", grid.tiles() as u64, grid.tiles() as u64);
