@@ -334,7 +334,12 @@ pub(crate) fn write<W: Write>(
             words.clear();
             c.values.text_at(i, &mut words);
             line.push(sep);
-            line.extend_from_slice(words.replace(' ', &s.to_string()).as_bytes());
+            if matches!(c.values, crate::Values::Bytes { .. }) {
+                // One field a byte: the row's bytes by the separator.
+                line.extend_from_slice(words.replace(' ', &s.to_string()).as_bytes());
+            } else {
+                line.extend_from_slice(words.as_bytes());
+            }
         }
         line.push(b'\n');
         w.write_all(&line)?;
