@@ -557,35 +557,11 @@ pub fn perceive_tiled(
     perceive_tiled_with(survey, params, options, &mut InProcess, progress, on_tile)
 }
 
-/// [`perceive_tiled`] with each stage's tiles run by `executor` (module
-/// docs): the survey is read, and the cleaned tiles handed on, here; the
-/// stages' tasks run wherever `executor` sends them, which must see
-/// [`TileOptions::work_dir`]. The result is the same whichever runs them.
-pub fn perceive_tiled_with(
-    survey: &Survey,
-    params: &PerceptionParams,
-    options: &TileOptions,
-    executor: &mut dyn TileExecutor,
-    progress: &mut dyn FnMut(&str, u64, u64),
-    on_tile: &mut dyn FnMut(&TileOutput) -> Result<()>,
-) -> Result<TiledPerceived> {
-    let p = params;
-    if !(options.model_cell_m.is_finite() && options.model_cell_m > 0.0) {
-        return Err(SurfaceError::BadParameter {
-            name: "model cell",
-            value: options.model_cell_m,
-            expected: "a finite length > 0 [m]",
-        });
-    }
-    if let Some(t) = options.tile_m {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(SurfaceError::BadParameter {
-                name: "tile size",
-                value: t,
-                expected: "a finite length > 0 [m]",
-            });
-        }
-    }
+/// Refuses, before any work, what the survey path cannot do rightly: a
+/// survey in degrees (as `perceive` does), one in another length than the
+/// metre (the path does not convert; settings are metres), and `[range]`
+/// (the tiles are read as coordinates alone).
+fn refuse_what_tiles_cannot_do(survey: &Survey, p: &PerceptionParams) -> Result<()> {
     // Degrees are refused as by `perceive`; a length other than the metre
     // too, since the survey path does not convert (settings are metres).
     if let (Some(first), Some(h)) = (survey.files.first(), survey.headers.first()) {
@@ -622,6 +598,39 @@ pub fn perceive_tiled_with(
                       for each file, or perceive without --tiles",
         });
     }
+    Ok(())
+}
+
+/// [`perceive_tiled`] with each stage's tiles run by `executor` (module
+/// docs): the survey is read, and the cleaned tiles handed on, here; the
+/// stages' tasks run wherever `executor` sends them, which must see
+/// [`TileOptions::work_dir`]. The result is the same whichever runs them.
+pub fn perceive_tiled_with(
+    survey: &Survey,
+    params: &PerceptionParams,
+    options: &TileOptions,
+    executor: &mut dyn TileExecutor,
+    progress: &mut dyn FnMut(&str, u64, u64),
+    on_tile: &mut dyn FnMut(&TileOutput) -> Result<()>,
+) -> Result<TiledPerceived> {
+    let p = params;
+    if !(options.model_cell_m.is_finite() && options.model_cell_m > 0.0) {
+        return Err(SurfaceError::BadParameter {
+            name: "model cell",
+            value: options.model_cell_m,
+            expected: "a finite length > 0 [m]",
+        });
+    }
+    if let Some(t) = options.tile_m {
+        if !(t.is_finite() && t > 0.0) {
+            return Err(SurfaceError::BadParameter {
+                name: "tile size",
+                value: t,
+                expected: "a finite length > 0 [m]",
+            });
+        }
+    }
+    refuse_what_tiles_cannot_do(survey, p)?;
     let mut stages = Vec::new();
     // Pass 1: bounds, count, sample.
     let t0 = Instant::now();
