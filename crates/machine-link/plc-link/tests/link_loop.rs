@@ -4,7 +4,11 @@
 //! stopped until acknowledged; a frozen or dropped RTK zeroes the
 //! setpoints once the pose is older than 300 ms.
 //!
-//! `LINK_CUTS` and `STALE_POSES` set how many (default 200 and 50).
+//! `LINK_CUTS` and `STALE_POSES` set how many (default 40 and 16, in
+//! `cargo test`'s time: the tests run on the wall clock, one at a time;
+//! docs/machine-link.md gives longer runs' figures, `LINK_CUTS=200
+//! STALE_POSES=50` and more). Issue 47 moves these timing claims onto the
+//! PLC's own clock.
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -213,7 +217,7 @@ fn quantile(xs: &mut [f64], q: f64) -> f64 {
 #[test]
 fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowledged() {
     let _one_at_a_time = real_time();
-    let n = count("LINK_CUTS", 200);
+    let n = count("LINK_CUTS", 40);
     let setup = long_straight();
     let latencies = rt().block_on(async {
         let (server, params) = start(&setup, Clock::Scaled(1.0), Vec::new()).await;
@@ -308,7 +312,7 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
 #[test]
 fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
     let _one_at_a_time = real_time();
-    let n = count("STALE_POSES", 50);
+    let n = count("STALE_POSES", 16);
     let setup = long_straight();
     let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(99);
     // Alternate freezes and dropouts, each 0.6 s, 2–3 s of machine time apart.
