@@ -184,6 +184,31 @@ impl Shape {
     }
 }
 
+/// How much nearer than the footprint a segment's bounding box must come
+/// before [`Map::is_clear`] computes the segment's distance (m): far above
+/// the rounding of a distance on a site of kilometres, so a skipped segment
+/// is one whose computed distance would also have cleared the footprint.
+pub const CLEAR_MARGIN_M: f64 = 1e-6;
+
+/// Squared distance from `p` to the bounding box of the segment `a`–`b`:
+/// never more than the distance to the segment, and no division.
+fn box_distance2(p: Vec2, a: Vec2, b: Vec2) -> f64 {
+    let dx = (a.x.min(b.x) - p.x).max(p.x - a.x.max(b.x)).max(0.0);
+    let dy = (a.y.min(b.y) - p.y).max(p.y - a.y.max(b.y)).max(0.0);
+    dx * dx + dy * dy
+}
+
+/// Whether `p` is outside a counter-clockwise convex polygon, by the same
+/// test as [`Shape::nearest`] (some edge has `p` on its right).
+fn outside_convex(vertices: &[Vec2], p: Vec2) -> bool {
+    let n = vertices.len();
+    (0..n).any(|i| {
+        let (a, b) = (vertices[i], vertices[(i + 1) % n]);
+        let (e, ap) = (b - a, p - a);
+        e.x * ap.y - e.y * ap.x < 0.0
+    })
+}
+
 fn bounds_of(points: &[Vec2]) -> (Vec2, Vec2) {
     let mut lo = Vec2::repeat(f64::INFINITY);
     let mut hi = Vec2::repeat(f64::NEG_INFINITY);
@@ -325,6 +350,65 @@ impl Map {
         best
     }
 
+    /// Whether a disc footprint of radius `footprint_radius_m` centred at `p`
+    /// is clear of every element: exactly `self.clearance(p, r) > 0.0`, with
+    /// the same arithmetic for every distance it computes, but it stops at
+    /// the first element in reach and skips the segments whose bounding box
+    /// lies farther than the footprint (plus [`CLEAR_MARGIN_M`]). The
+    /// reference planner asks this of every cell of its grid, where the
+    /// distance to every road boundary's segment was most of a study's time.
+    pub fn is_clear(&self, p: Vec2, footprint_radius_m: f64) -> bool {
+        let r = footprint_radius_m;
+        if r.is_nan() {
+            return false;
+        }
+        // `min(d) - r > 0` holds exactly when no `d - r <= 0` (subtraction
+        // is monotonic; a NaN distance is never the nearest).
+        let reaches = |d: f64| d - r <= 0.0;
+        let reach = r + CLEAR_MARGIN_M;
+        let far = |a: Vec2, b: Vec2| reach > 0.0 && box_distance2(p, a, b) > reach * reach;
+        for o in &self.obstacles {
+            let d = match &o.shape {
+                Shape::Polygon { vertices } if outside_convex(vertices, p) => {
+                    let n = vertices.len();
+                    let best2 = (0..n)
+                        .map(|i| (vertices[i], vertices[(i + 1) % n]))
+                        .filter(|(a, b)| !far(*a, *b))
+                        .map(|(a, b)| (p - segment_nearest(p, a, b).0).norm_squared())
+                        .fold(f64::INFINITY, f64::min);
+                    let best = best2.sqrt();
+                    if best > 1e-12 {
+                        best
+                    } else {
+                        0.0
+                    }
+                }
+                shape => shape.nearest(p).0,
+            };
+            if reaches(d) {
+                return false;
+            }
+        }
+        for b in &self.boundaries {
+            let best2 = b
+                .points
+                .windows(2)
+                .filter(|w| !far(w[0], w[1]))
+                .map(|w| (p - segment_nearest(p, w[0], w[1]).0).norm_squared())
+                .fold(f64::INFINITY, f64::min);
+            if reaches(best2.sqrt()) {
+                return false;
+            }
+        }
+        let sides = [
+            p.x - self.min.x,
+            self.max.x - p.x,
+            p.y - self.min.y,
+            self.max.y - p.y,
+        ];
+        !sides.into_iter().any(reaches)
+    }
+
     /// Clearance of a disc footprint of radius `footprint_radius_m` centred at
     /// `p`: distance from the disc to the nearest element (m), negative on
     /// contact or overlap.
@@ -409,6 +493,40 @@ mod tests {
         let (d, n) = c.nearest(Vec2::new(1.0, 3.0));
         assert_relative_eq!(d, 1.5);
         assert_relative_eq!(n, Vec2::new(0.0, 1.0));
+    }
+
+    proptest! {
+        /// `is_clear` skips work, never changes the answer: it is
+        /// `clearance > 0` for circles, polygons (from inside and out),
+        /// road boundaries, the site edge, and footprints down to zero.
+        #[test]
+        fn is_clear_is_clearance_above_zero(
+            cx in 1.0..19.0f64, cy in 1.0..19.0f64, cr in 0.1..3.0f64,
+            sx in 2.0..18.0f64, sy in 2.0..18.0f64, half in 0.2..2.0f64,
+            road in proptest::collection::vec((0.0..20.0f64, 0.0..20.0f64), 1..12),
+            px in -1.0..21.0f64, py in -1.0..21.0f64, r in 0.0..4.0f64,
+        ) {
+            let mut m = Map::new(Vec2::new(0.0, 0.0), Vec2::new(20.0, 20.0));
+            m.obstacles.push(Obstacle {
+                name: "disc".into(),
+                shape: Shape::Circle { center: Vec2::new(cx, cy), radius: cr },
+            });
+            let square = [(-1.0, -1.0), (1.0, -1.0), (1.0, 1.0), (-1.0, 1.0)]
+                .map(|(dx, dy)| Vec2::new(sx + dx * half, sy + dy * half * 0.7));
+            m.obstacles.push(Obstacle {
+                name: "block".into(),
+                shape: Shape::Polygon { vertices: square.to_vec() },
+            });
+            m.boundaries.push(Boundary {
+                name: "road".into(),
+                points: road.into_iter().map(|(x, y)| Vec2::new(x, y)).collect(),
+            });
+            let p = Vec2::new(px, py);
+            prop_assert_eq!(m.is_clear(p, r), m.clearance(p, r) > 0.0);
+            // On an element's edge: the footprint's own radius decides.
+            let q = Vec2::new(cx + cr + r, cy);
+            prop_assert_eq!(m.is_clear(q, r), m.clearance(q, r) > 0.0);
+        }
     }
 
     #[test]
