@@ -132,6 +132,9 @@ pub fn run(args: &Args) -> Result<()> {
             if let Some(note) = &s.fit_note {
                 crate::say!("  {note}");
             }
+            for w in &s.warnings {
+                eprintln!("warning: {w}");
+            }
         });
     }
     if input.is_dir() {

@@ -398,31 +398,59 @@ fn the_change_between_two_surveys_agrees_with_laspy_and_numpy() {
 }
 
 /// The survey path's cleaned tiles are in the survey's own coordinates and
-/// CRS: before, they were written less the survey's kilometre origin and
-/// with no CRS (Autzen's eastings of 494 km came out as 428 m).
+/// CRS, with its points' attributes: before, they were written less the
+/// survey's kilometre origin and with no CRS (Autzen's eastings of 494 km
+/// came out as 428 m), and then with every attribute field zero.
 #[test]
-fn survey_tiles_keep_the_surveys_coordinates_and_crs() {
+fn survey_tiles_keep_the_surveys_coordinates_crs_and_attributes() {
     let Some(py) = python() else { return };
     let tmp = TempDir::new("real-tiles");
     let input = data("autzen-utm.las");
     let out = tmp.path().join("out");
-    run(&[
-        "perceive".as_ref(),
-        "--tiles".as_ref(),
-        "--tile-size".as_ref(),
-        "300".as_ref(),
-        "--input".as_ref(),
-        input.as_os_str(),
-        "--out".as_ref(),
-        out.as_os_str(),
-    ])
-    .ok();
-    let mut tiles: Vec<PathBuf> = std::fs::read_dir(out.join("tiles"))
-        .unwrap()
-        .map(|e| e.unwrap().path())
-        .collect();
-    tiles.sort();
-    assert!(tiles.len() > 1, "{tiles:?}");
+    let survey = |out: &Path, config: Option<&Path>| {
+        let mut a = vec![
+            "perceive".as_ref(),
+            "--tiles".as_ref(),
+            "--tile-size".as_ref(),
+            "300".as_ref(),
+            "--input".as_ref(),
+            input.as_os_str(),
+            "--out".as_ref(),
+            out.as_os_str(),
+        ];
+        if let Some(c) = config {
+            a.extend(["--config".as_ref(), c.as_os_str()]);
+        }
+        let r = run(&a).ok();
+        let summary: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(out.join("summary.json")).unwrap())
+                .unwrap();
+        assert_eq!(summary["warnings"], serde_json::json!([]), "{summary}");
+        assert!(!r.stderr.contains("warning"), "{}", r.stderr);
+        let mut tiles: Vec<PathBuf> = std::fs::read_dir(out.join("tiles"))
+            .unwrap()
+            .map(|e| e.unwrap().path())
+            .collect();
+        tiles.sort();
+        assert!(tiles.len() > 1, "{tiles:?}");
+        tiles
+    };
+    // With filters that keep points as they are (the statistical and
+    // radius filters), every tile point is a survey point with all its
+    // attributes, as laspy reads both.
+    let config = tmp.path().join("keep.toml");
+    std::fs::write(
+        &config,
+        "[voxel]\nenabled = false\n[smooth]\nenabled = false\n",
+    )
+    .unwrap();
+    let kept = survey(&tmp.path().join("kept"), Some(&config));
+    let mut args: Vec<&Path> = vec![&input];
+    args.extend(kept.iter().map(PathBuf::as_path));
+    let v = peer(&py, &args, "tile-attributes");
+    assert!(v["points"].as_u64().unwrap() > 500, "{v}");
+    assert!(v["dimensions"].to_string().contains("gps_time"), "{v}");
+    let tiles = survey(&out, None);
     let mut args: Vec<&Path> = vec![&input];
     args.extend(tiles.iter().map(PathBuf::as_path));
     let v = peer(&py, &args, "tiles");

@@ -130,6 +130,8 @@ pub fn perceive_tiles(
     if let Some(s) = &staging {
         options.work_dir = s.path().to_path_buf();
     }
+    // The survey's records are kept only for tiles that are written.
+    options.attributes &= tiles_dir.is_some();
     if let Some(d) = &tiles_dir {
         std::fs::create_dir_all(d).map_err(|e| JobError::io(d, e))?;
     }

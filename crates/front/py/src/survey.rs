@@ -164,6 +164,8 @@ fn perceive_survey<'py>(
         sample_points,
         model_cell_m,
         work_dir: work_dir.unwrap_or(defaults.work_dir),
+        // The records are kept only for tiles that are written.
+        attributes: tiles_dir.is_some(),
     };
     let survey = Survey::open(&inputs).map_err(lib_err)?;
     let mut staged = tiles_dir.map(Staged::new).transpose()?;

@@ -211,6 +211,40 @@ impl LasLayout {
         let t = self.0.transforms();
         [t.x.offset, t.y.offset, t.z.offset]
     }
+
+    /// Bytes of one point record ([`crate::io::read_chunks_with`]'s rows).
+    pub fn record_len(&self) -> usize {
+        usize::from(self.0.point_format().len())
+    }
+
+    /// Whether points of `other` have the same fields as this layout's:
+    /// the same point format and extra bytes (rows of one decode as the
+    /// other's).
+    pub fn same_fields(&self, other: &LasLayout) -> bool {
+        self.0.point_format() == other.0.point_format()
+    }
+
+    /// The attributes of `rows`, point records as this layout lays them
+    /// out (as [`crate::io::read_chunks_with`] hands them on), as the
+    /// columns a cloud read from the file carries.
+    pub fn attributes_of_rows(&self, rows: &[u8]) -> Result<crate::Attributes, String> {
+        let format = *self.0.point_format();
+        let transforms = *self.0.transforms();
+        let len = self.record_len();
+        if len == 0 || rows.len() % len != 0 {
+            return Err(format!(
+                "{} bytes are not whole records of {len} bytes (point format {})",
+                rows.len(),
+                self.point_format()
+            ));
+        }
+        let mut cols = crate::io::las_columns::LasColumns::for_format(&format);
+        for r in rows.chunks_exact(len) {
+            let raw = las::raw::Point::read_from(r, &format).map_err(|e| e.to_string())?;
+            cols.push(&las::Point::new(raw, &transforms));
+        }
+        Ok(cols.into_attributes())
+    }
 }
 
 /// What a file said of its coordinates.

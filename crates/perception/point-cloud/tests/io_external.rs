@@ -200,3 +200,58 @@ fn old_pcd_headers_and_crlf_ply_headers() {
     let r = read_from_bytes(Format::Ply, &ply).unwrap();
     assert_eq!(r.cloud.points, vec![[1.0, 2.0, 3.0]]);
 }
+
+/// A stream's LAS rows decode to the attributes a whole read gives, row for
+/// row, in every point format here (1 and 3 from PDAL and laspy, 6 and 7
+/// with GPS time and colour, extra bytes, LAZ and COPC): the survey path
+/// carries a tile's attributes this way.
+#[test]
+fn streamed_las_rows_are_the_attributes_of_a_whole_read() {
+    use autoshovel_point_cloud::io::read_chunks_with;
+    for name in [
+        "autzen-utm.las",
+        "extrabytes.las",
+        "laspy_1_2_format1.las",
+        "laspy_1_2_format3.laz",
+        "laspy_1_4_format6.las",
+        "laspy_1_4_format7.laz",
+        "pdal_1.2-with-color.copc.laz",
+    ] {
+        let whole = load(name);
+        let layout = whole.cloud.georef.las.clone().expect("a LAS layout");
+        let (mut points, mut rows, mut calls) = (Vec::new(), Vec::new(), 0);
+        read_chunks_with(
+            &data(name),
+            whole.cloud.origin,
+            3,
+            true,
+            &mut |_, _| {},
+            &mut |p, r| {
+                assert_eq!(r.len(), p.len() * layout.record_len(), "{name}");
+                points.extend_from_slice(p);
+                rows.extend_from_slice(r);
+                calls += 1;
+                Ok(())
+            },
+        )
+        .unwrap_or_else(|e| panic!("{name}: {e}"));
+        assert_eq!(calls, points.len().div_ceil(3), "{name}: in chunks of 3");
+        assert_eq!(bits(&points), bits(&whole.cloud.points), "{name}");
+        let got = layout.attributes_of_rows(&rows).unwrap();
+        assert!(!got.is_empty(), "{name}");
+        assert_eq!(got, whole.cloud.attributes, "{name}");
+        // Without rows, none.
+        read_chunks_with(
+            &data(name),
+            whole.cloud.origin,
+            1 << 20,
+            false,
+            &mut |_, _| {},
+            &mut |_, r| {
+                assert!(r.is_empty());
+                Ok(())
+            },
+        )
+        .unwrap();
+    }
+}

@@ -240,6 +240,35 @@ def tiles(src, *outs):
     print(json.dumps({"ok": True, "tiles": len(outs), "points": n}))
 
 
+def tile_attributes(src, *outs):
+    """Every point of every tile is a point of SRC, attributes and all: its
+    coordinates on SRC's grid (X, Y, Z) and every other dimension of SRC's
+    point format equal one of SRC's points at those coordinates (a filter
+    that keeps points moves none; duplicates may differ in attributes)."""
+    a = laspy.read(src)
+    dims = [d for d in a.point_format.dimension_names if d not in ("X", "Y", "Z")]
+    scales, offsets = a.header.scales, a.header.offsets
+
+    def rows(las):
+        ints = [np.rint((np.asarray(getattr(las, ax)) - offsets[k]) / scales[k]).astype(np.int64)
+                for k, ax in enumerate("xyz")]
+        cols = [np.asarray(las[d]) for d in dims]
+        return [tuple(int(v[i]) for v in ints) + tuple(c[i].tolist() for c in cols) for i in range(len(las.points))]
+
+    have = set(rows(a))
+    n = 0
+    for t in outs:
+        b = laspy.read(t)
+        if b.header.point_format.id != a.header.point_format.id:
+            fail(f"{t}: point format {b.header.point_format.id}, the survey's {a.header.point_format.id}")
+        got = rows(b)
+        missing = [r for r in got if r not in have]
+        if missing:
+            fail(f"{t}: {len(missing)} of {len(got)} points are no survey point with these attributes, e.g. {missing[0]} ({dims})")
+        n += len(got)
+    print(json.dumps({"ok": True, "tiles": len(outs), "points": n, "dimensions": dims}))
+
+
 def copy(src, dst, shuffle=False):
     a = laspy.read(src)
     h = laspy.LasHeader(point_format=a.header.point_format.id, version="1.4")
@@ -258,5 +287,6 @@ def copy(src, dst, shuffle=False):
 if __name__ == "__main__":
     modes = {"wide": wide, "same": same, "subset": subset, "copy": copy, "volume": volume, "values": values,
              "range": ranged, "change": change, "tiles": tiles,
+             "tile-attributes": tile_attributes,
              "shuffle": lambda i, o: copy(i, o, shuffle=True)}
     modes[sys.argv[1]](*sys.argv[2:])

@@ -108,6 +108,7 @@ class SurveyPerception(Summary):
     tiles_used: int
     timings_ms: Summary
     total_ms: float
+    warnings: list[str]
     height_model: npt.NDArray[np.float64]
     model_origin: tuple[float, float]
     tile_files: list[str]

@@ -230,14 +230,18 @@ pub(crate) struct Points<'s> {
     pub(crate) attributes: crate::Attributes,
     /// A PCD file's sensor pose, where not the identity.
     pub(crate) viewpoint: Option<crate::Viewpoint>,
+    /// When streaming with rows: each kept point's LAS record, as the
+    /// file's point format lays it out (those not yet handed on).
+    pub(crate) rows: Option<Vec<u8>>,
 }
 
 /// Coordinates within this distance of zero are held about a zero origin
 /// when a file's header gives no bounds (f32 resolves 0.24 mm there).
 pub(crate) const ORIGIN_FREE: f64 = 4096.0;
 
-/// The receiver of a stream's chunks.
-pub(crate) type Sink<'s> = &'s mut dyn FnMut(&[Point]) -> crate::Result<()>;
+/// The receiver of a stream's chunks: the points, and their rows when
+/// asked for ([`Points::rows`]; empty otherwise).
+pub(crate) type Sink<'s> = &'s mut dyn FnMut(&[Point], &[u8]) -> crate::Result<()>;
 
 impl<'s> Points<'s> {
     /// Points that go to `sink` in chunks of `chunk`, not kept.
@@ -253,9 +257,12 @@ impl<'s> Points<'s> {
     pub(crate) fn hand_on(&mut self, all: bool) -> crate::Result<()> {
         if let Some((chunk, sink)) = &mut self.sink {
             if self.points.len() >= *chunk || (all && !self.points.is_empty()) {
-                sink(&self.points)?;
+                sink(&self.points, self.rows.as_deref().unwrap_or_default())?;
                 self.streamed += self.points.len() as u64;
                 self.points.clear();
+                if let Some(rows) = &mut self.rows {
+                    rows.clear();
+                }
             }
         }
         Ok(())

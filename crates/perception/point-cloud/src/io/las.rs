@@ -571,6 +571,7 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             out.origin = origin_of(&header);
             LasColumns::for_format(header.point_format())
         });
+        let (format, transforms) = (*header.point_format(), *header.transforms());
         let mut i = 0u64;
         while let Some(p) = reader
             .read_point()
@@ -579,6 +580,11 @@ pub(crate) fn read<R: Read + Seek + Send + Sync + 'static>(
             if out.push_f64(p.x, p.y, p.z) {
                 if let Some(cols) = &mut columns {
                     cols.push(&p);
+                }
+                if let Some(rows) = &mut out.rows {
+                    p.into_raw(&transforms)
+                        .and_then(|raw| raw.write_to(rows, &format))
+                        .map_err(|e| las_err(path, e, Some(i), &c, total))?;
                 }
             }
             out.hand_on(false)?;

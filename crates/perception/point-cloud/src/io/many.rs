@@ -8,12 +8,13 @@ use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
 use std::sync::{Condvar, Mutex};
 
-use super::read::{read_chunks, StreamReport};
+use super::read::{read_chunks_with, StreamReport};
 use crate::{CloudError, Point};
 
 /// What a decoding thread hands over for one file.
 enum Piece {
-    Chunk(Vec<Point>),
+    /// Points, and their rows when asked for.
+    Chunk(Vec<Point>, Vec<u8>),
     Done(crate::Result<StreamReport>),
 }
 
@@ -26,8 +27,9 @@ struct Shared {
 
 /// Reads `paths` as one stream: `on_chunk(file, points)` gets every file's
 /// finite points in file order, files in the given order, at most `chunk`
-/// at a time, less `origin`, exactly as [`read_chunks`] file after file
-/// would give them.
+/// at a time, less `origin`, exactly as [`read_chunks_with`] file after
+/// file would give them (with their LAS rows when `rows` is set, else
+/// empty rows).
 /// Up to `threads` files are decoded at once; files after the one being
 /// consumed may buffer at most `lookahead` points between them (the
 /// memory this costs: 12 bytes a point). `progress(points, files)` is
@@ -39,8 +41,9 @@ pub fn read_files_in_order(
     chunk: usize,
     threads: usize,
     lookahead: usize,
+    rows: bool,
     progress: &mut dyn FnMut(u64, usize),
-    on_chunk: &mut dyn FnMut(usize, &[Point]) -> crate::Result<()>,
+    on_chunk: &mut dyn FnMut(usize, &[Point], &[u8]) -> crate::Result<()>,
 ) -> crate::Result<Vec<StreamReport>> {
     let shared = Mutex::new(Shared {
         queues: (0..paths.len()).map(|_| VecDeque::new()).collect(),
@@ -59,28 +62,35 @@ pub fn read_files_in_order(
                 if f >= paths.len() || stop.load(Ordering::SeqCst) {
                     return;
                 }
-                let report = read_chunks(&paths[f], origin, chunk, &mut |_, _| {}, &mut |points| {
-                    let mut s = lock();
-                    // Files ahead of the consumer wait for room.
-                    while f != current.load(Ordering::SeqCst)
-                        && s.ahead + points.len() > lookahead
-                        && !stop.load(Ordering::SeqCst)
-                    {
-                        s = room.wait(s).unwrap_or_else(|e| e.into_inner());
-                    }
-                    if stop.load(Ordering::SeqCst) {
-                        return Err(CloudError::Format {
-                            path: paths[f].clone(),
-                            what: "reading stopped".into(),
-                        });
-                    }
-                    if f != current.load(Ordering::SeqCst) {
-                        s.ahead += points.len();
-                    }
-                    s.queues[f].push_back(Piece::Chunk(points.to_vec()));
-                    ready.notify_all();
-                    Ok(())
-                });
+                let report = read_chunks_with(
+                    &paths[f],
+                    origin,
+                    chunk,
+                    rows,
+                    &mut |_, _| {},
+                    &mut |points, row_bytes| {
+                        let mut s = lock();
+                        // Files ahead of the consumer wait for room.
+                        while f != current.load(Ordering::SeqCst)
+                            && s.ahead + points.len() > lookahead
+                            && !stop.load(Ordering::SeqCst)
+                        {
+                            s = room.wait(s).unwrap_or_else(|e| e.into_inner());
+                        }
+                        if stop.load(Ordering::SeqCst) {
+                            return Err(CloudError::Format {
+                                path: paths[f].clone(),
+                                what: "reading stopped".into(),
+                            });
+                        }
+                        if f != current.load(Ordering::SeqCst) {
+                            s.ahead += points.len();
+                        }
+                        s.queues[f].push_back(Piece::Chunk(points.to_vec(), row_bytes.to_vec()));
+                        ready.notify_all();
+                        Ok(())
+                    },
+                );
                 lock().queues[f].push_back(Piece::Done(report));
                 ready.notify_all();
             });
@@ -97,7 +107,7 @@ pub fn read_files_in_order(
                     let buffered: usize = s.queues[f]
                         .iter()
                         .map(|p| match p {
-                            Piece::Chunk(c) => c.len(),
+                            Piece::Chunk(c, _) => c.len(),
                             Piece::Done(_) => 0,
                         })
                         .sum();
@@ -115,8 +125,8 @@ pub fn read_files_in_order(
                         }
                     };
                     match piece {
-                        Piece::Chunk(c) => {
-                            on_chunk(f, &c)?;
+                        Piece::Chunk(c, r) => {
+                            on_chunk(f, &c, &r)?;
                             points += c.len() as u64;
                             progress(points, f);
                         }

@@ -22,7 +22,7 @@
 mod format;
 mod input;
 mod las;
-mod las_columns;
+pub(crate) mod las_columns;
 pub mod lzf;
 mod many;
 mod pcd;
@@ -36,5 +36,7 @@ mod xyz;
 pub use format::{Encoding, Format};
 pub use las::{LasHeader, LasVersion, LAS_SCALE_M, LAZ_MAX_POINTS_PER_BYTE, LAZ_MIN_CHUNK_BYTES};
 pub use many::read_files_in_order;
-pub use read::{las_header, read, read_chunks, read_from_bytes, ReadReport, StreamReport};
+pub use read::{
+    las_header, read, read_chunks, read_chunks_with, read_from_bytes, ReadReport, StreamReport,
+};
 pub use write::{write, write_named, write_with, WriteOptions};

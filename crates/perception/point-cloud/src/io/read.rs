@@ -120,6 +120,26 @@ pub fn read_chunks(
     progress: &mut dyn FnMut(u64, u64),
     on_chunk: &mut dyn FnMut(&[crate::Point]) -> crate::Result<()>,
 ) -> crate::Result<StreamReport> {
+    read_chunks_with(path, origin, chunk, false, progress, &mut |points, _| {
+        on_chunk(points)
+    })
+}
+
+/// [`read_chunks`], handing on with each chunk, when `rows` is set, every
+/// point's LAS record as the file's point format lays it out
+/// ([`crate::LasLayout::record_len`] bytes a point, x, y and z included;
+/// [`crate::LasLayout::attributes_of_rows`] makes them columns): a
+/// survey's attributes travel beside its points without being decoded into
+/// columns on the way. Rows are empty without `rows`, and for formats
+/// other than LAS and LAZ.
+pub fn read_chunks_with(
+    path: &Path,
+    origin: [f64; 3],
+    chunk: usize,
+    rows: bool,
+    progress: &mut dyn FnMut(u64, u64),
+    on_chunk: &mut dyn FnMut(&[crate::Point], &[u8]) -> crate::Result<()>,
+) -> crate::Result<StreamReport> {
     let format = Format::from_path(path)?;
     if !matches!(format, Format::Las | Format::Laz) {
         let mut r = read(path, progress)?;
@@ -129,7 +149,7 @@ pub fn read_chunks(
             }
         }
         for c in r.cloud.points.chunks(chunk.max(1)) {
-            on_chunk(c)?;
+            on_chunk(c, &[])?;
         }
         return Ok(StreamReport {
             points: r.cloud.len() as u64,
@@ -140,6 +160,7 @@ pub fn read_chunks(
     let (file, total) = open(path)?;
     let mut out = Points::streaming(chunk, on_chunk);
     out.origin = origin;
+    out.rows = rows.then(Vec::new);
     let got = las::read(
         BufReader::with_capacity(BUFFER, file),
         total,

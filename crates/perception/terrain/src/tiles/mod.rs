@@ -6,7 +6,10 @@
 //! keeps every n-th point as a sample, on which the floor is found and
 //! roll and pitch are estimated ([RS eq. 11]–[RS eq. 12]), and writes every
 //! point as read to the working folder (12 bytes a point: decoding LAZ
-//! again would cost more than reading them back). The second pass reads
+//! again would cost more than reading them back), and, when tiles are
+//! written, every point's LAS record (its attributes, the point format's
+//! bytes a point), read back by point index for each tile written. The
+//! second pass reads
 //! them back, levels each point,
 //! removes the floor (the ground pass-through) and files it under the tile
 //! of the levelled (x, y) grid its position falls in. Then each stage of
@@ -84,7 +87,10 @@ use autoshovel_point_cloud::{CloudError, Point, PointCloud};
 use nalgebra::Matrix3;
 use serde::Serialize;
 
-use store::{dist_path, f32_at, Filing, RawSpill, Rec, StageFiles, TileLayout, DIST_RECORD};
+use store::{
+    dist_path, f32_at, Filing, RawSpill, Rec, RowBack, RowSpill, StageFiles, TileLayout,
+    DIST_RECORD,
+};
 use task::{filter_err, Step};
 pub use task::{run_tile_task, InProcess, TileExecutor, TileReport, TileTask};
 
@@ -130,6 +136,11 @@ pub struct TileOptions {
     pub model_cell_m: f64,
     /// Where the working folder is made (removed at the end).
     pub work_dir: PathBuf,
+    /// Whether the tiles handed on carry the survey's attributes (its LAS
+    /// records kept in the working folder beside the points, a point
+    /// format's bytes a point, and read back by point index for each
+    /// tile). Off where no tile is written.
+    pub attributes: bool,
 }
 
 impl Default for TileOptions {
@@ -142,6 +153,7 @@ impl Default for TileOptions {
             sample_points: 2_000_000,
             model_cell_m: 1.0,
             work_dir: std::env::temp_dir(),
+            attributes: true,
         }
     }
 }
@@ -373,6 +385,8 @@ pub struct TiledPerceived {
     pub peak_memory: Option<u64>,
     /// The origin subtracted from the files' coordinates ([`Survey::origin`]) (m).
     pub origin_m: [f64; 3],
+    /// What the run could not do as asked ([`attribute_layout`]).
+    pub warnings: Vec<String>,
 }
 
 impl TiledPerceived {
@@ -466,6 +480,42 @@ pub struct TiledSummary {
     pub pipeline: PerceptionParams,
     /// Always true (a failed run is an error).
     pub success: bool,
+    /// What the run could not do as asked: the tiles' attributes (see
+    /// [`attribute_layout`]). Also printed on stderr.
+    pub warnings: Vec<String>,
+}
+
+/// The layout the tiles' attributes are carried in: the survey's LAS
+/// point format when every file has the same fields and `options` asks
+/// for attributes. Otherwise none, with a warning when tiles will still
+/// be written in the first file's point format, whose attribute fields
+/// then hold zero.
+pub fn attribute_layout(
+    survey: &Survey,
+    options: &TileOptions,
+) -> (Option<autoshovel_point_cloud::LasLayout>, Vec<String>) {
+    let layouts: Vec<_> = survey
+        .headers
+        .iter()
+        .filter_map(|h| h.georef.las.as_ref())
+        .collect();
+    let Some(first) = layouts.first().copied() else {
+        return (None, Vec::new());
+    };
+    if !options.attributes {
+        return (None, Vec::new());
+    }
+    if let Some(other) = layouts.iter().find(|l| !first.same_fields(l)) {
+        let warning = format!(
+            "the survey's files differ in point format ({} and {}): the tiles keep coordinates, CRS and point format {} \
+             but not the attributes, whose fields are written as zero; convert the files to one point format to keep them",
+            first.point_format(),
+            other.point_format(),
+            first.point_format()
+        );
+        return (None, vec![warning]);
+    }
+    (Some(first.clone()), Vec::new())
 }
 
 impl TiledSummary {
@@ -522,6 +572,7 @@ impl TiledSummary {
             fit_note: got.fit_note.clone(),
             pipeline: params.clone(),
             success: true,
+            warnings: got.warnings.clone(),
         }
     }
 }
@@ -646,6 +697,12 @@ pub fn perceive_tiled_with(
     // The points as read, for the second pass (decoding a LAZ survey
     // again costs more than reading them back).
     let mut raw = RawSpill::create(work.0.join("read"))?;
+    // The survey's records, for the attributes of the tiles written.
+    let (layout, warnings) = attribute_layout(survey, options);
+    let mut rows = layout
+        .as_ref()
+        .map(|l| RowSpill::create(work.0.join("rows"), l.record_len()))
+        .transpose()?;
     let mut spill_failed: Option<SurfaceError> = None;
     let reports = read_files_in_order(
         &survey.files,
@@ -653,8 +710,9 @@ pub fn perceive_tiled_with(
         READ_CHUNK,
         threads,
         LOOKAHEAD,
+        rows.is_some(),
         &mut |done, _| progress("reading (1 of 2)", done, claimed),
-        &mut |f, chunk: &[Point]| {
+        &mut |f, chunk: &[Point], chunk_rows: &[u8]| {
             for q in chunk {
                 for a in 0..3 {
                     lo[a] = lo[a].min(q[a]);
@@ -665,7 +723,11 @@ pub fn perceive_tiled_with(
                 }
                 n += 1;
             }
-            if let Err(e) = raw.put(chunk) {
+            let put = raw.put(chunk).and_then(|()| match &mut rows {
+                Some(r) => r.put(chunk_rows),
+                None => Ok(()),
+            });
+            if let Err(e) = put {
                 spill_failed = Some(e);
                 return Err(CloudError::Format {
                     path: survey.files[f].clone(),
@@ -680,6 +742,7 @@ pub fn perceive_tiled_with(
     }
     let reports = reports?;
     let mut raw = raw.finish()?;
+    let mut rows = rows.map(|r| r.finish(n)).transpose()?;
     let non_finite: u64 = reports.iter().map(|r| r.non_finite_dropped as u64).sum();
     let format = reports.first().map_or("", |r| r.format);
     if n == 0 {
@@ -911,11 +974,14 @@ pub fn perceive_tiled_with(
             bounds: grid.bounds(tile),
             // About the survey's origin, with its first file's CRS and
             // header: a tile written is in the survey's coordinates.
-            cloud: survey.cloud(recs.iter().map(|r| r.p).collect(), origin),
+            cloud: tile_cloud(survey, &recs, origin, layout.as_ref().zip(rows.as_mut()))?,
         })?;
     }
     progress("writing", grid.tiles() as u64, grid.tiles() as u64);
     lists.remove();
+    if let Some(r) = rows {
+        r.remove();
+    }
     for i in 0..model.z.len() {
         if count[i] > 0 {
             model.z[i] = sum[i] / f64::from(count[i]);
@@ -975,7 +1041,33 @@ pub fn perceive_tiled_with(
         model,
         peak_memory: peak_memory(),
         origin_m: origin,
+        warnings,
     })
+}
+
+/// A tile's cleaned points as a cloud of the survey (about `origin`, its
+/// first file's CRS and header), with each point's attributes from the
+/// survey's records when they are carried: a point keeps its own; a
+/// voxel's centroid, filed under its first point, takes that point's
+/// (PDAL's `filters.voxeldownsize` keeps the first point too).
+fn tile_cloud(
+    survey: &Survey,
+    recs: &[Rec],
+    origin: [f64; 3],
+    rows: Option<(&autoshovel_point_cloud::LasLayout, &mut RowBack)>,
+) -> Result<PointCloud> {
+    let mut cloud = survey.cloud(recs.iter().map(|r| r.p).collect(), origin);
+    if let Some((layout, back)) = rows {
+        let bytes = back.rows(recs.iter().map(|r| r.id))?;
+        cloud.attributes =
+            layout
+                .attributes_of_rows(&bytes)
+                .map_err(|problem| SurfaceError::TileFile {
+                    path: back.path.clone(),
+                    problem,
+                })?;
+    }
+    Ok(cloud)
 }
 
 fn record(stage: &'static str, lists: &StageFiles, t: Instant) -> StageRecord {

@@ -14,7 +14,9 @@
 //! The first pass over the survey also keeps every point it read, as read
 //! (x, y, z as f32, 12 bytes a point), in `read` under the run's folder:
 //! the second pass reads them back rather than decoding the files again
-//! ([`RawSpill`], [`RawBack`]).
+//! ([`RawSpill`], [`RawBack`]). When tiles are written it keeps each
+//! point's LAS record too, in `rows`, read back by point index for a
+//! tile's attributes ([`RowSpill`], [`RowBack`]).
 
 use std::fs::{self, File, OpenOptions};
 use std::io::{BufReader, BufWriter, Read, Write};
@@ -126,6 +128,109 @@ impl RawBack {
         );
         self.left -= take as u64;
         Ok(true)
+    }
+
+    /// Removes the file.
+    pub fn remove(self) {
+        let _ = fs::remove_file(&self.path);
+    }
+}
+
+/// The survey's LAS records, a fixed number of bytes a point in survey
+/// order, written in the first pass ([`RowSpill::put`]) and read back by
+/// point index for the tiles written ([`RowSpill::rows`]): the attributes
+/// travel beside the points without the stages carrying them.
+pub(super) struct RowSpill {
+    path: PathBuf,
+    file: BufWriter<File>,
+    len: usize,
+    points: u64,
+}
+
+impl RowSpill {
+    /// A spill of `len` bytes a point.
+    pub fn create(path: PathBuf, len: usize) -> Result<Self> {
+        let file = File::create(&path).map_err(spill(&path))?;
+        Ok(Self {
+            file: BufWriter::with_capacity(1 << 20, file),
+            path,
+            len: len.max(1),
+            points: 0,
+        })
+    }
+
+    /// Appends whole records.
+    pub fn put(&mut self, rows: &[u8]) -> Result<()> {
+        self.file.write_all(rows).map_err(spill(&self.path))?;
+        self.points += (rows.len() / self.len) as u64;
+        Ok(())
+    }
+
+    /// Ends the writing, checking the records against `points`; the file,
+    /// to read records back from.
+    pub fn finish(self, points: u64) -> Result<RowBack> {
+        let file = self
+            .file
+            .into_inner()
+            .map_err(|e| spill(&self.path)(e.into_error()))?;
+        drop(file);
+        let file = File::open(&self.path).map_err(spill(&self.path))?;
+        let bytes = file.metadata().map_err(spill(&self.path))?.len();
+        if self.points != points || bytes != points * self.len as u64 {
+            return Err(SurfaceError::TileFile {
+                path: self.path,
+                problem: format!(
+                    "holds {bytes} bytes of {}-byte records where {points} points were read",
+                    self.len
+                ),
+            });
+        }
+        Ok(RowBack {
+            file: BufReader::with_capacity(1 << 16, file),
+            path: self.path,
+            len: self.len,
+            points,
+            at: 0,
+        })
+    }
+}
+
+/// The survey's records, read back by point index.
+pub(super) struct RowBack {
+    pub path: PathBuf,
+    file: BufReader<File>,
+    len: usize,
+    points: u64,
+    /// The file position the reader is at.
+    at: u64,
+}
+
+impl RowBack {
+    /// The records of the points `ids` (in survey order for speed: a
+    /// tile's points are), one after another.
+    pub fn rows(&mut self, ids: impl Iterator<Item = u64>) -> Result<Vec<u8>> {
+        let mut out = Vec::new();
+        for id in ids {
+            if id >= self.points {
+                return Err(SurfaceError::TileFile {
+                    path: self.path.clone(),
+                    problem: format!("has no point {id} (it holds {})", self.points),
+                });
+            }
+            let want = id * self.len as u64;
+            if want != self.at {
+                // Within the buffer when near: a tile's points come in runs.
+                let jump = want as i64 - self.at as i64;
+                self.file.seek_relative(jump).map_err(spill(&self.path))?;
+            }
+            let start = out.len();
+            out.resize(start + self.len, 0);
+            self.file
+                .read_exact(&mut out[start..])
+                .map_err(spill(&self.path))?;
+            self.at = want + self.len as u64;
+        }
+        Ok(out)
     }
 
     /// Removes the file.
