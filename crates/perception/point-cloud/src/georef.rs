@@ -231,7 +231,7 @@ impl LasLayout {
         let format = *self.0.point_format();
         let transforms = *self.0.transforms();
         let len = self.record_len();
-        if len == 0 || rows.len() % len != 0 {
+        if len == 0 || !rows.len().is_multiple_of(len) {
             return Err(format!(
                 "{} bytes are not whole records of {len} bytes (point format {})",
                 rows.len(),

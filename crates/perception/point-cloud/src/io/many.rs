@@ -25,26 +25,46 @@ struct Shared {
     ahead: usize,
 }
 
-/// Reads `paths` as one stream: `on_chunk(file, points)` gets every file's
-/// finite points in file order, files in the given order, at most `chunk`
-/// at a time, less `origin`, exactly as [`read_chunks_with`] file after
-/// file would give them (with their LAS rows when `rows` is set, else
-/// empty rows).
-/// Up to `threads` files are decoded at once; files after the one being
-/// consumed may buffer at most `lookahead` points between them (the
-/// memory this costs: 12 bytes a point). `progress(points, files)` is
+/// How [`read_files_in_order`] reads.
+#[derive(Debug, Clone, Copy, PartialEq, Eq)]
+pub struct InOrder {
+    /// Most points handed on at a time.
+    pub chunk: usize,
+    /// Files decoded at once.
+    pub threads: usize,
+    /// Most points buffered by the files after the one being consumed.
+    pub lookahead: usize,
+    /// Hand each point's LAS record on too ([`super::read_chunks_with`]).
+    pub rows: bool,
+}
+
+/// The receiver of [`read_files_in_order`]'s chunks: the file's index, its
+/// points, and their LAS rows (empty unless asked for).
+pub type FileChunkSink<'a> = &'a mut dyn FnMut(usize, &[Point], &[u8]) -> crate::Result<()>;
+
+/// Reads `paths` as one stream: `on_chunk(file, points, rows)` gets every
+/// file's finite points in file order, files in the given order, at most
+/// `how.chunk` at a time, less `origin`, exactly as [`read_chunks_with`]
+/// file after file would give them (with their LAS rows when `how.rows`
+/// is set, else empty rows). Up to `how.threads` files are decoded at
+/// once; files after the one being consumed may buffer at most
+/// `how.lookahead` points between them (the memory this costs: 12 bytes a
+/// point, and a record's bytes with rows). `progress(points, files)` is
 /// called as chunks are consumed. An error (a file's, or `on_chunk`'s)
 /// stops every thread and is returned.
 pub fn read_files_in_order(
     paths: &[PathBuf],
     origin: [f64; 3],
-    chunk: usize,
-    threads: usize,
-    lookahead: usize,
-    rows: bool,
+    how: InOrder,
     progress: &mut dyn FnMut(u64, usize),
-    on_chunk: &mut dyn FnMut(usize, &[Point], &[u8]) -> crate::Result<()>,
+    on_chunk: FileChunkSink<'_>,
 ) -> crate::Result<Vec<StreamReport>> {
+    let InOrder {
+        chunk,
+        threads,
+        lookahead,
+        rows,
+    } = how;
     let shared = Mutex::new(Shared {
         queues: (0..paths.len()).map(|_| VecDeque::new()).collect(),
         ahead: 0,

@@ -35,8 +35,9 @@ mod xyz;
 
 pub use format::{Encoding, Format};
 pub use las::{LasHeader, LasVersion, LAS_SCALE_M, LAZ_MAX_POINTS_PER_BYTE, LAZ_MIN_CHUNK_BYTES};
-pub use many::read_files_in_order;
+pub use many::{read_files_in_order, FileChunkSink, InOrder};
 pub use read::{
-    las_header, read, read_chunks, read_chunks_with, read_from_bytes, ReadReport, StreamReport,
+    las_header, read, read_chunks, read_chunks_with, read_from_bytes, ChunkSink, ReadReport,
+    StreamReport,
 };
 pub use write::{write, write_named, write_with, WriteOptions};

@@ -125,6 +125,10 @@ pub fn read_chunks(
     })
 }
 
+/// The receiver of [`read_chunks_with`]'s chunks: the points, and their
+/// LAS rows (empty unless asked for); its error stops the read.
+pub type ChunkSink<'a> = &'a mut dyn FnMut(&[crate::Point], &[u8]) -> crate::Result<()>;
+
 /// [`read_chunks`], handing on with each chunk, when `rows` is set, every
 /// point's LAS record as the file's point format lays it out
 /// ([`crate::LasLayout::record_len`] bytes a point, x, y and z included;
@@ -138,7 +142,7 @@ pub fn read_chunks_with(
     chunk: usize,
     rows: bool,
     progress: &mut dyn FnMut(u64, u64),
-    on_chunk: &mut dyn FnMut(&[crate::Point], &[u8]) -> crate::Result<()>,
+    on_chunk: ChunkSink<'_>,
 ) -> crate::Result<StreamReport> {
     let format = Format::from_path(path)?;
     if !matches!(format, Format::Las | Format::Laz) {

@@ -82,7 +82,7 @@ use autoshovel_point_cloud::filter::{
     pass_through_indices, BilateralParams, DistanceSums, PassThroughParams, RadiusOutlierParams,
     StatisticalOutlierParams, VoxelGridParams,
 };
-use autoshovel_point_cloud::io::{las_header, read_files_in_order, LasHeader};
+use autoshovel_point_cloud::io::{las_header, read_files_in_order, InOrder, LasHeader};
 use autoshovel_point_cloud::{CloudError, Point, PointCloud};
 use nalgebra::Matrix3;
 use serde::Serialize;
@@ -707,10 +707,12 @@ pub fn perceive_tiled_with(
     let reports = read_files_in_order(
         &survey.files,
         origin,
-        READ_CHUNK,
-        threads,
-        LOOKAHEAD,
-        rows.is_some(),
+        InOrder {
+            chunk: READ_CHUNK,
+            threads,
+            lookahead: LOOKAHEAD,
+            rows: rows.is_some(),
+        },
         &mut |done, _| progress("reading (1 of 2)", done, claimed),
         &mut |f, chunk: &[Point], chunk_rows: &[u8]| {
             for q in chunk {
