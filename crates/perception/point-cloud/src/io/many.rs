@@ -120,8 +120,11 @@ pub fn read_files_in_order(
             let mut reports = Vec::with_capacity(paths.len());
             let mut points = 0u64;
             for f in 0..paths.len() {
-                {
+                if f > 0 {
                     // This file's buffered points no longer count as ahead.
+                    // (The first file's never did: it starts as the current
+                    // one, and subtracting its queue underflowed `ahead`
+                    // when its reader was quicker than this thread.)
                     let mut s = lock();
                     current.store(f, Ordering::SeqCst);
                     let buffered: usize = s.queues[f]
