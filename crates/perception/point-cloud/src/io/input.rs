@@ -241,7 +241,7 @@ pub(crate) const ORIGIN_FREE: f64 = 4096.0;
 
 /// The receiver of a stream's chunks: the points, and their rows when
 /// asked for ([`Points::rows`]; empty otherwise).
-pub(crate) type Sink<'s> = &'s mut dyn FnMut(&[Point], &[u8]) -> crate::Result<()>;
+pub(crate) type Sink<'s> = super::ChunkSink<'s>;
 
 impl<'s> Points<'s> {
     /// Points that go to `sink` in chunks of `chunk`, not kept.

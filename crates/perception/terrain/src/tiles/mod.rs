@@ -499,12 +499,9 @@ pub fn attribute_layout(
         .iter()
         .filter_map(|h| h.georef.las.as_ref())
         .collect();
-    let Some(first) = layouts.first().copied() else {
+    let Some(first) = layouts.first().copied().filter(|_| options.attributes) else {
         return (None, Vec::new());
     };
-    if !options.attributes {
-        return (None, Vec::new());
-    }
     if let Some(other) = layouts.iter().find(|l| !first.same_fields(l)) {
         let warning = format!(
             "the survey's files differ in point format ({} and {}): the tiles keep coordinates, CRS and point format {} \
@@ -608,6 +605,24 @@ pub fn perceive_tiled(
     perceive_tiled_with(survey, params, options, &mut InProcess, progress, on_tile)
 }
 
+/// Refuses a model cell or tile side that is not a finite length > 0.
+fn check_options(options: &TileOptions) -> Result<()> {
+    let lengths = [
+        ("model cell", Some(options.model_cell_m)),
+        ("tile size", options.tile_m),
+    ];
+    for (name, value) in lengths {
+        if let Some(v) = value.filter(|v| !(v.is_finite() && *v > 0.0)) {
+            return Err(SurfaceError::BadParameter {
+                name,
+                value: v,
+                expected: "a finite length > 0 [m]",
+            });
+        }
+    }
+    Ok(())
+}
+
 /// Refuses, before any work, what the survey path cannot do rightly: a
 /// survey in degrees (as `perceive` does), one in another length than the
 /// metre (the path does not convert; settings are metres), and `[range]`
@@ -665,22 +680,7 @@ pub fn perceive_tiled_with(
     on_tile: &mut dyn FnMut(&TileOutput) -> Result<()>,
 ) -> Result<TiledPerceived> {
     let p = params;
-    if !(options.model_cell_m.is_finite() && options.model_cell_m > 0.0) {
-        return Err(SurfaceError::BadParameter {
-            name: "model cell",
-            value: options.model_cell_m,
-            expected: "a finite length > 0 [m]",
-        });
-    }
-    if let Some(t) = options.tile_m {
-        if !(t.is_finite() && t > 0.0) {
-            return Err(SurfaceError::BadParameter {
-                name: "tile size",
-                value: t,
-                expected: "a finite length > 0 [m]",
-            });
-        }
-    }
+    check_options(options)?;
     refuse_what_tiles_cannot_do(survey, p)?;
     let mut stages = Vec::new();
     // Pass 1: bounds, count, sample.

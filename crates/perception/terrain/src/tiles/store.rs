@@ -76,13 +76,7 @@ impl RawSpill {
 
     /// Ends the writing; the file, to read back from its start.
     pub fn finish(self) -> Result<RawBack> {
-        let file = self
-            .file
-            .into_inner()
-            .map_err(|e| spill(&self.path)(e.into_error()))?;
-        drop(file);
-        let file = File::open(&self.path).map_err(spill(&self.path))?;
-        let len = file.metadata().map_err(spill(&self.path))?.len();
+        let (file, len) = reopen(self.file, &self.path)?;
         if len != self.points * RAW_RECORD as u64 {
             return Err(SurfaceError::TileFile {
                 path: self.path,
@@ -99,6 +93,15 @@ impl RawSpill {
             bytes: Vec::new(),
         })
     }
+}
+
+/// Flushes and closes a spill written through `file`, then opens it again
+/// to read back from its start; with its length in bytes.
+fn reopen(file: BufWriter<File>, path: &Path) -> Result<(File, u64)> {
+    drop(file.into_inner().map_err(|e| spill(path)(e.into_error()))?);
+    let file = File::open(path).map_err(spill(path))?;
+    let len = file.metadata().map_err(spill(path))?.len();
+    Ok((file, len))
 }
 
 /// The first pass's points read back, a chunk at a time.
@@ -169,13 +172,7 @@ impl RowSpill {
     /// Ends the writing, checking the records against `points`; the file,
     /// to read records back from.
     pub fn finish(self, points: u64) -> Result<RowBack> {
-        let file = self
-            .file
-            .into_inner()
-            .map_err(|e| spill(&self.path)(e.into_error()))?;
-        drop(file);
-        let file = File::open(&self.path).map_err(spill(&self.path))?;
-        let bytes = file.metadata().map_err(spill(&self.path))?.len();
+        let (file, bytes) = reopen(self.file, &self.path)?;
         if self.points != points || bytes != points * self.len as u64 {
             return Err(SurfaceError::TileFile {
                 path: self.path,
