@@ -235,7 +235,7 @@ pub fn replay(
             &read_rtk_csv(log)?,
             sc.setup.legs.clone(),
             &log.display().to_string(),
-        ),
+        )?,
         (true, None) => {
             return Err(JobError::setting(
                 "--path",

@@ -48,6 +48,8 @@ fn roundtrip(c: &mut Criterion) {
         );
         p.connect_timeout = Duration::from_secs(20);
         let link = Link::open(&p).await.unwrap();
+        link.claim().await.unwrap();
+        let _beat = link.keep_heartbeat();
         (server, link)
     });
     let mut g = c.benchmark_group("opcua_loopback");

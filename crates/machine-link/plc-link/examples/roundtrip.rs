@@ -57,6 +57,8 @@ fn main() {
         );
         p.connect_timeout = Duration::from_secs(20);
         let link = Link::open(&p).await.expect("session");
+        link.claim().await.expect("control");
+        let beat = link.keep_heartbeat();
         let mut read = Vec::with_capacity(n);
         let mut write = Vec::with_capacity(n);
         for i in 0..n {
@@ -71,6 +73,8 @@ fn main() {
             link.write_setpoints(cmd, None).await.expect("write");
             write.push(t.elapsed().as_secs_f64() * 1e3);
         }
+        beat.abort();
+        let _ = link.release().await;
         link.close().await;
         let mut peer = String::new();
         if std::env::var("PEER").as_deref() == Ok("python") {

@@ -1,7 +1,8 @@
 """The peer of `cargo run --release -p autoshovel-plc-link --example roundtrip`:
 python asyncua (PyPI) as the workstation's client against the same plc-sim,
 the same two calls (a Read of the 18 nodes the workstation reads, a Write of
-both setpoints) over Basic256Sha256 SignAndEncrypt as the operator.
+both setpoints) over Basic256Sha256 SignAndEncrypt as the operator, holding
+control (InitLock on Shovel.Control, a heartbeat every 50 ms) as `drive` does.
 
 Usage: asyncua_roundtrip.py ENDPOINT PKI_ROOT PASSWORD [N]
 (start `autoshovel plc-sim --manual --pki PKI_ROOT --port 4840` first).
@@ -50,6 +51,19 @@ async def main():
         nodes = [c.get_node(ua.NodeId(s, ns)) for s in NODES]
         left = c.get_node(ua.NodeId("Shovel.Crawler.Left.SpeedSetpoint", ns))
         right = c.get_node(ua.NodeId("Shovel.Crawler.Right.SpeedSetpoint", ns))
+        control = c.get_node(ua.NodeId("Shovel.Control", ns))
+        [status] = [await control.call_method(ua.NodeId("Shovel.Control.InitLock", ns), "asyncua roundtrip")]
+        assert status == 0, f"InitLock: {status} (another session holds control)"
+        beat = c.get_node(ua.NodeId("Shovel.Workstation.Heartbeat", ns))
+
+        async def heartbeat():
+            k = 1
+            while True:
+                await beat.write_value(ua.Variant(k, ua.VariantType.UInt32))
+                k += 1
+                await asyncio.sleep(0.05)
+
+        beating = asyncio.create_task(heartbeat())
         read, write = [], []
         for i in range(n):
             t = time.perf_counter()
@@ -61,6 +75,8 @@ async def main():
                 [ua.Variant(float(i % 100), ua.VariantType.Double), ua.Variant(0.0, ua.VariantType.Double)],
             )
             write.append((time.perf_counter() - t) * 1e3)
+        beating.cancel()
+        await control.call_method(ua.NodeId("Shovel.Control.ExitLock", ns))
     print(f"python asyncua client, {n} round trips each")
     print("| call | p50 [ms] | p99 [ms] | max [ms] |\n|---|---|---|---|")
     for name, xs in [("state read (18 nodes)", read), ("setpoint write (2 nodes)", write)]:

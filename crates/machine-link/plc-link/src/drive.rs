@@ -29,25 +29,65 @@ use opcua::types::{
 use serde::Serialize;
 use tokio::time::Instant;
 
+use crate::control::lock_status;
 use crate::error::LinkError;
-use crate::model::{self, Var, Writer, ACKNOWLEDGE, NAMESPACE_URI};
+use crate::model::{self, Var, Writer, ACKNOWLEDGE, EXIT_LOCK, INIT_LOCK, NAMESPACE_URI};
 use crate::pki::{self, Role};
 use autoshovel_run_log::{
     topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, RtkMsg, RunLog, TickMsg,
 };
 
-/// Messages of any type through one logging closure.
-mod erased {
-    use crate::error::LinkError;
-    use autoshovel_run_log::RunLog;
+/// The run log as the loop writes it: the first error kept (the drive
+/// goes on; the error is returned at the end), each control period's
+/// messages made durable together ([`RunLog::sync`]), the link's events
+/// written as they happen.
+struct Logger<'a> {
+    log: Option<&'a mut RunLog>,
+    error: Option<LinkError>,
+    /// Workstation and link events written so far.
+    logged: (usize, usize),
+}
 
-    pub trait Msg {
-        fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError>;
+impl Logger<'_> {
+    fn write<T: Serialize>(&mut self, topic: &'static str, t: f64, msg: &T) {
+        if let Some(l) = self.log.as_deref_mut() {
+            if let Err(e) = l.write(topic, t, msg) {
+                self.error.get_or_insert(e.into());
+            }
+        }
     }
 
-    impl<T: serde::Serialize> Msg for T {
-        fn write(&self, log: &mut RunLog, topic: &'static str, t: f64) -> Result<(), LinkError> {
-            Ok(log.write(topic, t, self)?)
+    /// Writes the events not yet written, then makes the log durable.
+    fn sync(&mut self, t: f64, ws_events: &[Event], link_events: &[LinkEvent]) {
+        for e in &ws_events[self.logged.0.min(ws_events.len())..] {
+            self.write(
+                topic::EVENT,
+                e.t_s,
+                &EventMsg {
+                    t_s: e.t_s,
+                    source: "workstation".into(),
+                    kind: e.kind.into(),
+                    message: e.message.clone(),
+                },
+            );
+        }
+        for e in &link_events[self.logged.1.min(link_events.len())..] {
+            self.write(
+                topic::EVENT,
+                t,
+                &EventMsg {
+                    t_s: e.wall_s,
+                    source: "link".into(),
+                    kind: e.kind.into(),
+                    message: e.message.clone(),
+                },
+            );
+        }
+        self.logged = (ws_events.len(), link_events.len());
+        if let Some(l) = self.log.as_deref_mut() {
+            if let Err(e) = l.sync() {
+                self.error.get_or_insert(e.into());
+            }
         }
     }
 }
@@ -127,6 +167,9 @@ pub struct Link {
     ns: u16,
     /// Whether the PLC has the `Simulator` folder (it is `plc-sim`).
     pub simulator: bool,
+    /// The PLC's `Shovel.InstanceId` when the session opened: a PLC that
+    /// answers with another is a restarted one, and is not driven.
+    pub instance: String,
     event_loop: tokio::task::JoinHandle<StatusCode>,
 }
 
@@ -181,6 +224,12 @@ impl Link {
         if p.policy == Policy::None && !p.insecure {
             return Err(LinkError::InsecureRefused {
                 endpoint: p.endpoint.clone(),
+            });
+        }
+        if let (Policy::None, Some((user, _))) = (p.policy, &p.user) {
+            return Err(LinkError::PasswordInClear {
+                endpoint: p.endpoint.clone(),
+                user: user.clone(),
             });
         }
         if p.policy == Policy::None {
@@ -269,9 +318,11 @@ impl Link {
             endpoint: p.endpoint.clone(),
             ns,
             simulator: false,
+            instance: String::new(),
             event_loop,
         };
         link.check_model().await?;
+        link.instance = link.read_instance().await?;
         Ok(link)
     }
 
@@ -364,10 +415,28 @@ impl Link {
         Ok(())
     }
 
-    /// Calls the acknowledge method.
-    pub async fn acknowledge(&self) -> Result<(), LinkError> {
-        let fault_obj = NodeId::new(self.ns, model::parent(ACKNOWLEDGE));
-        let req: CallMethodRequest = (fault_obj, NodeId::new(self.ns, ACKNOWLEDGE), None).into();
+    /// The PLC's `Shovel.InstanceId` now.
+    async fn read_instance(&self) -> Result<String, LinkError> {
+        let got = self
+            .session
+            .read(
+                &[self.id(Var::InstanceId).into()],
+                TimestampsToReturn::Neither,
+                0.0,
+            )
+            .await
+            .map_err(|e| service_err(&self.endpoint, "read", e))?;
+        let mut r = Reader {
+            link: self,
+            vals: vec![(Var::InstanceId, got.into_iter().next().unwrap_or_default())],
+        };
+        r.string(Var::InstanceId)
+    }
+
+    /// Calls a method of the model on its object with `args`; its outputs.
+    async fn call(&self, method: &str, args: Vec<Variant>) -> Result<Vec<Variant>, LinkError> {
+        let object = NodeId::new(self.ns, model::parent(method));
+        let req: CallMethodRequest = (object, NodeId::new(self.ns, method), Some(args)).into();
         let r = self
             .session
             .call_one(req)
@@ -376,35 +445,93 @@ impl Link {
         if r.status_code.is_bad() {
             return Err(LinkError::Refused {
                 endpoint: self.endpoint.clone(),
-                what: "Acknowledge".into(),
+                what: model::leaf(method).to_string(),
                 status: explain_status(r.status_code),
             });
         }
-        Ok(())
+        Ok(r.output_arguments.unwrap_or_default())
+    }
+
+    /// Claims control of the machine for this session (`InitLock`); a
+    /// claim by the holder renews it. Another session holding control is
+    /// [`LinkError::ControlHeld`].
+    pub async fn claim(&self) -> Result<(), LinkError> {
+        let out = self
+            .call(INIT_LOCK, vec![Variant::from("autoshovel drive")])
+            .await?;
+        match out.first() {
+            Some(Variant::Int32(lock_status::OK)) => Ok(()),
+            Some(Variant::Int32(lock_status::ALREADY_LOCKED)) => Err(LinkError::ControlHeld {
+                endpoint: self.endpoint.clone(),
+                by: self.holder().await,
+            }),
+            other => Err(LinkError::BadValue {
+                endpoint: self.endpoint.clone(),
+                node: format!("ns={};s={INIT_LOCK}", self.ns),
+                value: format!("{other:?}"),
+                why: "InitLockStatus is not 0 or -1".into(),
+            }),
+        }
+    }
+
+    /// Who holds control, as `LockingUser` on `LockingClient` say.
+    async fn holder(&self) -> String {
+        let ids = [Var::LockingUser, Var::LockingClient];
+        let read: Vec<ReadValueId> = ids.iter().map(|v| self.id(*v).into()).collect();
+        let Ok(got) = self
+            .session
+            .read(&read, TimestampsToReturn::Neither, 0.0)
+            .await
+        else {
+            return "another session".into();
+        };
+        let mut r = Reader {
+            link: self,
+            vals: ids.into_iter().zip(got).collect(),
+        };
+        match (r.string(Var::LockingUser), r.string(Var::LockingClient)) {
+            (Ok(u), Ok(c)) => format!("{u} on {c}"),
+            _ => "another session".into(),
+        }
+    }
+
+    /// A task writing this session's heartbeat every 50 ms until aborted:
+    /// for tools that hold control without a control loop (benchmarks,
+    /// tests). `drive` keeps its own, tied to its loop coming round.
+    pub fn keep_heartbeat(&self) -> tokio::task::JoinHandle<()> {
+        let session = self.session.clone();
+        let id = self.id(Var::Heartbeat);
+        tokio::spawn(async move {
+            let mut n: u32 = 1;
+            let mut iv = tokio::time::interval(HEARTBEAT_PERIOD);
+            loop {
+                iv.tick().await;
+                let _ = session
+                    .write(&[write(id.clone(), Variant::UInt32(n))])
+                    .await;
+                n = n.wrapping_add(1);
+            }
+        })
+    }
+
+    /// Releases control (`ExitLock`).
+    pub async fn release(&self) -> Result<(), LinkError> {
+        self.call(EXIT_LOCK, Vec::new()).await.map(|_| ())
+    }
+
+    /// Calls the acknowledge method.
+    pub async fn acknowledge(&self) -> Result<(), LinkError> {
+        self.call(ACKNOWLEDGE, Vec::new()).await.map(|_| ())
     }
 
     /// Calls the simulator's fault injection.
     pub async fn inject(&self, kind: &str, value: f64) -> Result<(), LinkError> {
-        let obj = NodeId::new(self.ns, model::parent(model::INJECT_FAULT));
-        let req: CallMethodRequest = (
-            obj,
-            NodeId::new(self.ns, model::INJECT_FAULT),
-            Some(vec![Variant::from(kind), Variant::Double(value)]),
+        self.call(
+            model::INJECT_FAULT,
+            vec![Variant::from(kind), Variant::Double(value)],
         )
-            .into();
-        let r = self
-            .session
-            .call_one(req)
-            .await
-            .map_err(|e| service_err(&self.endpoint, "method call", e))?;
-        if r.status_code.is_bad() {
-            return Err(LinkError::Refused {
-                endpoint: self.endpoint.clone(),
-                what: format!("InjectFault({kind}, {value})"),
-                status: explain_status(r.status_code),
-            });
-        }
-        Ok(())
+        .await
+        .map(|_| ())
     }
 
     /// Reads the values the workstation needs, in one request.
@@ -429,6 +556,7 @@ impl Link {
             Var::RightFrequency,
             Var::RightCurrent,
             Var::RightVoltage,
+            Var::InstanceId,
             Var::SimStep,
             Var::SimTrueX,
             Var::SimTrueY,
@@ -451,6 +579,14 @@ impl Link {
             link: self,
             vals: VARS.iter().copied().zip(got).collect(),
         };
+        let instance = r.string(Var::InstanceId)?;
+        if instance != self.instance {
+            return Err(LinkError::PlcRestarted {
+                endpoint: self.endpoint.clone(),
+                was: self.instance.clone(),
+                now: instance,
+            });
+        }
         Ok(PlcState {
             clock_ticks: r.ticks(Var::PlcTime)?,
             east_m: r.f64(Var::RtkEast)?,
@@ -514,7 +650,11 @@ fn write(node_id: NodeId, v: Variant) -> WriteValue {
 }
 
 fn explain_status(st: StatusCode) -> String {
-    let hint = if st == StatusCode::BadUserAccessDenied || st == StatusCode::BadNotWritable {
+    let hint = if st == StatusCode::BadLocked {
+        " (another session holds control of the machine)"
+    } else if st == StatusCode::BadRequiresLock {
+        " (this session does not hold control: it was released or lost)"
+    } else if st == StatusCode::BadUserAccessDenied || st == StatusCode::BadNotWritable {
         " (the session's identity may not write: log in as the operator)"
     } else if st == StatusCode::BadOutOfRange {
         " (outside the machine's limits; the PLC latched a fault)"
@@ -670,6 +810,10 @@ pub struct DriveRun {
 /// Ticks of 100 ns per second.
 const TICKS: f64 = 1e7;
 
+/// The heartbeat's period: 50 ms, a fifth of the PLC's timeout
+/// ([`crate::HEARTBEAT_TIMEOUT`]).
+pub const HEARTBEAT_PERIOD: Duration = Duration::from_millis(50);
+
 /// On the link the workstation treats a pose as stale this much before the
 /// scenario's `pose_timeout_s`: the margin covers a poll (5 ms) and the
 /// setpoint write's round trip, so the setpoints are zero by the time the
@@ -725,8 +869,31 @@ pub async fn drive_logged(
     };
     let run = drive(&link, setup, controller, opts, Some(&mut log)).await;
     link.close().await;
-    // The log is kept whatever happened.
-    let logged = log.finish();
+    // Why the run ended, as the log's last event; the log is kept whatever happened.
+    let why = match &run {
+        Ok(r) if r.run.metrics.completed => "the path was driven to its end".to_string(),
+        Ok(r) => format!(
+            "stopped before the path's end ({})",
+            r.run
+                .events
+                .last()
+                .map(|e| e.message.as_str())
+                .unwrap_or("no event")
+        ),
+        Err(e) => autoshovel_core::error_chain(e),
+    };
+    let t = log.last_t_s();
+    let ended = log.write(
+        topic::EVENT,
+        t,
+        &EventMsg {
+            t_s: t,
+            source: "link".into(),
+            kind: "end".into(),
+            message: why,
+        },
+    );
+    let logged = ended.and_then(|()| log.finish());
     Ok((run?, logged?))
 }
 
@@ -754,6 +921,9 @@ pub async fn drive(
             return Err(e);
         }
     };
+    // Control of the machine, for this session only, just before the
+    // heartbeat that keeps it.
+    link.claim().await?;
     if let Some(log) = log.as_deref_mut() {
         log.set_origin_ticks(first.clock_ticks);
         log.write(
@@ -777,7 +947,7 @@ pub async fn drive(
         let alive = alive.clone();
         tokio::spawn(async move {
             let mut n: u32 = 1;
-            let mut iv = tokio::time::interval(Duration::from_millis(50));
+            let mut iv = tokio::time::interval(HEARTBEAT_PERIOD);
             while !hb_stop.load(Ordering::Relaxed) {
                 iv.tick().await;
                 let last = alive.load(Ordering::Relaxed);
@@ -805,10 +975,14 @@ pub async fn drive(
         log,
     )
     .await;
-    // Whatever happened: zero setpoints, then stop the heartbeat.
+    // Whatever happened: zero setpoints, stop the heartbeat, release
+    // control (the PLC then wants an acknowledgement before the next claim
+    // moves the machine; if the release does not arrive, the watchdog ends
+    // the lock the same way).
     let zero = zero_setpoints(link).await;
     hb_stop.store(true, Ordering::Relaxed);
     let _ = hb.await;
+    let _ = link.release().await;
     let mut run = result?;
     if zero.is_err() {
         run.link_events.push(LinkEvent {
@@ -907,13 +1081,10 @@ async fn run_loop(
     alive: &dyn Fn(),
     mut log: Option<&mut RunLog>,
 ) -> Result<DriveRun, LinkError> {
-    let mut log_error: Option<LinkError> = None;
-    let mut logw = |topic: &'static str, t: f64, msg: &dyn erased::Msg| {
-        if let Some(l) = log.as_deref_mut() {
-            if let Err(e) = msg.write(l, topic, t) {
-                log_error.get_or_insert(e);
-            }
-        }
+    let mut logger = Logger {
+        log: log.take(),
+        error: None,
+        logged: (0, 0),
     };
     let wall0 = Instant::now();
     let wall = || wall0.elapsed().as_secs_f64();
@@ -940,6 +1111,7 @@ async fn run_loop(
     let mut stopped_wait: Option<f64> = None;
     let status = loop {
         alive();
+        logger.sync(secs(state.clock_ticks), &ws.events, &link_events);
         if stop.load(Ordering::Relaxed) {
             link_events.push(LinkEvent {
                 wall_s: wall(),
@@ -964,13 +1136,12 @@ async fn run_loop(
                     }
                     state = s;
                 }
-                Err(LinkError::BadValue { .. }) | Err(LinkError::Model { .. })
-                    if lost_since.is_none() =>
-                {
-                    return Err(link.read_state().await.err().unwrap_or_else(|| {
-                        connect_err(&link.endpoint, "a value went bad and came back")
-                    }));
-                }
+                // A value that cannot be right, or another PLC: never retried.
+                Err(
+                    e @ (LinkError::BadValue { .. }
+                    | LinkError::Model { .. }
+                    | LinkError::PlcRestarted { .. }),
+                ) => return Err(e),
                 Err(e) => {
                     match lost_since {
                         None => {
@@ -1031,8 +1202,13 @@ async fn run_loop(
                     });
                 }
             }
-            // Keep the setpoints at zero (the PLC ignores them anyway) and
-            // answer lockstep steps so the machine's own stop runs.
+            // Hold control again if the fault took it (a claim by the
+            // holder only renews it); another session holding it ends the
+            // run. Keep the setpoints at zero (the PLC ignores them anyway)
+            // and answer lockstep steps so the machine's own stop runs.
+            if let Err(e @ LinkError::ControlHeld { .. }) = link.claim().await {
+                return Err(e);
+            }
             let _ = link.write_setpoints(TrackCommand::STOP, state.step).await;
             tokio::time::sleep(Duration::from_millis(20)).await;
             continue;
@@ -1087,7 +1263,7 @@ async fn run_loop(
         last_step = state.step;
         last_tick_t = t;
         if let Some(f) = fix {
-            logw(
+            logger.write(
                 topic::RTK,
                 f.time_s,
                 &RtkMsg {
@@ -1099,7 +1275,7 @@ async fn run_loop(
                 },
             );
         }
-        logw(
+        logger.write(
             topic::MOTORS,
             t,
             &MotorsMsg {
@@ -1126,7 +1302,7 @@ async fn run_loop(
             last_measured = Some(d.measured);
             let (truth, travelled) = state.truth.unwrap_or((d.measured, travelled_measured));
             samples.push(eval.sample(&setup.legs, d, t, truth, travelled));
-            logw(
+            logger.write(
                 topic::TICK,
                 t,
                 &TickMsg {
@@ -1179,31 +1355,8 @@ async fn run_loop(
     ));
     let completed = status == Status::Finished;
     let metrics = measure(&samples, setup, end, travelled, t_end, completed);
-    for e in &ws.events {
-        logw(
-            topic::EVENT,
-            e.t_s,
-            &EventMsg {
-                t_s: e.t_s,
-                source: "workstation".into(),
-                kind: e.kind.into(),
-                message: e.message.clone(),
-            },
-        );
-    }
-    for e in &link_events {
-        logw(
-            topic::EVENT,
-            t_end,
-            &EventMsg {
-                t_s: e.wall_s,
-                source: "link".into(),
-                kind: e.kind.into(),
-                message: e.message.clone(),
-            },
-        );
-    }
-    logw(
+    logger.sync(t_end, &ws.events, &link_events);
+    logger.write(
         topic::SUMMARY,
         t_end,
         &EndMsg {
@@ -1214,7 +1367,8 @@ async fn run_loop(
             metrics,
         },
     );
-    if let Some(e) = log_error {
+    logger.sync(t_end, &ws.events, &link_events);
+    if let Some(e) = logger.error {
         return Err(e);
     }
     let mut events: Vec<Event> = ws.events;

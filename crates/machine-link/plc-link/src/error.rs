@@ -151,7 +151,34 @@ pub enum LinkError {
         /// The limit.
         limit_s: f64,
     },
-    /// Interrupted by the user (Ctrl-C); setpoints were zeroed.
+    /// Another session holds control of the machine.
+    #[error("{endpoint}: control of the machine is held by {by}; it moves only for that session (it releases control, or an operator breaks it at rest with the machine stopped)")]
+    ControlHeld {
+        /// The endpoint URL.
+        endpoint: String,
+        /// Who holds it (`Shovel.Control.LockingUser` on `LockingClient`).
+        by: String,
+    },
+    /// The PLC on the endpoint is not the one the run started with.
+    #[error("{endpoint}: the PLC restarted (Shovel.InstanceId was {was}, now {now}); this run will not drive a new instance: check the machine, acknowledge, and start a new drive")]
+    PlcRestarted {
+        /// The endpoint URL.
+        endpoint: String,
+        /// The instance at the start.
+        was: String,
+        /// The instance now.
+        now: String,
+    },
+    /// A user password asked to travel over a channel without encryption.
+    #[error("{endpoint}: security None would send the password of {user} in clear; a user identity is only sent over SignAndEncrypt (drop --policy none, or read anonymously)")]
+    PasswordInClear {
+        /// The endpoint URL.
+        endpoint: String,
+        /// The user.
+        user: String,
+    },
+    /// Interrupted by the user (Ctrl-C) or a signal (SIGTERM, SIGHUP);
+    /// setpoints were zeroed.
     #[error("interrupted: setpoints zeroed on {endpoint}")]
     Interrupted {
         /// The endpoint URL.

@@ -5,15 +5,18 @@
 //! ([`pki`]), and the network relay that lets tests pull the cable
 //! ([`relay`]). Runs are recorded in the run log of `autoshovel-run-log`. The protocol is async-opcua's; nothing of it is written here.
 
+pub mod control;
 pub mod drive;
 pub mod error;
 pub mod model;
+pub mod nodes;
 pub mod pki;
 pub mod plc;
 pub mod relay;
 pub mod server;
 
 pub use autoshovel_run_log::RunLog;
+pub use control::{Caller, Refusal};
 pub use drive::{drive, drive_logged, DriveOptions, DriveRun, Link, LinkEvent, LinkParams, Policy};
 pub use error::LinkError;
 pub use plc::{Clock, FaultKind, Plc, PlcParams, PlcSimSummary, HEARTBEAT_TIMEOUT};

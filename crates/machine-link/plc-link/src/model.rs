@@ -33,6 +33,8 @@ pub enum Ty {
     DateTime,
     /// UTF-8 string.
     String,
+    /// OPC UA Duration: a Double of milliseconds.
+    Duration,
 }
 
 impl Ty {
@@ -47,6 +49,7 @@ impl Ty {
             Ty::Boolean => D::Boolean,
             Ty::DateTime => D::DateTime,
             Ty::String => D::String,
+            Ty::Duration => D::Duration,
         }
     }
 
@@ -60,6 +63,7 @@ impl Ty {
             Ty::Boolean => "Boolean",
             Ty::DateTime => "DateTime",
             Ty::String => "String",
+            Ty::Duration => "Duration",
         }
     }
 }
@@ -112,6 +116,11 @@ pub enum Var {
     FaultText,
     MaxSpeed,
     MaxAccel,
+    InstanceId,
+    Locked,
+    LockingClient,
+    LockingUser,
+    RemainingLockTime,
     SimStep,
     SimStepAck,
     SimTrueX,
@@ -173,15 +182,24 @@ pub const VARIABLES: &[VarSpec] = &[
     var!(RtkTime, "Shovel.Rtk.Timestamp", DateTime, "", Plc, "The receiver's timestamp of the fix (UTC)"),
     var!(PlcTime, "Shovel.Clock", DateTime, "", Plc, "The PLC's clock (UTC); a pose's age is Clock − Rtk.Timestamp"),
     var!(Heartbeat, "Shovel.Workstation.Heartbeat", UInt32, "", Workstation,
-        "Counter the workstation changes every 50 ms; unchanged for 250 ms: the PLC ramps the motors to zero and latches a fault"),
+        "Counter the session holding control changes every 50 ms; unchanged for 250 ms: the PLC ramps the motors to zero, latches a fault and ends the lock"),
     var!(Mode, "Shovel.Mode", Byte, "", Plc, "0 manual (setpoints ignored), 1 auto (setpoints obeyed)"),
     var!(FaultActive, "Shovel.Fault.Active", Boolean, "", Plc,
         "A latched fault: motors ramped to zero, setpoints ignored until Acknowledge"),
     var!(FaultCode, "Shovel.Fault.Code", UInt32, "", Plc,
-        "0 none, 1 heartbeat lost, 2 link dropped, 3 setpoint rejected, 4 injected"),
+        "0 none, 1 heartbeat lost, 2 controlling session closed, 3 setpoint rejected, 4 injected, 5 control released or broken"),
     var!(FaultText, "Shovel.Fault.Text", String, "", Plc, "What latched the fault"),
     var!(MaxSpeed, "Shovel.Limits.MotorMaxSpeed", Double, "rpm", Plc, "Motor speed limit"),
     var!(MaxAccel, "Shovel.Limits.MotorMaxAcceleration", Double, "rpm/s", Plc, "Motor acceleration limit (the PLC's ramp)"),
+    var!(InstanceId, "Shovel.InstanceId", String, "", Plc,
+        "This start of the PLC (its start time and process); a workstation drives only the instance it found when it started"),
+    var!(Locked, "Shovel.Control.Locked", Boolean, "", Plc,
+        "A session holds control of the machine (OPC 10000-100 LockingServices)"),
+    var!(LockingClient, "Shovel.Control.LockingClient", String, "", Plc,
+        "The controlling client: its application URI and certificate thumbprint, and its session"),
+    var!(LockingUser, "Shovel.Control.LockingUser", String, "", Plc, "The user the controlling session logged in as"),
+    var!(RemainingLockTime, "Shovel.Control.RemainingLockTime", Duration, "ms", Plc,
+        "Time left before the lock lapses unless the holder's heartbeat or RenewLock comes (the heartbeat timeout)"),
     var!(SimStep, "Shovel.Simulator.Step", UInt64, "", Simulator,
         "Lockstep: the control period the simulator waits at (counts up)"),
     var!(SimStepAck, "Shovel.Simulator.StepAck", UInt64, "", Workstation,
@@ -204,12 +222,32 @@ pub const FOLDERS: &[&str] = &[
     "Shovel.Workstation",
     "Shovel.Fault",
     "Shovel.Limits",
+    "Shovel.Control",
     "Shovel.Simulator",
 ];
 
 /// The acknowledge method (component of `Shovel.Fault`): clears a latched
 /// fault once both motors are at rest; needs a user identity.
 pub const ACKNOWLEDGE: &str = "Shovel.Fault.Acknowledge";
+/// The lock methods of `Shovel.Control` (OPC 10000-100 §7), each with an
+/// Int32 status out (0 OK, −1 E_AlreadyLocked / E_NotLocked): `InitLock`
+/// (String Context) claims control, `RenewLock` counts as activity,
+/// `ExitLock` releases it, `BreakLock` ends another's at rest. Callers
+/// need a user identity.
+pub const LOCK_METHODS: &[(&str, &str)] = &[
+    ("Shovel.Control.InitLock", "Claims control for this session (String Context); Int32 InitLockStatus: 0 OK, −1 E_AlreadyLocked"),
+    ("Shovel.Control.RenewLock", "Counts as the holder's activity; Int32 RenewLockStatus: 0 OK, −1 E_NotLocked; BadLocked from another session"),
+    ("Shovel.Control.ExitLock", "Releases control (a fault latches: the next claim moves the machine after an acknowledgement at rest); Int32 ExitLockStatus: 0 OK, −1 E_NotLocked"),
+    ("Shovel.Control.BreakLock", "Ends another session's control, only with the machine at rest or its heartbeat stopped; Int32 BreakLockStatus: 0 OK, −1 E_NotLocked"),
+];
+/// `InitLock`.
+pub const INIT_LOCK: &str = "Shovel.Control.InitLock";
+/// `RenewLock`.
+pub const RENEW_LOCK: &str = "Shovel.Control.RenewLock";
+/// `ExitLock`.
+pub const EXIT_LOCK: &str = "Shovel.Control.ExitLock";
+/// `BreakLock`.
+pub const BREAK_LOCK: &str = "Shovel.Control.BreakLock";
 /// The simulator's fault-injection method (component of
 /// `Shovel.Simulator`): arguments kind (String) and duration (s) (Double).
 pub const INJECT_FAULT: &str = "Shovel.Simulator.InjectFault";
@@ -220,12 +258,15 @@ pub mod fault_code {
     pub const NONE: u32 = 0;
     /// The workstation's heartbeat did not change for the timeout.
     pub const HEARTBEAT_LOST: u32 = 1;
-    /// The workstation's session ended.
+    /// The controlling session closed (or the server timed it out).
     pub const LINK_DROPPED: u32 = 2;
     /// A setpoint out of range or not finite was written.
     pub const SETPOINT_REJECTED: u32 = 3;
     /// Injected by the simulator.
     pub const INJECTED: u32 = 4;
+    /// Control was released (`ExitLock`) or broken (`BreakLock`): the
+    /// next claim moves the machine only after an acknowledgement at rest.
+    pub const CONTROL_ENDED: u32 = 5;
 }
 
 /// The mode values of `Shovel.Mode`.
@@ -271,8 +312,18 @@ pub fn markdown_table() -> String {
         ));
     }
     s.push_str(&format!(
-        "| `{ACKNOWLEDGE}` | method () | – | workstation / operator | Clears a latched fault once both motors are at rest |\n"
+        "| `{ACKNOWLEDGE}` | method () | – | operator (any session) | Clears a latched fault once both motors are at rest |\n"
     ));
+    for (id, doc) in LOCK_METHODS {
+        let args = if *id == INIT_LOCK {
+            "String Context"
+        } else {
+            ""
+        };
+        s.push_str(&format!(
+            "| `{id}` | method ({args}) → Int32 | – | operator | {doc} |\n"
+        ));
+    }
     s.push_str(&format!(
         "| `{INJECT_FAULT}` | method (String kind, Double duration_s) | – | test harness | Simulator only: injects a fault (see plc-sim) |\n"
     ));
@@ -302,7 +353,12 @@ mod tests {
         for v in VARIABLES {
             assert!(FOLDERS.contains(&parent(v.id)), "{}", v.id);
         }
-        for m in [ACKNOWLEDGE, INJECT_FAULT] {
+        let lock_ids = LOCK_METHODS.iter().map(|m| m.0);
+        assert_eq!(
+            lock_ids.clone().collect::<Vec<_>>(),
+            [INIT_LOCK, RENEW_LOCK, EXIT_LOCK, BREAK_LOCK]
+        );
+        for m in [ACKNOWLEDGE, INJECT_FAULT].into_iter().chain(lock_ids) {
             assert!(FOLDERS.contains(&parent(m)), "{m}");
         }
         for f in FOLDERS.iter().skip(1) {

@@ -17,6 +17,7 @@ use autoshovel_walk_tracker::sim::plant_steps;
 use autoshovel_walk_tracker::{Machine, RtkFix, Setup, TrackCommand};
 use serde::Serialize;
 
+use crate::control::{lock_status, Caller, Control, Refusal};
 use crate::model::{fault_code, mode};
 
 /// Which fault to inject, and for how long.
@@ -166,6 +167,11 @@ pub struct PlcSimSummary {
     pub setpoints_zeroed_at_s: Vec<f64>,
     /// Whether the motors sped up while a fault was latched (must never happen).
     pub moved_while_faulted: bool,
+    /// The session holding control at the end, if any.
+    pub controller: Option<String>,
+    /// Writes and calls refused because the caller did not hold control
+    /// (none of them touched the machine).
+    pub refused_writes: u64,
     /// Everything the PLC did.
     pub events: Vec<PlcEvent>,
     /// The machine never moved while a fault was latched.
@@ -182,7 +188,9 @@ pub struct PlcEvent {
     pub wall_s: f64,
     /// Machine time (s).
     pub t_s: f64,
-    /// Kind: `fault`, `acknowledged`, `inject`, `setpoint-rejected`, `lockstep`.
+    /// Kind: `fault`, `acknowledged`, `inject`, `setpoint-rejected`,
+    /// `control-claimed`, `control-refused`, `control-released`,
+    /// `control-lost`, `write-refused`.
     pub kind: &'static str,
     /// Human text.
     pub message: String,
@@ -229,6 +237,12 @@ pub struct Plc {
     setpoints: TrackCommand,
     heartbeat: Option<u32>,
     heartbeat_at: Option<f64>,
+    /// The holder's next heartbeat counts whatever its value (set by a claim).
+    claimed_afresh: bool,
+    /// Who holds control (OPC 10000-100 LockingServices).
+    pub control: Control,
+    refused_writes: u64,
+    refusals_logged: std::collections::BTreeSet<(u32, &'static str)>,
     /// The latched fault: code and text.
     pub fault: Option<(u32, String)>,
     mode: u8,
@@ -275,6 +289,10 @@ impl Plc {
             setpoints: TrackCommand::STOP,
             heartbeat: None,
             heartbeat_at: None,
+            claimed_afresh: false,
+            control: Control::default(),
+            refused_writes: 0,
+            refusals_logged: Default::default(),
             fault: None,
             step: 0,
             step_ack: None,
@@ -351,11 +369,23 @@ impl Plc {
     /// The setpoints the PLC obeys now (zero when faulted, in manual, or
     /// without a fresh heartbeat).
     pub fn effective_command(&self) -> TrackCommand {
-        if self.fault.is_some() || self.mode != mode::AUTO || self.heartbeat_at.is_none() {
+        if self.fault.is_some()
+            || self.mode != mode::AUTO
+            || self.heartbeat_at.is_none()
+            || self.control.holder().is_none()
+        {
             TrackCommand::STOP
         } else {
             self.setpoints
         }
+    }
+
+    /// Time left (s) before the lock lapses unless the holder's heartbeat
+    /// comes (None: nobody holds control, or the watchdog is not armed).
+    pub fn lock_remaining_s(&self) -> Option<f64> {
+        self.control.holder()?;
+        let at = self.heartbeat_at?;
+        Some((self.params.heartbeat_timeout.as_secs_f64() - (self.wall_s - at)).max(0.0))
     }
 
     /// The setpoints as last written and accepted.
@@ -383,23 +413,48 @@ impl Plc {
             faults_latched: self.stops.len(),
             setpoints_zeroed_at_s: self.zeroed_at.clone(),
             moved_while_faulted: self.moved_while_faulted,
+            controller: self.control.holder().map(|h| h.caller.describe()),
+            refused_writes: self.refused_writes,
             events: self.events.clone(),
             success: !self.moved_while_faulted,
             log: None,
         }
     }
 
-    /// A setpoint write (`right` selects the motor): refused when not
-    /// finite or beyond the motor limit (and a fault is latched, as a PLC
-    /// treats a nonsense command); ignored, though accepted, while a fault is latched.
-    pub fn write_setpoint(&mut self, right: bool, rpm: f64) -> Result<(), String> {
+    /// Refuses a command from `who` unless it holds control: counted, the
+    /// first of each kind from each session logged, nothing else changed.
+    fn commanded_by(&mut self, who: &Caller, what: &'static str) -> Result<(), Refusal> {
+        let r = self.control.check(who);
+        if let Err(why) = &r {
+            self.refused_writes += 1;
+            if self.refusals_logged.insert((who.session, what)) {
+                let why = match why {
+                    Refusal::Locked { by } => format!("control is held by {by}"),
+                    _ => "nobody holds control (InitLock first)".to_string(),
+                };
+                self.event(
+                    "write-refused",
+                    format!("{what} from {} refused: {why}", who.describe()),
+                );
+            }
+        }
+        r
+    }
+
+    /// A setpoint write by `who` (`right` selects the motor): refused
+    /// unless `who` holds control (no effect); from the holder, refused
+    /// when not finite or beyond the motor limit (and a fault is latched,
+    /// as a PLC treats a nonsense command); ignored, though accepted,
+    /// while a fault is latched.
+    pub fn write_setpoint(&mut self, who: &Caller, right: bool, rpm: f64) -> Result<(), Refusal> {
+        self.commanded_by(who, "setpoint")?;
         let max = self.params.setup.crawler.motor_max_rpm;
         if !rpm.is_finite() || rpm.abs() > max * (1.0 + 1e-9) {
             let side = if right { "right" } else { "left" };
             let why = format!("{side} setpoint {rpm} rpm is outside ±{max} rpm");
             self.event("setpoint-rejected", why.clone());
             self.latch(fault_code::SETPOINT_REJECTED, why.clone());
-            return Err(why);
+            return Err(Refusal::OutOfRange(why));
         }
         if self.fault.is_some() {
             return Ok(());
@@ -416,33 +471,148 @@ impl Plc {
         Ok(())
     }
 
-    /// A heartbeat write: a changed value refreshes the watchdog.
-    pub fn write_heartbeat(&mut self, value: u32) {
-        if self.heartbeat != Some(value) {
+    /// A heartbeat write by `who`: from the holder, a changed value (or
+    /// the first after its claim) refreshes the watchdog; from anyone
+    /// else, refused.
+    pub fn write_heartbeat(&mut self, who: &Caller, value: u32) -> Result<(), Refusal> {
+        self.commanded_by(who, "heartbeat")?;
+        if self.claimed_afresh || self.heartbeat != Some(value) {
+            self.claimed_afresh = false;
             self.heartbeat = Some(value);
             self.heartbeat_at = Some(self.wall_s);
         }
+        Ok(())
     }
 
-    /// A lockstep answer for `step`.
-    pub fn write_step_ack(&mut self, step: u64) {
+    /// A lockstep answer for `step` by `who` (the holder only).
+    pub fn write_step_ack(&mut self, who: &Caller, step: u64) -> Result<(), Refusal> {
+        self.commanded_by(who, "lockstep answer")?;
         self.step_ack = Some(step);
+        Ok(())
     }
 
-    /// The workstation's connection ended (the relay saw it close).
-    pub fn link_dropped(&mut self) {
-        if self.heartbeat_at.is_some() {
-            self.heartbeat_at = None;
-            self.latch(
+    /// `InitLock` by `who`: takes control when nobody holds it (a latched
+    /// fault stays latched: the claim moves nothing until acknowledged);
+    /// arms the watchdog, so the holder's heartbeat must follow within
+    /// the timeout. Returns the lock status (OPC 10000-100).
+    pub fn init_lock(&mut self, who: &Caller, context: &str) -> i32 {
+        let again = self.control.holds(who);
+        let status = self.control.claim(who, context);
+        if status != lock_status::OK {
+            let by = self.control.holder().map(|h| h.caller.describe());
+            self.event(
+                "control-refused",
+                format!(
+                    "claim by {} refused: control is held by {}",
+                    who.describe(),
+                    by.unwrap_or_default()
+                ),
+            );
+            return status;
+        }
+        self.heartbeat_at = Some(self.wall_s);
+        if !again {
+            self.claimed_afresh = true;
+            self.event(
+                "control-claimed",
+                format!("control claimed by {} ({context})", who.describe()),
+            );
+        }
+        status
+    }
+
+    /// `RenewLock` by `who`: the holder's claim counts as activity (as a heartbeat).
+    pub fn renew_lock(&mut self, who: &Caller) -> Result<i32, Refusal> {
+        match self.control.check(who) {
+            Ok(()) => {
+                self.heartbeat_at = Some(self.wall_s);
+                Ok(lock_status::OK)
+            }
+            Err(Refusal::RequiresLock) => Ok(lock_status::NOT_LOCKED),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// Ends the lock with `text` (the fault's, code `code`): setpoints
+    /// zero, watchdog disarmed, a fault latched so that the next claim
+    /// moves the machine only after an acknowledgement at rest.
+    fn end_control(&mut self, code: u32, text: String) {
+        if let Some(h) = self.control.end() {
+            self.event(
+                if code == fault_code::CONTROL_ENDED {
+                    "control-released"
+                } else {
+                    "control-lost"
+                },
+                format!("{}: {text}", h.caller.describe()),
+            );
+        }
+        self.heartbeat_at = None;
+        self.setpoints = TrackCommand::STOP;
+        self.latch(code, text);
+    }
+
+    /// `ExitLock` by `who`: the holder releases control.
+    pub fn exit_lock(&mut self, who: &Caller) -> Result<i32, Refusal> {
+        match self.control.check(who) {
+            Ok(()) => {
+                self.end_control(
+                    fault_code::CONTROL_ENDED,
+                    format!(
+                        "control released by {}: a new claim moves the machine after an acknowledgement at rest",
+                        who.describe()
+                    ),
+                );
+                Ok(lock_status::OK)
+            }
+            Err(Refusal::RequiresLock) => Ok(lock_status::NOT_LOCKED),
+            Err(e) => Err(e),
+        }
+    }
+
+    /// `BreakLock` by an operator `who`: ends another session's control,
+    /// only with the machine at rest or its holder's heartbeat already
+    /// stopped (a person takes over a stopped machine; nobody stops a
+    /// moving one this way: its controller does, or the machine's own
+    /// emergency stop).
+    pub fn break_lock(&mut self, who: &Caller) -> Result<i32, Refusal> {
+        let Some(h) = self.control.holder() else {
+            return Ok(lock_status::NOT_LOCKED);
+        };
+        if self.heartbeat_at.is_some() && !self.machine.at_rest() {
+            return Err(Refusal::InvalidState(format!(
+                "the machine is moving under {}: break control only at rest",
+                h.caller.describe()
+            )));
+        }
+        let text = format!(
+            "control of {} broken by {}: a new claim moves the machine after an acknowledgement at rest",
+            h.caller.describe(),
+            who.describe()
+        );
+        self.end_control(fault_code::CONTROL_ENDED, text);
+        Ok(lock_status::OK)
+    }
+
+    /// The session `session` closed (or the server timed it out): if it
+    /// held control, the machine stops and the fault latches.
+    pub fn session_closed(&mut self, session: u32) {
+        let holder = self.control.holder().map(|h| h.caller.clone());
+        if let Some(c) = holder.filter(|c| c.session == session) {
+            self.end_control(
                 fault_code::LINK_DROPPED,
-                "the workstation's connection dropped: motors ramped to zero".into(),
+                format!(
+                    "the controlling session of {} closed: motors ramped to zero",
+                    c.describe()
+                ),
             );
         }
     }
 
-    /// The acknowledge method: clears a latched fault once both motors are
-    /// at rest; the setpoints start from zero.
-    pub fn acknowledge(&mut self) -> Result<(), String> {
+    /// The acknowledge method, by `who` (any operator session): clears a
+    /// latched fault once both motors are at rest; the setpoints start
+    /// from zero. Closing `who`'s session afterwards changes nothing.
+    pub fn acknowledge(&mut self, who: &Caller) -> Result<(), String> {
         match &self.fault {
             None => Ok(()),
             Some(_) if !self.machine.at_rest() => {
@@ -452,7 +622,10 @@ impl Plc {
                 let text = text.clone();
                 self.fault = None;
                 self.setpoints = TrackCommand::STOP;
-                self.event("acknowledged", format!("fault cleared: {text}"));
+                self.event(
+                    "acknowledged",
+                    format!("fault cleared by {}: {text}", who.describe()),
+                );
                 Ok(())
             }
         }
@@ -525,13 +698,12 @@ impl Plc {
         let wall_dt = (wall_s - self.wall_s).max(0.0);
         self.wall_s = wall_s;
         if let Some(at) = self.heartbeat_at {
-            if self.fault.is_none() && wall_s - at > self.params.heartbeat_timeout.as_secs_f64() {
+            if wall_s - at > self.params.heartbeat_timeout.as_secs_f64() {
                 let age = (wall_s - at) * 1e3;
-                self.heartbeat_at = None;
-                self.latch(
+                self.end_control(
                     fault_code::HEARTBEAT_LOST,
                     format!(
-                        "heartbeat unchanged for {age:.0} ms (limit {:.0} ms): motors ramped to zero",
+                        "heartbeat unchanged for {age:.0} ms (limit {:.0} ms): motors ramped to zero, control released",
                         self.params.heartbeat_timeout.as_secs_f64() * 1e3
                     ),
                 );
@@ -590,27 +762,42 @@ mod tests {
 
     fn plc(clock: Clock) -> Plc {
         let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
-        Plc::new(PlcParams {
+        let mut p = Plc::new(PlcParams {
             setup: sc.setup,
             clock,
             heartbeat_timeout: HEARTBEAT_TIMEOUT,
             auto: true,
             schedule: Vec::new(),
-        })
+        });
+        assert_eq!(p.init_lock(&ws(), "test"), lock_status::OK);
+        p
+    }
+
+    /// The workstation's session.
+    fn ws() -> Caller {
+        caller(1, Some("operator"))
+    }
+
+    fn caller(session: u32, user: Option<&str>) -> Caller {
+        Caller {
+            session,
+            user: user.map(str::to_string),
+            client: format!("urn:test:{session}"),
+        }
     }
 
     #[test]
     fn the_watchdog_latches_and_only_an_acknowledgement_at_rest_clears_it() {
         let mut p = plc(Clock::Scaled(1.0));
-        p.write_heartbeat(1);
-        p.write_setpoint(false, 1000.0).unwrap();
-        p.write_setpoint(true, 1000.0).unwrap();
+        p.write_heartbeat(&ws(), 1).unwrap();
+        p.write_setpoint(&ws(), false, 1000.0).unwrap();
+        p.write_setpoint(&ws(), true, 1000.0).unwrap();
         // 0.24 s with heartbeats every 20 ms: moving, no fault.
         let mut t = 0.0;
         for k in 0..12 {
             t += 0.02;
             p.run_to(t);
-            p.write_heartbeat(2 + k);
+            p.write_heartbeat(&ws(), 2 + k).unwrap();
         }
         assert!(p.fault.is_none() && !p.machine.at_rest());
         // Silence: latched once the heartbeat is older than 250 ms, not before.
@@ -623,23 +810,33 @@ mod tests {
         assert!(waited > 0.25 && waited <= 0.252, "{waited}");
         assert_eq!(p.effective_command(), TrackCommand::STOP);
         // Still turning: the acknowledgement is refused.
-        assert!(p.acknowledge().is_err());
-        // New setpoints and heartbeats do not restart it.
-        p.write_heartbeat(100);
-        p.write_setpoint(false, 2000.0).unwrap();
-        for _ in 0..2000 {
+        assert!(p.acknowledge(&ws()).is_err());
+        // Control went with the heartbeat: the old holder's commands are
+        // refused; claimed again, its setpoints and heartbeats do not
+        // restart the machine.
+        assert!(p.control.holder().is_none());
+        assert_eq!(
+            p.write_setpoint(&ws(), false, 2000.0),
+            Err(Refusal::RequiresLock)
+        );
+        assert_eq!(p.init_lock(&ws(), "again"), lock_status::OK);
+        p.write_heartbeat(&ws(), 100).unwrap();
+        p.write_setpoint(&ws(), false, 2000.0).unwrap();
+        for k in 0..2000 {
             t += 0.001;
             p.run_to(t);
+            p.write_heartbeat(&ws(), 101 + k).unwrap();
         }
         assert!(p.machine.at_rest() && p.fault.is_some() && !p.moved_while_faulted());
         // The summary reads the same state: one fault latched and held,
         // the crawler moved, then stopped, never while faulted.
         let s = p.summary("fig9a", 7, "opc.tcp://here:1/");
         assert_eq!((s.faults_latched, s.seed, s.success), (1, 7, true));
+        assert_eq!(s.refused_writes, 1);
         assert_eq!(s.fault, p.fault.as_ref().map(|f| f.1.clone()));
         assert!(s.travelled_m > 0.0 && s.machine_time_s >= t - 1e-9);
         assert_eq!(s.events, p.events);
-        p.acknowledge().unwrap();
+        p.acknowledge(&ws()).unwrap();
         assert!(p.fault.is_none() && p.setpoints() == TrackCommand::STOP);
         assert_eq!(p.summary("fig9a", 7, "").fault, None);
     }
@@ -647,24 +844,24 @@ mod tests {
     #[test]
     fn nonsense_setpoints_are_refused_and_latch_a_fault() {
         let mut p = plc(Clock::Scaled(1.0));
-        p.write_heartbeat(1);
-        assert!(p.write_setpoint(true, f64::NAN).is_err());
+        p.write_heartbeat(&ws(), 1).unwrap();
+        assert!(p.write_setpoint(&ws(), true, f64::NAN).is_err());
         assert_eq!(
             p.fault.as_ref().map(|f| f.0),
             Some(fault_code::SETPOINT_REJECTED)
         );
         let mut p = plc(Clock::Scaled(1.0));
-        assert!(p.write_setpoint(false, 3000.1).is_err());
+        assert!(p.write_setpoint(&ws(), false, 3000.1).is_err());
         assert!(p.fault.is_some());
     }
 
     #[test]
     fn injected_rtk_faults_do_what_they_say() {
         let mut p = plc(Clock::Lockstep);
-        p.write_heartbeat(1);
+        p.write_heartbeat(&ws(), 1).unwrap();
         let step = |p: &mut Plc| {
             let s = p.step();
-            p.write_step_ack(s);
+            p.write_step_ack(&ws(), s).unwrap();
             p.run_to(0.0);
         };
         step(&mut p);
@@ -695,5 +892,118 @@ mod tests {
             (p.fix().unwrap().east_m - p.truth().0.x).abs() < 1e-9,
             "one fix only"
         );
+    }
+
+    /// Runs `p` for `secs` of wall time from `t`, the holder's heartbeat
+    /// every 20 ms; the new time.
+    fn hold(p: &mut Plc, mut t: f64, secs: f64, beat: &mut u32) -> f64 {
+        let end = t + secs;
+        while t < end {
+            t += 0.02;
+            p.run_to(t);
+            *beat += 1;
+            p.write_heartbeat(&ws(), *beat).unwrap();
+        }
+        t
+    }
+
+    #[test]
+    fn only_the_session_holding_control_moves_the_machine() {
+        let mut p = plc(Clock::Scaled(1.0));
+        let hmi = caller(7, None);
+        let second = caller(8, Some("operator"));
+        let mut beat = 0;
+        let mut t = hold(&mut p, 0.0, 0.1, &mut beat);
+        p.write_setpoint(&ws(), false, 1000.0).unwrap();
+        p.write_setpoint(&ws(), true, 1000.0).unwrap();
+        t = hold(&mut p, t, 0.5, &mut beat);
+        // A second operator session can neither claim nor command, and
+        // its heartbeats keep nothing alive; a reader closing changes nothing.
+        assert_eq!(
+            p.init_lock(&second, "take over"),
+            lock_status::ALREADY_LOCKED
+        );
+        for (who, what) in [(&second, "operator"), (&hmi, "anonymous")] {
+            assert!(
+                matches!(
+                    p.write_setpoint(who, false, -2000.0),
+                    Err(Refusal::Locked { .. })
+                ),
+                "{what}"
+            );
+            assert!(matches!(
+                p.write_heartbeat(who, 9),
+                Err(Refusal::Locked { .. })
+            ));
+            assert!(matches!(
+                p.write_step_ack(who, 1),
+                Err(Refusal::Locked { .. })
+            ));
+            assert!(matches!(p.exit_lock(who), Err(Refusal::Locked { .. })));
+            assert!(matches!(p.break_lock(who), Err(Refusal::InvalidState(_))));
+            p.session_closed(who.session);
+        }
+        assert_eq!(
+            p.setpoints(),
+            TrackCommand {
+                left_rpm: 1000.0,
+                right_rpm: 1000.0
+            }
+        );
+        assert!(p.fault.is_none());
+        assert_eq!(p.summary("straight", 1, "").refused_writes, 6);
+        let refused = p
+            .events
+            .iter()
+            .filter(|e| e.kind == "write-refused")
+            .count();
+        assert_eq!(refused, 6, "one event per session and kind");
+        // The holder frozen: the other session's heartbeats do not keep
+        // the machine moving.
+        let frozen = t;
+        while p.fault.is_none() {
+            t += 0.02;
+            p.run_to(t);
+            let _ = p.write_heartbeat(&second, (t * 1e3) as u32);
+        }
+        assert!(t - frozen <= 0.25 + 0.02 + 1e-9);
+        assert_eq!(p.fault.as_ref().unwrap().0, fault_code::HEARTBEAT_LOST);
+        // Now unheld: the second session claims, but moves nothing until a
+        // person acknowledges at rest, from any operator session.
+        assert_eq!(p.init_lock(&second, "take over"), lock_status::OK);
+        assert!(p.acknowledge(&ws()).is_err(), "still turning");
+        for k in 0..300 {
+            t += 0.02;
+            p.run_to(t);
+            p.write_heartbeat(&second, k).unwrap();
+        }
+        assert!(p.machine.at_rest() && !p.moved_while_faulted());
+        p.acknowledge(&hmi).unwrap();
+        // The old holder's session closing now changes nothing.
+        p.session_closed(ws().session);
+        assert!(p.fault.is_none());
+        // The holder's own session closing stops the machine.
+        p.session_closed(second.session);
+        assert_eq!(p.fault.as_ref().unwrap().0, fault_code::LINK_DROPPED);
+        assert!(p.control.holder().is_none());
+    }
+
+    #[test]
+    fn release_and_break_end_control_and_need_an_acknowledgement() {
+        let mut p = plc(Clock::Scaled(1.0));
+        let mut beat = 0;
+        let t = hold(&mut p, 0.0, 0.1, &mut beat);
+        assert_eq!(p.exit_lock(&ws()), Ok(lock_status::OK));
+        assert_eq!(p.fault.as_ref().unwrap().0, fault_code::CONTROL_ENDED);
+        assert_eq!(p.exit_lock(&ws()), Ok(lock_status::NOT_LOCKED));
+        p.acknowledge(&ws()).unwrap();
+        // Held but at rest: an operator may break it; a fault latches.
+        let other = caller(9, Some("operator"));
+        assert_eq!(p.init_lock(&ws(), "again"), lock_status::OK);
+        p.run_to(t + 0.05);
+        assert_eq!(p.break_lock(&other), Ok(lock_status::OK));
+        assert!(p.fault.is_some() && p.control.holder().is_none());
+        assert_eq!(p.break_lock(&other), Ok(lock_status::NOT_LOCKED));
+        assert_eq!(p.renew_lock(&other), Ok(lock_status::NOT_LOCKED));
     }
 }

@@ -3,8 +3,8 @@
 //! while (pulling the cable: nothing passes either way and nobody is told;
 //! bytes sent meanwhile arrive after, as TCP's retransmissions deliver them
 //! once the cable is back) or hold back the server's replies (a slow link). It passes bytes and knows nothing of the
-//! protocol; it tells the PLC when a workstation's connection ends, as a
-//! PLC's communication processor does.
+//! protocol, and tells the PLC nothing: a connection opening or closing is
+//! no command (a scanner, an HMI or a discovery probe does so all day).
 
 use std::net::SocketAddr;
 use std::sync::atomic::{AtomicU64, Ordering};
@@ -61,13 +61,8 @@ impl RelayControl {
     }
 }
 
-/// Starts a relay from `listener` to `upstream`; `on_close` is called each
-/// time a relayed connection ends.
-pub fn spawn(
-    listener: TcpListener,
-    upstream: SocketAddr,
-    on_close: Arc<dyn Fn() + Send + Sync>,
-) -> Arc<RelayControl> {
+/// Starts a relay from `listener` to `upstream`.
+pub fn spawn(listener: TcpListener, upstream: SocketAddr) -> Arc<RelayControl> {
     let control = Arc::new(RelayControl::new());
     let ctl = control.clone();
     tokio::spawn(async move {
@@ -76,14 +71,12 @@ pub fn spawn(
                 continue;
             };
             let ctl = ctl.clone();
-            let on_close = on_close.clone();
             tokio::spawn(async move {
                 ctl.wait_while_cut().await;
                 if let Ok(server) = TcpStream::connect(upstream).await {
                     pipe(client, server, &ctl).await;
                 }
                 ctl.closed.fetch_add(1, Ordering::Relaxed);
-                on_close();
             });
         }
     });

@@ -6,9 +6,11 @@
 //! SignAndEncrypt, with the PLC's application-instance certificate and a
 //! trust list (`pki/plc/trusted`); a client certificate not in the list is
 //! refused and copied to `pki/plc/rejected`. Security None is offered only
-//! with `insecure` (and then logged loudly). The operator's user name and
-//! password are needed to write and to call methods; an anonymous session
-//! may browse and read (an HMI's view), never write.
+//! with `insecure` (and then logged loudly), and only to anonymous sessions:
+//! a password never crosses an unencrypted channel. The operator's user
+//! name and password are needed to write and to call methods; an anonymous
+//! session may browse and read (an HMI's view), never write. Who may move
+//! the machine is [`crate::control`]'s: the one session holding control.
 
 use std::collections::BTreeMap;
 use std::net::SocketAddr;
@@ -20,8 +22,6 @@ use async_trait::async_trait;
 use opcua::crypto::{SecurityPolicy, Thumbprint};
 use opcua::server::address_space::{AccessLevel, MethodBuilder, VariableBuilder};
 use opcua::server::authenticator::{AuthManager, DefaultAuthenticator, Password, UserToken};
-use opcua::server::diagnostics::NamespaceMetadata;
-use opcua::server::node_manager::memory::{simple_node_manager, SimpleNodeManager};
 use opcua::server::{
     ServerBuilder, ServerEndpoint, ServerHandle, ServerUserToken, ANONYMOUS_USER_TOKEN_ID,
 };
@@ -32,8 +32,13 @@ use opcua::types::{
 use tokio::net::TcpListener;
 use tokio::time::Instant;
 
+use crate::control::{Caller, Refusal};
 use crate::error::LinkError;
-use crate::model::{self, Ty, Var, Writer, ACKNOWLEDGE, FOLDERS, INJECT_FAULT, NAMESPACE_URI};
+use crate::model::{
+    self, Ty, Var, Writer, ACKNOWLEDGE, BREAK_LOCK, EXIT_LOCK, FOLDERS, INIT_LOCK, INJECT_FAULT,
+    NAMESPACE_URI, RENEW_LOCK,
+};
+use crate::nodes::{shovel_node_manager, ShovelNodeManager};
 use crate::pki::{self, Role};
 use crate::plc::{FaultKind, Plc, PlcParams};
 use autoshovel_run_log::{topic, EventMsg, MotorsMsg, PoseMsg, RtkMsg, RunLog};
@@ -65,9 +70,18 @@ pub struct PlcServer {
     addr: SocketAddr,
     host: String,
     epoch_ticks: i64,
+    instance: String,
     wall0: Instant,
     loop_task: tokio::task::JoinHandle<()>,
     log: Arc<Mutex<Option<RunLog>>>,
+}
+
+/// A PLC start's identity: its start time (100 ns ticks), its process and
+/// its place among the PLCs this process started, so two starts never share one.
+fn instance_id(epoch_ticks: i64) -> String {
+    static STARTS: std::sync::atomic::AtomicU64 = std::sync::atomic::AtomicU64::new(0);
+    let n = STARTS.fetch_add(1, std::sync::atomic::Ordering::Relaxed);
+    format!("{epoch_ticks}-{}-{n}", std::process::id())
 }
 
 fn nid(ns: u16, id: &str) -> NodeId {
@@ -143,6 +157,7 @@ fn initial(ty: Ty) -> Variant {
         Ty::Boolean => Variant::Boolean(false),
         Ty::DateTime => Variant::DateTime(Box::new(DateTime::null())),
         Ty::String => Variant::String(UAString::from("")),
+        Ty::Duration => Variant::Double(0.0),
     }
 }
 
@@ -196,13 +211,7 @@ impl PlcServer {
             .host(serve.host.clone())
             .port(addr.port())
             .discovery_urls(vec![format!("opc.tcp://{}:{}/", serve.host, addr.port())])
-            .with_node_manager(simple_node_manager(
-                NamespaceMetadata {
-                    namespace_uri: NAMESPACE_URI.to_owned(),
-                    ..Default::default()
-                },
-                "shovel",
-            ))
+            .with_node_manager(shovel_node_manager(NAMESPACE_URI))
             .with_authenticator(Arc::new(PlcAuth {
                 inner: DefaultAuthenticator::new(users.clone()),
             }))
@@ -229,8 +238,10 @@ impl PlcServer {
             builder = builder.add_user_token(k, v);
         }
         if serve.insecure {
+            // Anonymous only: a user's password never crosses an
+            // unencrypted channel, so None can read, never command.
             eprintln!(
-                "plc-sim: WARNING: security None offered on {addr} (--insecure): setpoints travel unsigned and unencrypted"
+                "plc-sim: WARNING: security None offered on {addr} (--insecure), for anonymous reading only"
             );
             builder = builder.add_endpoint(
                 "none",
@@ -238,14 +249,14 @@ impl PlcServer {
                     "/",
                     SecurityPolicy::None,
                     MessageSecurityMode::None,
-                    &ids as &[&str],
+                    &[ANONYMOUS_USER_TOKEN_ID] as &[&str],
                 ),
             );
         }
         let (server, handle) = builder.build().map_err(serve_err)?;
         let manager = handle
             .node_managers()
-            .get_of_type::<SimpleNodeManager>()
+            .get_of_type::<ShovelNodeManager>()
             .ok_or_else(|| serve_err("node manager missing".into()))?;
         let ns = handle
             .get_namespace_index(NAMESPACE_URI)
@@ -255,14 +266,12 @@ impl PlcServer {
         build_address_space(&manager, ns, &plc);
 
         tokio::spawn(server.run_with(inner));
-        let plc_c = plc.clone();
-        let relay = crate::relay::spawn(
-            public,
-            inner_addr,
-            Arc::new(move || lock(&plc_c).link_dropped()),
-        );
+        // Connections opening and closing tell the PLC nothing: only the
+        // controlling session's heartbeat and its session's end count.
+        let relay = crate::relay::spawn(public, inner_addr);
 
         let epoch_ticks = DateTime::now().ticks();
+        let instance = instance_id(epoch_ticks);
         let wall0 = Instant::now();
         let log = Arc::new(Mutex::new(log.map(|mut l| {
             l.set_origin_ticks(epoch_ticks);
@@ -274,7 +283,7 @@ impl PlcServer {
             handle.clone(),
             ns,
             relay.clone(),
-            epoch_ticks,
+            (epoch_ticks, instance.clone()),
             wall0,
             log.clone(),
         ));
@@ -285,10 +294,16 @@ impl PlcServer {
             addr,
             host: serve.host,
             epoch_ticks,
+            instance,
             wall0,
             loop_task,
             log,
         })
+    }
+
+    /// This start's identity (`Shovel.InstanceId`).
+    pub fn instance_id(&self) -> &str {
+        &self.instance
     }
 
     /// The endpoint URL.
@@ -333,7 +348,7 @@ impl PlcServer {
     }
 }
 
-fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mutex<Plc>>) {
+fn build_address_space(manager: &Arc<ShovelNodeManager>, ns: u16, plc: &Arc<Mutex<Plc>>) {
     {
         let space = manager.address_space();
         let mut space = space.write();
@@ -400,57 +415,125 @@ fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mute
             ],
         )
         .insert(&mut *space);
+        for (id, _) in model::LOCK_METHODS {
+            let name = model::leaf(id);
+            let mut b = MethodBuilder::new(&nid(ns, id), QualifiedName::new(ns, name), name)
+                .component_of(nid(ns, model::parent(id)))
+                .executable(true)
+                .user_executable(true);
+            if *id == INIT_LOCK {
+                b = b.input_args(
+                    &mut *space,
+                    &nid(ns, &format!("{id}.InputArguments")),
+                    &[("Context", DataTypeId::String).into()],
+                );
+            }
+            b.output_args(
+                &mut *space,
+                &nid(ns, &format!("{id}.OutputArguments")),
+                &[(format!("{name}Status").as_str(), DataTypeId::Int32).into()],
+            )
+            .insert(&mut *space);
+        }
     }
     let inner = manager.inner();
-    for (var, right) in [(Var::LeftSetpoint, false), (Var::RightSetpoint, true)] {
-        let p = plc.clone();
-        inner.add_write_callback(nid(ns, model::spec(var).id), move |dv, _| match dv.value {
-            Some(Variant::Double(v)) => match lock(&p).write_setpoint(right, v) {
-                Ok(()) => StatusCode::Good,
-                Err(_) => StatusCode::BadOutOfRange,
-            },
-            _ => StatusCode::BadTypeMismatch,
-        });
-    }
-    let p = plc.clone();
-    inner.add_write_callback(
-        nid(ns, model::spec(Var::Heartbeat).id),
-        move |dv, _| match dv.value {
-            Some(Variant::UInt32(v)) => {
-                lock(&p).write_heartbeat(v);
-                StatusCode::Good
-            }
-            _ => StatusCode::BadTypeMismatch,
-        },
-    );
-    let p = plc.clone();
-    inner.add_write_callback(
-        nid(ns, model::spec(Var::SimStepAck).id),
-        move |dv, _| match dv.value {
-            Some(Variant::UInt64(v)) => {
-                lock(&p).write_step_ack(v);
-                StatusCode::Good
-            }
-            _ => StatusCode::BadTypeMismatch,
-        },
-    );
-    let p = plc.clone();
-    inner.add_method_callback(nid(ns, ACKNOWLEDGE), move |_| {
-        lock(&p)
-            .acknowledge()
-            .map(|_| Vec::new())
-            .map_err(|_| StatusCode::BadInvalidState)
-    });
-    let p = plc.clone();
-    inner.add_method_callback(nid(ns, INJECT_FAULT), move |args| {
-        let (Some(Variant::String(kind)), Some(Variant::Double(v))) = (args.first(), args.get(1))
-        else {
-            return Err(StatusCode::BadInvalidArgument);
+    let on_write =
+        |var: Var, f: Box<dyn Fn(&mut Plc, &Caller, &Variant) -> StatusCode + Send + Sync>| {
+            let p = plc.clone();
+            inner.on_write(
+                nid(ns, model::spec(var).id),
+                Box::new(move |who, v| f(&mut lock(&p), who, v)),
+            );
         };
-        let f = FaultKind::parse(kind.as_ref(), *v).map_err(|_| StatusCode::BadInvalidArgument)?;
-        lock(&p).inject(f);
-        Ok(Vec::new())
-    });
+    for (var, right) in [(Var::LeftSetpoint, false), (Var::RightSetpoint, true)] {
+        on_write(
+            var,
+            Box::new(move |p, who, v| match v {
+                Variant::Double(v) => status(p.write_setpoint(who, right, *v)),
+                _ => StatusCode::BadTypeMismatch,
+            }),
+        );
+    }
+    on_write(
+        Var::Heartbeat,
+        Box::new(|p, who, v| match v {
+            Variant::UInt32(v) => status(p.write_heartbeat(who, *v)),
+            _ => StatusCode::BadTypeMismatch,
+        }),
+    );
+    on_write(
+        Var::SimStepAck,
+        Box::new(|p, who, v| match v {
+            Variant::UInt64(v) => status(p.write_step_ack(who, *v)),
+            _ => StatusCode::BadTypeMismatch,
+        }),
+    );
+    let on_call = |id: &str,
+                   f: Box<
+        dyn Fn(&mut Plc, &Caller, &[Variant]) -> Result<Vec<Variant>, StatusCode> + Send + Sync,
+    >| {
+        let p = plc.clone();
+        inner.on_call(
+            nid(ns, id),
+            Box::new(move |who, args| f(&mut lock(&p), who, args)),
+        );
+    };
+    on_call(
+        ACKNOWLEDGE,
+        Box::new(|p, who, _| {
+            p.acknowledge(who)
+                .map(|_| Vec::new())
+                .map_err(|_| StatusCode::BadInvalidState)
+        }),
+    );
+    on_call(
+        INIT_LOCK,
+        Box::new(|p, who, args| match args.first() {
+            Some(Variant::String(context)) => {
+                Ok(vec![Variant::Int32(p.init_lock(who, context.as_ref()))])
+            }
+            _ => Err(StatusCode::BadInvalidArgument),
+        }),
+    );
+    type LockCall = fn(&mut Plc, &Caller) -> Result<i32, Refusal>;
+    for (id, f) in [
+        (RENEW_LOCK, Plc::renew_lock as LockCall),
+        (EXIT_LOCK, Plc::exit_lock),
+        (BREAK_LOCK, Plc::break_lock),
+    ] {
+        on_call(
+            id,
+            Box::new(move |p, who, _| match f(p, who) {
+                Ok(s) => Ok(vec![Variant::Int32(s)]),
+                Err(e) => Err(status(Err(e))),
+            }),
+        );
+    }
+    on_call(
+        INJECT_FAULT,
+        Box::new(|p, _, args| {
+            let (Some(Variant::String(kind)), Some(Variant::Double(v))) =
+                (args.first(), args.get(1))
+            else {
+                return Err(StatusCode::BadInvalidArgument);
+            };
+            let f =
+                FaultKind::parse(kind.as_ref(), *v).map_err(|_| StatusCode::BadInvalidArgument)?;
+            p.inject(f);
+            Ok(Vec::new())
+        }),
+    );
+}
+
+/// The OPC UA status of a command's outcome.
+fn status(r: Result<(), Refusal>) -> StatusCode {
+    match r {
+        Ok(()) => StatusCode::Good,
+        Err(Refusal::RequiresLock) => StatusCode::BadRequiresLock,
+        Err(Refusal::Locked { .. }) => StatusCode::BadLocked,
+        Err(Refusal::OutOfRange(_)) => StatusCode::BadOutOfRange,
+        Err(Refusal::InvalidState(_)) => StatusCode::BadInvalidState,
+    }
 }
 
 // The loop's eight inputs are the server's parts it publishes; a struct
@@ -458,11 +541,11 @@ fn build_address_space(manager: &Arc<SimpleNodeManager>, ns: u16, plc: &Arc<Mute
 #[allow(clippy::too_many_arguments)]
 async fn run_loop(
     plc: Arc<Mutex<Plc>>,
-    manager: Arc<SimpleNodeManager>,
+    manager: Arc<ShovelNodeManager>,
     handle: ServerHandle,
     ns: u16,
     relay: Arc<crate::relay::RelayControl>,
-    epoch_ticks: i64,
+    (epoch_ticks, instance): (i64, String),
     wall0: Instant,
     log: Arc<Mutex<Option<RunLog>>>,
 ) {
@@ -481,6 +564,12 @@ async fn run_loop(
         let network;
         {
             let mut p = lock(&plc);
+            // The controlling session closed or timed out: the machine stops.
+            if let Some(h) = p.control.holder().map(|h| h.caller.session) {
+                if manager.inner().session_open(h) == Some(false) {
+                    p.session_closed(h);
+                }
+            }
             p.run_to(wall0.elapsed().as_secs_f64());
             network = std::mem::take(&mut p.network);
             let t = p.machine.time_s();
@@ -512,6 +601,30 @@ async fn run_loop(
                 ),
                 (Var::SimStep, Variant::UInt64(p.step())),
             ]);
+            let holder = p.control.holder();
+            values.extend([
+                (Var::Locked, Variant::Boolean(holder.is_some())),
+                (
+                    Var::LockingClient,
+                    Variant::String(UAString::from(
+                        holder
+                            .map(|h| format!("{} (session {})", h.caller.client, h.caller.session))
+                            .unwrap_or_default(),
+                    )),
+                ),
+                (
+                    Var::LockingUser,
+                    Variant::String(UAString::from(
+                        holder
+                            .and_then(|h| h.caller.user.clone())
+                            .unwrap_or_default(),
+                    )),
+                ),
+                (
+                    Var::RemainingLockTime,
+                    Variant::Double(p.lock_remaining_s().unwrap_or(0.0) * 1e3),
+                ),
+            ]);
             let (truth, travelled) = p.truth();
             values.extend([
                 (Var::SimTrueX, Variant::Double(truth.x)),
@@ -523,6 +636,10 @@ async fn run_loop(
                 let c = p.params.setup.crawler;
                 values.push((Var::MaxSpeed, Variant::Double(c.motor_max_rpm)));
                 values.push((Var::MaxAccel, Variant::Double(c.motor_max_accel_rpm_per_s)));
+                values.push((
+                    Var::InstanceId,
+                    Variant::String(UAString::from(instance.as_str())),
+                ));
                 published_once = true;
             }
             let fix_changed = p.take_fix_changed();
@@ -600,8 +717,12 @@ fn log_machine(
             },
         )?;
     }
+    let new_events = *logged_events < p.events.len();
     *logged_events = p.events.len();
     if !fix_changed {
+        if new_events {
+            l.sync()?;
+        }
         return Ok(());
     }
     if let Some(f) = p.fix() {
@@ -649,5 +770,7 @@ fn log_machine(
             ],
         },
     )?;
+    // Durable each fix: a killed plc-sim leaves its log readable.
+    l.sync()?;
     Ok(())
 }

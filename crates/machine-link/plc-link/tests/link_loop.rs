@@ -78,6 +78,15 @@ fn real_time() -> std::sync::MutexGuard<'static, ()> {
         .unwrap_or_else(std::sync::PoisonError::into_inner)
 }
 
+/// A person at the machine, acknowledging (as `plc-ack` would, from its own session).
+fn person() -> autoshovel_plc_link::Caller {
+    autoshovel_plc_link::Caller {
+        session: u32::MAX,
+        user: Some(pki::OPERATOR.into()),
+        client: "the test, at the machine".into(),
+    }
+}
+
 fn rt() -> tokio::runtime::Runtime {
     tokio::runtime::Builder::new_multi_thread()
         .worker_threads(2)
@@ -276,7 +285,7 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
                         "cut {i}: never sped up while faulted"
                     );
                 }
-                plc.lock().unwrap().acknowledge().unwrap();
+                plc.lock().unwrap().acknowledge(&person()).unwrap();
             }
             stop.store(true, std::sync::atomic::Ordering::Relaxed);
             lat

@@ -9,10 +9,12 @@
 //! OPC UA stack in.
 
 mod error;
+pub mod read;
 pub mod record;
 pub mod replay;
 
 pub use error::RunLogError;
+pub use read::{read_messages, LogEnd};
 pub use record::{
     topic, EndMsg, EventMsg, LegMsg, MotorsMsg, PathMsg, PoseMsg, RtkMsg, RunLog, TickMsg,
     UNIX_EPOCH_TICKS,

@@ -6,8 +6,10 @@
 //! setpoints, readings and events. [`crate::replay`] reads the drive's log
 //! back into the tracking metrics.
 //!
-//! Written uncompressed (no C compression libraries to build); MCAP's
-//! indexes and summary are kept, so readers seek by time.
+//! Written uncompressed (no C compression libraries to build), in chunks
+//! with CRCs closed each control period ([`RunLog::sync`]): a writer killed
+//! mid-run leaves a log readable up to its last period. MCAP's indexes and
+//! summary are kept, so readers seek by time.
 
 use std::collections::BTreeMap;
 use std::fs::File;
@@ -185,6 +187,8 @@ pub struct RunLog {
     path: PathBuf,
     /// Unix time of the run's t = 0 (ns).
     pub origin_ns: u64,
+    /// The latest run time written (s).
+    last_t_s: f64,
 }
 
 fn write_err(path: &Path, source: mcap::McapError) -> RunLogError {
@@ -218,8 +222,12 @@ impl RunLog {
                 RunLogError::Io { path, source }
             }
         })?;
+        // Chunks carry CRCs; [`RunLog::sync`] closes one each control
+        // period, so a killed writer leaves every period but the last whole.
         let opts = mcap::WriteOptions::new()
             .compression(None)
+            .calculate_chunk_crcs(true)
+            .calculate_data_section_crc(true)
             .profile("")
             .library(format!("autoshovel {}", env!("CARGO_PKG_VERSION")));
         let mut w = opts
@@ -239,6 +247,7 @@ impl RunLog {
             seq: 0,
             path: path.to_path_buf(),
             origin_ns: 0,
+            last_t_s: 0.0,
         })
     }
 
@@ -276,6 +285,9 @@ impl RunLog {
             path: self.path.clone(),
             source,
         })?;
+        if t_s.is_finite() {
+            self.last_t_s = self.last_t_s.max(t_s);
+        }
         let t = self
             .origin_ns
             .saturating_add((t_s.max(0.0) * 1e9).round() as u64);
@@ -291,6 +303,18 @@ impl RunLog {
                 &data,
             )
             .map_err(|e| write_err(&self.path, e))
+    }
+
+    /// The latest run time written (s).
+    pub fn last_t_s(&self) -> f64 {
+        self.last_t_s
+    }
+
+    /// Makes what was written so far durable: closes the open chunk (with
+    /// its CRC) and hands it to the operating system, so that a process
+    /// killed after this leaves it readable ([`crate::read`]).
+    pub fn sync(&mut self) -> Result<(), RunLogError> {
+        self.w.flush().map_err(|e| write_err(&self.path, e))
     }
 
     /// Writes the summary and index and closes the file.

@@ -13,6 +13,7 @@ use autoshovel_walk_tracker::{deviations, RefLeg, RtkFix, TrackCommand};
 use serde::Serialize;
 
 use crate::error::RunLogError;
+use crate::read::{read_messages, LogEnd};
 use crate::record::{topic, EventMsg, PathMsg, PoseMsg, TickMsg};
 
 /// The part of the end message replay needs.
@@ -35,6 +36,11 @@ pub struct Replay {
     pub measured_on: &'static str,
     /// Where the record came from.
     pub source: String,
+    /// For a log its writer never closed (killed, power lost): the bytes
+    /// read as whole records, up to which it was replayed.
+    pub cut: Option<u64>,
+    /// Why the run ended, as its last `end` event says.
+    pub ended: Option<String>,
 }
 
 fn err(path: &Path, why: impl Into<String>) -> RunLogError {
@@ -81,36 +87,50 @@ fn setup_with(legs: Vec<RefLeg>, start: Pose2) -> Setup {
     }
 }
 
-/// Replays a `drive` MCAP log.
+/// Replays a `drive` MCAP log, read record by record ([`crate::read`]):
+/// the path first, then every decision measured as it comes. A log whose
+/// writer was killed is replayed up to its last whole chunk, and the
+/// replay says it was cut.
 pub fn replay_mcap(path: &Path) -> Result<Replay, RunLogError> {
-    let bytes = std::fs::read(path).map_err(|source| io_err(path, source))?;
-    let stream = mcap::MessageStream::new(&bytes).map_err(|source| RunLogError::McapRead {
-        path: path.to_path_buf(),
-        what: "not an MCAP file",
-        source,
-    })?;
-    let mut path_msg: Option<PathMsg> = None;
-    let mut ticks: Vec<TickMsg> = Vec::new();
+    let mut legs: Option<Vec<RefLeg>> = None;
+    let mut eval = Evaluator::new();
+    let mut samples: Vec<Sample> = Vec::new();
+    let mut last: Option<TickMsg> = None;
+    let mut truth_all = true;
     let mut events: Vec<Event> = Vec::new();
+    let mut ended: Option<String> = None;
     let mut end_msg: Option<(f64, PoseMsg, f64, bool)> = None;
-    for m in stream {
-        let m = m.map_err(|source| RunLogError::McapRead {
-            path: path.to_path_buf(),
-            what: "damaged MCAP",
-            source,
-        })?;
-        let topic_name = m.channel.topic.as_str();
+    let end = read_messages(path, |topic_name, sequence, data| {
         let bad = |source: serde_json::Error| RunLogError::Message {
             path: path.to_path_buf(),
             topic: topic_name.to_string(),
-            sequence: m.sequence,
+            sequence,
             source,
         };
         match topic_name {
-            topic::PATH => path_msg = Some(serde_json::from_slice(&m.data).map_err(bad)?),
-            topic::TICK => ticks.push(serde_json::from_slice(&m.data).map_err(bad)?),
+            topic::PATH => {
+                let msg: PathMsg = serde_json::from_slice(data).map_err(bad)?;
+                legs = Some(legs_of(&msg, path)?);
+            }
+            topic::TICK => {
+                let t: TickMsg = serde_json::from_slice(data).map_err(bad)?;
+                let legs = legs.as_ref().ok_or_else(|| {
+                    err(path, format!("message {sequence}: a tick before the path"))
+                })?;
+                check_tick(&t, legs.len()).map_err(|why| {
+                    err(path, format!("message {sequence} on {topic_name}: {why}"))
+                })?;
+                let d = decision(legs, &t);
+                truth_all &= t.truth.is_some();
+                let truth: Pose2 = t.truth.unwrap_or(t.measured).into();
+                samples.push(eval.sample(legs, &d, t.t_s, truth, t.travelled_m));
+                last = Some(t);
+            }
             topic::EVENT => {
-                let e: EventMsg = serde_json::from_slice(&m.data).map_err(bad)?;
+                let e: EventMsg = serde_json::from_slice(data).map_err(bad)?;
+                if e.kind == "end" {
+                    ended = Some(e.message.clone());
+                }
                 if e.source == "workstation" {
                     events.push(Event {
                         t_s: e.t_s,
@@ -120,35 +140,20 @@ pub fn replay_mcap(path: &Path) -> Result<Replay, RunLogError> {
                 }
             }
             topic::SUMMARY => {
-                let v: EndIn = serde_json::from_slice(&m.data).map_err(bad)?;
+                let v: EndIn = serde_json::from_slice(data).map_err(bad)?;
                 end_msg = Some((v.t_s, v.end, v.travelled_m, v.completed));
             }
             _ => {}
         }
-    }
-    let path_msg = path_msg
-        .ok_or_else(|| err(path, format!("no {} message: not a drive log", topic::PATH)))?;
-    let legs = legs_of(&path_msg, path)?;
-    if ticks.is_empty() {
+        Ok(())
+    })?;
+    let legs =
+        legs.ok_or_else(|| err(path, format!("no {} message: not a drive log", topic::PATH)))?;
+    let Some(last) = last else {
         return Err(err(path, format!("no {} messages", topic::TICK)));
-    }
-    let truth_all = ticks.iter().all(|t| t.truth.is_some());
-    let mut eval = Evaluator::new();
-    let mut samples: Vec<Sample> = Vec::with_capacity(ticks.len());
-    for t in &ticks {
-        if t.leg >= legs.len() {
-            return Err(err(
-                path,
-                format!("tick at {} s names leg {} of {}", t.t_s, t.leg, legs.len()),
-            ));
-        }
-        let d = decision(&legs, t);
-        let truth: Pose2 = t.truth.unwrap_or(t.measured).into();
-        samples.push(eval.sample(&legs, &d, t.t_s, truth, t.travelled_m));
-    }
+    };
     // The end as the drive recorded it; a log cut short ends at its last tick.
-    let last = ticks.last().expect("not empty");
-    let (t_end, end, travelled, completed) = end_msg.unwrap_or_else(|| {
+    let (t_end, end_pose, travelled, completed) = end_msg.unwrap_or_else(|| {
         (
             last.t_s,
             last.truth.unwrap_or(last.measured),
@@ -157,7 +162,14 @@ pub fn replay_mcap(path: &Path) -> Result<Replay, RunLogError> {
         )
     });
     let setup = setup_with(legs.clone(), samples[0].truth);
-    let metrics = measure(&samples, &setup, end.into(), travelled, t_end, completed);
+    let metrics = measure(
+        &samples,
+        &setup,
+        end_pose.into(),
+        travelled,
+        t_end,
+        completed,
+    );
     Ok(Replay {
         run: Run {
             samples,
@@ -171,7 +183,31 @@ pub fn replay_mcap(path: &Path) -> Result<Replay, RunLogError> {
             "rtk fixes"
         },
         source: path.display().to_string(),
+        cut: match end {
+            LogEnd::Complete => None,
+            LogEnd::Cut { bytes } => Some(bytes),
+        },
+        ended,
     })
+}
+
+/// What a tick must be to be measured: its leg on the path, its numbers finite.
+fn check_tick(t: &TickMsg, legs: usize) -> Result<(), String> {
+    if t.leg >= legs {
+        return Err(format!("tick at {} s names leg {} of {legs}", t.t_s, t.leg));
+    }
+    let poses = [Some(t.measured), t.truth].into_iter().flatten();
+    let finite = [t.t_s, t.travelled_m, t.d_m, t.d0_m]
+        .into_iter()
+        .chain(poses.flat_map(|p| [p.x, p.y, p.theta]))
+        .all(f64::is_finite);
+    if !finite {
+        return Err(format!(
+            "tick at {} s holds a number that is not finite",
+            t.t_s
+        ));
+    }
+    Ok(())
 }
 
 fn decision(legs: &[RefLeg], t: &TickMsg) -> Decision {
@@ -281,6 +317,16 @@ pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, RunLogError> {
                 })
         };
         let t = num(ct, "t_s")?;
+        let (east, north) = (num(ce, "east_m")?, num(cn, "north_m")?);
+        if east.abs().max(north.abs()) > COORD_LIMIT_M {
+            return Err(err(
+                path,
+                format!(
+                    "line {}: east {east} m, north {north} m lies beyond any projected grid (|x| ≤ {COORD_LIMIT_M:e} m)",
+                    i + 1
+                ),
+            ));
+        }
         if let Some(prev) = rows.last().map(|r: &TrackRow| r.t_s) {
             if t <= prev {
                 return Err(err(
@@ -296,8 +342,8 @@ pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, RunLogError> {
             t_s: t,
             fix: RtkFix {
                 time_s: t,
-                east_m: num(ce, "east_m")?,
-                north_m: num(cn, "north_m")?,
+                east_m: east,
+                north_m: north,
                 heading_north_cw_rad: num(ch, "heading_deg")?.to_radians(),
             },
         });
@@ -311,10 +357,40 @@ pub fn read_rtk_csv(path: &Path) -> Result<Vec<TrackRow>, RunLogError> {
 /// A run is complete when its last fix is within this of the path's end (m).
 pub const COMPLETE_WITHIN_M: f64 = 0.5;
 
+/// The largest coordinate a fix may have (m): UTM northings stay below
+/// 10 000 km, and every projected grid in use within that.
+pub const COORD_LIMIT_M: f64 = 1e7;
+
+/// A track is replayed against a path only if its first fix lies within
+/// this of the path's start (m): farther, it is another walk's track or
+/// another path.
+pub const START_WITHIN_M: f64 = 10.0;
+
 /// Replays a real machine's RTK track (`read_rtk_csv`) against `legs`: each
 /// fix is measured against the leg the machine is on (the next leg takes
 /// over once the fix is nearer to it and the current one is run to its end).
-pub fn replay_rtk(rows: &[TrackRow], legs: Vec<RefLeg>, source: &str) -> Replay {
+///
+/// Refused when the track does not start on the path (its first fix farther
+/// than [`START_WITHIN_M`] from the path's start) or a metric comes out not finite.
+pub fn replay_rtk(
+    rows: &[TrackRow],
+    legs: Vec<RefLeg>,
+    source: &str,
+) -> Result<Replay, RunLogError> {
+    let path = Path::new(source);
+    let (Some(first), Some(start)) = (rows.first(), legs.first().and_then(|l| l.points.first()))
+    else {
+        return Err(err(path, "no fixes, or a path without points"));
+    };
+    let off = (first.fix.to_pose().position() - *start).norm();
+    if !(off <= START_WITHIN_M) {
+        return Err(err(
+            path,
+            format!(
+                "the track's first fix is {off:.1} m from the path's start (limit {START_WITHIN_M} m): is this the walk's own --path?"
+            ),
+        ));
+    }
     let mut eval = Evaluator::new();
     let mut samples = Vec::with_capacity(rows.len());
     let mut leg = 0usize;
@@ -356,7 +432,18 @@ pub fn replay_rtk(rows: &[TrackRow], legs: Vec<RefLeg>, source: &str) -> Replay 
     let setup = setup_with(legs.clone(), samples[0].truth);
     let t_end = rows.last().map(|r| r.t_s).unwrap_or(0.0) - rows[0].t_s;
     let metrics = measure(&samples, &setup, end, travelled, t_end, completed);
-    Replay {
+    let numbers = [
+        metrics.max_centroid_dev_m,
+        metrics.mean_centroid_dev_m,
+        metrics.final_position_error_m,
+    ];
+    if !numbers.iter().all(|x| x.is_finite()) {
+        return Err(err(
+            path,
+            format!("the deviations from the path are not finite ({numbers:?}): the track does not follow this path"),
+        ));
+    }
+    Ok(Replay {
         run: Run {
             samples,
             events: Vec::new(),
@@ -365,7 +452,9 @@ pub fn replay_rtk(rows: &[TrackRow], legs: Vec<RefLeg>, source: &str) -> Replay 
         legs,
         measured_on: "rtk fixes",
         source: source.to_string(),
-    }
+        cut: None,
+        ended: None,
+    })
 }
 
 /// The `replay` job's summary.
@@ -384,6 +473,11 @@ pub struct ReplaySummary {
     pub events: Vec<Event>,
     /// Whether the run completed.
     pub success: bool,
+    /// The log was cut (its writer never closed it): replayed up to its
+    /// last whole record.
+    pub cut: bool,
+    /// Why the run ended, as the log's `end` event says (None: no such event).
+    pub ended: Option<String>,
 }
 
 impl Replay {
@@ -396,6 +490,8 @@ impl Replay {
             metrics: self.run.metrics,
             events: self.run.events.clone(),
             success: self.run.metrics.completed,
+            cut: self.cut.is_some(),
+            ended: self.ended.clone(),
         }
     }
 }
