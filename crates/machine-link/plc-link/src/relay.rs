@@ -25,6 +25,8 @@ pub struct RelayControl {
     delay_us: AtomicU64,
     /// Number of connections that have ended (either side, or cut).
     pub closed: AtomicU64,
+    /// Set once: the relay stops listening and drops every connection.
+    shutdown: watch::Sender<bool>,
 }
 
 impl RelayControl {
@@ -33,7 +35,18 @@ impl RelayControl {
             cut_until: watch::channel(None).0,
             delay_us: AtomicU64::new(0),
             closed: AtomicU64::new(0),
+            shutdown: watch::channel(false).0,
         }
+    }
+
+    /// Stops listening and drops every connection (the PLC is gone).
+    pub fn shut_down(&self) {
+        self.shutdown.send_replace(true);
+    }
+
+    async fn until_shut_down(&self) {
+        let mut rx = self.shutdown.subscribe();
+        let _ = rx.wait_for(|down| *down).await;
     }
 
     /// Cuts the link now for `d`: nothing passes either way until then.
@@ -61,26 +74,40 @@ impl RelayControl {
     }
 }
 
-/// Starts a relay from `listener` to `upstream`.
-pub fn spawn(listener: TcpListener, upstream: SocketAddr) -> Arc<RelayControl> {
+/// Starts a relay from `listener` to `upstream`; its switches, and the
+/// task that listens (done once [`RelayControl::shut_down`] has freed the port).
+pub fn spawn(
+    listener: TcpListener,
+    upstream: SocketAddr,
+) -> (Arc<RelayControl>, tokio::task::JoinHandle<()>) {
     let control = Arc::new(RelayControl::new());
     let ctl = control.clone();
-    tokio::spawn(async move {
+    let task = tokio::spawn(async move {
         loop {
-            let Ok((client, _)) = listener.accept().await else {
+            let accepted = tokio::select! {
+                a = listener.accept() => a,
+                () = ctl.until_shut_down() => return,
+            };
+            let Ok((client, _)) = accepted else {
                 continue;
             };
             let ctl = ctl.clone();
             tokio::spawn(async move {
-                ctl.wait_while_cut().await;
-                if let Ok(server) = TcpStream::connect(upstream).await {
-                    pipe(client, server, &ctl).await;
+                let relayed = async {
+                    ctl.wait_while_cut().await;
+                    if let Ok(server) = TcpStream::connect(upstream).await {
+                        pipe(client, server, &ctl).await;
+                    }
+                };
+                tokio::select! {
+                    () = relayed => {}
+                    () = ctl.until_shut_down() => {}
                 }
                 ctl.closed.fetch_add(1, Ordering::Relaxed);
             });
         }
     });
-    control
+    (control, task)
 }
 
 async fn pipe(client: TcpStream, server: TcpStream, ctl: &RelayControl) {

@@ -73,6 +73,7 @@ pub struct PlcServer {
     instance: String,
     wall0: Instant,
     loop_task: tokio::task::JoinHandle<()>,
+    relay_task: tokio::task::JoinHandle<()>,
     log: Arc<Mutex<Option<RunLog>>>,
 }
 
@@ -268,7 +269,7 @@ impl PlcServer {
         tokio::spawn(server.run_with(inner));
         // Connections opening and closing tell the PLC nothing: only the
         // controlling session's heartbeat and its session's end count.
-        let relay = crate::relay::spawn(public, inner_addr);
+        let (relay, relay_task) = crate::relay::spawn(public, inner_addr);
 
         let epoch_ticks = DateTime::now().ticks();
         let instance = instance_id(epoch_ticks);
@@ -297,6 +298,7 @@ impl PlcServer {
             instance,
             wall0,
             loop_task,
+            relay_task,
             log,
         })
     }
@@ -336,12 +338,13 @@ impl PlcServer {
         self.relay.cut(d);
     }
 
-    /// Stops the server.
-    /// Stops the server; finishes the log (its path, or the error that
+    /// Stops the server (its port is free again once this returns); finishes the log (its path, or the error that
     /// stopped it) when there is one.
     pub async fn stop(self) -> Option<Result<std::path::PathBuf, LinkError>> {
         self.loop_task.abort();
         let _ = self.loop_task.await;
+        self.relay.shut_down();
+        let _ = self.relay_task.await;
         self.handle.cancel();
         let log = self.log.lock().unwrap_or_else(|e| e.into_inner()).take();
         log.map(|l| Ok(l.finish()?))

@@ -33,6 +33,9 @@ fn python() -> Option<String> {
     match (ok, set) {
         (true, _) => Some(py),
         (false, Some(p)) => panic!("AUTOSHOVEL_PYTHON={p} cannot import asyncua"),
+        (false, None) if std::env::var_os("CI").is_some() => {
+            panic!("CI: python3 has no asyncua; CI installs the peers (.ci/run sets AUTOSHOVEL_PYTHON)")
+        }
         (false, None) => {
             eprintln!(
                 "SKIPPED: python3 has no asyncua (pip install asyncua, or run .ci/run, which sets AUTOSHOVEL_PYTHON)"
@@ -138,9 +141,16 @@ fn python_asyncua_client_browses_reads_and_writes_securely() {
             let fix = plc.fix().unwrap();
             assert_eq!(v["east_m"].as_f64().unwrap(), fix.east_m);
             assert_eq!(v["quality"], 4);
-            // The operator's write was taken; the out-of-range one was refused
-            // and latched a fault, which zeroed the setpoints.
+            // Before claiming control the operator's write changes
+            // nothing; after InitLock it is taken; the out-of-range one was
+            // refused and latched a fault, which zeroed the setpoints.
+            assert_eq!(v["write_unclaimed"], "BadRequiresLock", "{v}");
+            assert_eq!(v["init_lock"], 0, "{v}");
+            assert_eq!(v["locking_user"], "operator", "{v}");
             assert_eq!(v["write_in_range"], "Good");
+            // A second operator session neither claims nor commands.
+            assert_eq!(v["second_init_lock"], -1, "{v}");
+            assert_eq!(v["second_write"], "BadLocked", "{v}");
             assert_eq!(plc.setpoints().left_rpm, 0.0, "cleared by the fault");
             assert_eq!(v["write_out_of_range"], "BadOutOfRange");
             assert_eq!(v["fault_after"], true);

@@ -3,8 +3,10 @@
 Usage: ua_client.py ENDPOINT PKI_ROOT PASSWORD
 Connects with Basic256Sha256 SignAndEncrypt presenting the workstation's
 certificate (pki/workstation), checks the server's against pki/plc, browses
-the model, reads the RTK pose, writes a setpoint as the operator, tries an
-out-of-range setpoint and an anonymous write, and prints what it saw as JSON.
+the model, reads the RTK pose, writes a setpoint as the operator before and
+after claiming control (OPC 10000-100 InitLock), tries an out-of-range
+setpoint, a second operator session's claim and writes, and an anonymous
+write, and prints what it saw as JSON.
 """
 
 import asyncio
@@ -62,8 +64,28 @@ async def main():
         out["max_rpm"] = await node("Shovel.Limits.MotorMaxSpeed").read_value()
         dt = await node("Shovel.Crawler.Left.SpeedSetpoint").read_data_type_as_variant_type()
         out["setpoint_type"] = dt.name
+        try:
+            await node("Shovel.Crawler.Left.SpeedSetpoint").write_value(ua.Variant(12.5, ua.VariantType.Double))
+            out["write_unclaimed"] = "Good"
+        except ua.UaStatusCodeError as e:
+            out["write_unclaimed"] = type(e).__name__
+        control = node("Shovel.Control")
+        out["init_lock"] = await control.call_method(ua.NodeId("Shovel.Control.InitLock", ns), "asyncua interop")
+        out["locking_user"] = await node("Shovel.Control.LockingUser").read_value()
         await node("Shovel.Crawler.Left.SpeedSetpoint").write_value(ua.Variant(123.5, ua.VariantType.Double))
         out["write_in_range"] = "Good"
+        # A second operator session: its claim and its writes are refused.
+        other = await session(endpoint, pki, "operator", password)
+        async with other:
+            o_control = other.get_node(ua.NodeId("Shovel.Control", ns))
+            out["second_init_lock"] = await o_control.call_method(ua.NodeId("Shovel.Control.InitLock", ns), "second")
+            try:
+                await other.get_node(ua.NodeId("Shovel.Crawler.Left.SpeedSetpoint", ns)).write_value(
+                    ua.Variant(-2000.0, ua.VariantType.Double)
+                )
+                out["second_write"] = "Good"
+            except ua.UaStatusCodeError as e:
+                out["second_write"] = type(e).__name__
         try:
             await node("Shovel.Crawler.Right.SpeedSetpoint").write_value(ua.Variant(1e9, ua.VariantType.Double))
             out["write_out_of_range"] = "Good"

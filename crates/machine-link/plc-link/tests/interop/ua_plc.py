@@ -7,7 +7,12 @@ Basic256Sha256 SignAndEncrypt only, the PLC's certificate from pki/plc, the
 operator's user name and password required. An ideal crawler (no slip, no
 noise; 1.5 m gauge, sprocket 0.3 m, gear 38, 3000 rpm, 6000 rpm/s) at 10 ms
 steps, RTK fixes at 10 Hz with their own timestamps, a 250 ms heartbeat
-watchdog that latches a fault. No Simulator folder: it is a PLC, not plc-sim.
+watchdog that latches a fault and ends the lock, an instance id, and control
+on OPC 10000-100's LockingServices (Shovel.Control): InitLock / ExitLock /
+RenewLock / BreakLock, setpoints obeyed only while locked. asyncua's method
+callbacks do not see the calling session, so this lock is the first
+claimant's until released or lost, not bound to a session as plc-sim's is.
+No Simulator folder: it is a PLC, not plc-sim.
 `--wrong-type NODE` makes that node an Int32; `--nan NODE` makes it NaN.
 It prints "ready" once listening and runs until killed.
 """
@@ -51,6 +56,11 @@ VARS = [
     ("Shovel.Fault.Text", ua.VariantType.String, "", False),
     ("Shovel.Limits.MotorMaxSpeed", ua.VariantType.Double, MAX_RPM, False),
     ("Shovel.Limits.MotorMaxAcceleration", ua.VariantType.Double, MAX_ACC, False),
+    ("Shovel.InstanceId", ua.VariantType.String, f"python-{time.time_ns()}", False),
+    ("Shovel.Control.Locked", ua.VariantType.Boolean, False, False),
+    ("Shovel.Control.LockingClient", ua.VariantType.String, "", False),
+    ("Shovel.Control.LockingUser", ua.VariantType.String, "", False),
+    ("Shovel.Control.RemainingLockTime", ua.VariantType.Double, 0.0, False),
 ]
 
 
@@ -98,10 +108,37 @@ async def main():
             vt, init = ua.VariantType.Int32, 0
         if vt == ua.VariantType.DateTime:
             init = datetime.datetime(1601, 1, 1, tzinfo=datetime.timezone.utc)
-        v = await parent.add_variable(ua.NodeId(path, ns), ua.QualifiedName(leaf, ns), ua.Variant(init, vt))
+        kind = {"Shovel.Control.RemainingLockTime": ua.NodeId(ua.ObjectIds.Duration)}.get(path)
+        v = await parent.add_variable(
+            ua.NodeId(path, ns), ua.QualifiedName(leaf, ns), ua.Variant(init, vt), datatype=kind
+        )
         if writable:
             await v.set_writable()
         nodes[path] = (v, vt)
+
+    lock = {"held": False}
+
+    def lock_method(name):
+        def call(parent, *args):
+            if name == "InitLock":
+                if lock["held"]:
+                    return [ua.Variant(-1, ua.VariantType.Int32)]
+                lock["held"] = True
+            elif not lock["held"]:
+                return [ua.Variant(-1, ua.VariantType.Int32)]
+            elif name != "RenewLock":
+                lock["held"] = False
+            return [ua.Variant(0, ua.VariantType.Int32)]
+
+        return call
+
+    control = await folder("Shovel.Control")
+    for name in ["InitLock", "RenewLock", "ExitLock", "BreakLock"]:
+        inargs = [ua.VariantType.String] if name == "InitLock" else []
+        await control.add_method(
+            ua.NodeId(f"Shovel.Control.{name}", ns), ua.QualifiedName(name, ns),
+            lock_method(name), inargs, [ua.VariantType.Int32],
+        )
 
     async def put(path, value):
         v, vt = nodes[path]
@@ -131,11 +168,14 @@ async def main():
             if beat != hb:
                 hb, hb_at = beat, now
             if fault is None and hb_at is not None and now - hb_at > 0.25:
+                lock["held"] = False
                 fault = "heartbeat lost"
                 await put("Shovel.Fault.Active", True)
                 await put("Shovel.Fault.Code", 1)
                 await put("Shovel.Fault.Text", fault)
-            if fault is None and hb_at is not None:
+            await put("Shovel.Control.Locked", lock["held"])
+            await put("Shovel.Control.LockingUser", "operator" if lock["held"] else "")
+            if fault is None and hb_at is not None and lock["held"]:
                 want_l = await nodes["Shovel.Crawler.Left.SpeedSetpoint"][0].read_value()
                 want_r = await nodes["Shovel.Crawler.Right.SpeedSetpoint"][0].read_value()
             else:
