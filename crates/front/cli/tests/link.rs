@@ -199,56 +199,85 @@ fn killing_drive_stops_the_machine_and_it_stays_stopped_until_acknowledged() {
         s["travelled_m"].as_f64().unwrap() > 0.1,
         "it had moved: {s}"
     );
+    // The killed drive's log: every control period up to the kill, and
+    // replay says it was cut.
+    let r = run(&[
+        "replay".as_ref(),
+        d.path().join("d.mcap").as_os_str(),
+        "--json".as_ref(),
+    ]);
+    let j = parse_one_json(&r.stdout).unwrap_or_else(|e| panic!("{e}: {}", r.stderr));
+    assert_eq!(j["cut"], true, "{j}");
+    assert!(j["max_centroid_dev_m"].as_f64().unwrap().is_finite(), "{j}");
 }
 
 #[test]
-fn ctrl_c_zeroes_the_setpoints_before_drive_exits() {
-    let d = TempDir::new("link-int");
-    let pki = d.path().join("pki");
-    let (sim, endpoint) = plc_sim(
-        &pki,
-        &["--scenario", "straight", "--duration", "8", "--json"],
-    );
-    let mut drive = Command::new(bin())
-        .args([
-            "drive",
-            "--endpoint",
-            &endpoint,
-            "--scenario",
-            "straight",
-            "--pki",
-        ])
-        .arg(&pki)
-        .arg("--log")
-        .arg(d.path().join("d.mcap"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::piped())
-        .spawn()
-        .unwrap();
-    std::thread::sleep(Duration::from_millis(3000));
-    let ok = Command::new("kill")
-        .args(["-INT", &drive.id().to_string()])
-        .status()
-        .unwrap();
-    assert!(ok.success());
-    let status = wait_or_kill(&mut drive, Duration::from_secs(20), "drive");
-    let mut err = String::new();
-    use std::io::Read;
-    drive
-        .stderr
-        .take()
-        .unwrap()
-        .read_to_string(&mut err)
-        .unwrap();
-    assert_eq!(status.code(), Some(130), "{err}");
-    assert!(err.contains("setpoints zeroed"), "{err}");
-    let s = parse_one_json(&finish(sim)).unwrap();
-    // The workstation's own zeroing reached the PLC.
-    assert!(
-        !s["setpoints_zeroed_at_s"].as_array().unwrap().is_empty(),
-        "{s}"
-    );
-    assert!(d.path().join("d.mcap").exists(), "the log is kept");
+fn sigterm_and_ctrl_c_zero_the_setpoints_and_leave_a_log_that_says_why() {
+    for signal in ["-TERM", "-INT", "-HUP"] {
+        let d = TempDir::new("link-int");
+        let pki = d.path().join("pki");
+        let (sim, endpoint) = plc_sim(
+            &pki,
+            &["--scenario", "straight", "--duration", "8", "--json"],
+        );
+        let mut drive = Command::new(bin())
+            .args([
+                "drive",
+                "--endpoint",
+                &endpoint,
+                "--scenario",
+                "straight",
+                "--pki",
+            ])
+            .arg(&pki)
+            .arg("--log")
+            .arg(d.path().join("d.mcap"))
+            .stdout(Stdio::null())
+            .stderr(Stdio::piped())
+            .spawn()
+            .unwrap();
+        std::thread::sleep(Duration::from_millis(3000));
+        let ok = Command::new("kill")
+            .args([signal, &drive.id().to_string()])
+            .status()
+            .unwrap();
+        assert!(ok.success());
+        let status = wait_or_kill(&mut drive, Duration::from_secs(20), "drive");
+        let mut err = String::new();
+        use std::io::Read;
+        drive
+            .stderr
+            .take()
+            .unwrap()
+            .read_to_string(&mut err)
+            .unwrap();
+        assert_eq!(status.code(), Some(130), "{signal}: {err}");
+        assert!(err.contains("setpoints zeroed"), "{signal}: {err}");
+        let s = parse_one_json(&finish(sim)).unwrap();
+        // The workstation's own zeroing reached the PLC, then its release.
+        assert!(
+            !s["setpoints_zeroed_at_s"].as_array().unwrap().is_empty(),
+            "{signal}: {s}"
+        );
+        assert!(
+            s["events"]
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|e| e["kind"] == "control-released"),
+            "{signal}: {s}"
+        );
+        // The log is whole (closed by drive itself) and its last event says why.
+        let r = run(&[
+            "replay".as_ref(),
+            d.path().join("d.mcap").as_os_str(),
+            "--json".as_ref(),
+        ]);
+        let j = parse_one_json(&r.stdout).unwrap_or_else(|e| panic!("{e}: {}", r.stderr));
+        assert_eq!(j["cut"], false, "{signal}: {j}");
+        let why = j["ended"].as_str().unwrap_or_default();
+        assert!(why.contains("interrupted"), "{signal}: {why}");
+    }
 }
 
 #[test]
@@ -290,6 +319,46 @@ fn the_link_refuses_what_it_must_and_names_it() {
     ])
     .fails();
     assert!(r.error_message().contains("--insecure"), "{}", r.stderr);
+    // ... and even then, never with a password.
+    let r = run(&[
+        "drive".as_ref(),
+        "--policy".as_ref(),
+        "none".as_ref(),
+        "--insecure".as_ref(),
+        "--pki".as_ref(),
+        pki.as_os_str(),
+    ])
+    .fails();
+    assert!(r.error_message().contains("in clear"), "{}", r.stderr);
+    // A track that is not of this path, and a fix no grid has.
+    let track = d.write(
+        "far.csv",
+        "t_s,east_m,north_m,heading_deg\n0,500,500,90\n0.1,500.1,500,90\n",
+    );
+    let r = run(&[
+        "replay".as_ref(),
+        track.as_os_str(),
+        "--path".as_ref(),
+        "fig9a".as_ref(),
+    ])
+    .fails();
+    assert!(
+        r.error_message().contains("from the path's start"),
+        "{}",
+        r.stderr
+    );
+    let huge = d.write(
+        "huge.csv",
+        "t_s,east_m,north_m,heading_deg\n0,0,0,90\n0.1,1e308,0,90\n",
+    );
+    let r = run(&[
+        "replay".as_ref(),
+        huge.as_os_str(),
+        "--path".as_ref(),
+        "fig9a".as_ref(),
+    ])
+    .fails();
+    assert!(r.error_message().contains("line 3"), "{}", r.stderr);
     // Faults and time scales plc-sim cannot run.
     for (args, want) in [
         (vec!["--fault", "warp@1"], "unknown fault"),
