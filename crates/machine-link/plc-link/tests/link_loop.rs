@@ -4,11 +4,13 @@
 //! stopped until acknowledged; a frozen or dropped RTK zeroes the
 //! setpoints once the pose is older than 300 ms.
 //!
-//! `LINK_CUTS` and `STALE_POSES` set how many (default 40 and 16, in
-//! `cargo test`'s time: the tests run on the wall clock, one at a time;
-//! docs/machine-link.md gives longer runs' figures, `LINK_CUTS=200
-//! STALE_POSES=50` and more). Issue 47 moves these timing claims onto the
-//! PLC's own clock.
+//! The lockstep tests run in `cargo test`: their results do not depend on
+//! the machine's load. The real-time ones assert wall-clock margins, so
+//! they are `#[ignore]`d there and run alone, one at a time, in
+//! `.ci/run`'s serial step, where nothing else competes for the cores;
+//! their latencies are stamped by the PLC's own loop (`Plc::stops`,
+//! `Plc::zeroed_at`). `LINK_CUTS` and `STALE_POSES` set how many (default
+//! 40 and 16; docs/machine-link.md gives longer runs' figures).
 
 use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
@@ -172,6 +174,7 @@ fn replay_of_the_drive_log_gives_the_drive_metrics() {
 }
 
 #[test]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
 fn real_time_drive_stays_within_a_centimetre_of_the_in_process_run() {
     let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Rtk), 3).unwrap();
@@ -224,6 +227,7 @@ fn quantile(xs: &mut [f64], q: f64) -> f64 {
 }
 
 #[test]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
 fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowledged() {
     let _one_at_a_time = real_time();
     let n = count("LINK_CUTS", 40);
@@ -319,6 +323,7 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
 }
 
 #[test]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
 fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
     let _one_at_a_time = real_time();
     let n = count("STALE_POSES", 16);
@@ -418,6 +423,7 @@ fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
 }
 
 #[test]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
 fn a_delay_fault_holds_the_plcs_replies_back_for_its_length() {
     let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
