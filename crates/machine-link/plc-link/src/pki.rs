@@ -117,7 +117,26 @@ pub fn ensure(root: &Path, role: Role, hosts: &[String]) -> Result<bool, LinkErr
     store
         .create_and_store_application_instance_cert(&data, false)
         .map_err(|e| pki_err(&store.own_certificate_path(), e))?;
+    owner_only(&store.own_private_key_path())?;
     Ok(true)
+}
+
+/// Makes `key` readable and writable by its owner alone (0600), and its
+/// folder enterable by the owner alone (0700): async-opcua writes keys
+/// with the process's umask (0644 here).
+fn owner_only(key: &Path) -> Result<(), LinkError> {
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        fs::set_permissions(key, fs::Permissions::from_mode(0o600)).map_err(|e| pki_io(key, e))?;
+        if let Some(dir) = key.parent() {
+            fs::set_permissions(dir, fs::Permissions::from_mode(0o700))
+                .map_err(|e| pki_io(dir, e))?;
+        }
+    }
+    #[cfg(not(unix))]
+    let _ = key;
+    Ok(())
 }
 
 /// Adds the certificate at `cert` (DER or PEM) to the trust list of the
@@ -142,6 +161,16 @@ pub fn trust(dir: &Path, cert: &Path) -> Result<PathBuf, LinkError> {
         source,
     })?;
     fs::write(&to, der).map_err(|e| pki_io(&to, e))?;
+    // The store looks in rejected/ first: a certificate left there would
+    // stay refused however trusted.
+    let rejected = store
+        .rejected_certs_dir()
+        .join(CertificateStore::cert_file_name(&x));
+    if let Err(e) = fs::remove_file(&rejected) {
+        if e.kind() != std::io::ErrorKind::NotFound {
+            return Err(pki_io(&rejected, e));
+        }
+    }
     Ok(to)
 }
 
@@ -223,4 +252,37 @@ pub fn read_password(path: &Path) -> Result<String, LinkError> {
         return Err(pki_err(path, "the password file is empty"));
     }
     Ok(line)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn keys_are_the_owners_alone_and_trust_takes_a_certificate_out_of_rejected() {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("pki");
+        // Each side makes its own key; neither trusts the other yet.
+        ensure(&root, Role::Plc, &[]).unwrap();
+        ensure(&root, Role::Workstation, &[]).unwrap();
+        #[cfg(unix)]
+        for role in [Role::Plc, Role::Workstation] {
+            use std::os::unix::fs::PermissionsExt;
+            let key = CertificateStore::new(&role_dir(&root, role)).own_private_key_path();
+            let mode = fs::metadata(&key).unwrap().permissions().mode() & 0o777;
+            assert_eq!(mode, 0o600, "{}", key.display());
+        }
+        // The PLC's certificate as a refused connection leaves it.
+        let plc_cert = own_cert(&root, Role::Plc);
+        let x = X509::from_der(&fs::read(&plc_cert).unwrap()).unwrap();
+        let ws = CertificateStore::new(&role_dir(&root, Role::Workstation));
+        let rejected = ws
+            .rejected_certs_dir()
+            .join(CertificateStore::cert_file_name(&x));
+        fs::copy(&plc_cert, &rejected).unwrap();
+        let to = trust(&role_dir(&root, Role::Workstation), &plc_cert).unwrap();
+        assert!(to.exists() && !rejected.exists());
+        // Trusting again (nothing in rejected/) is no error.
+        trust(&role_dir(&root, Role::Workstation), &plc_cert).unwrap();
+    }
 }

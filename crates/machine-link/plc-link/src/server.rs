@@ -95,14 +95,48 @@ fn lock(plc: &Mutex<Plc>) -> MutexGuard<'_, Plc> {
     plc.lock().unwrap_or_else(|e| e.into_inner())
 }
 
-/// Anonymous sessions may read and browse, not write or call.
+/// Sessions the server holds at once.
+pub const MAX_SESSIONS: usize = 32;
+
+/// Of [`MAX_SESSIONS`], how many anonymous sessions can never take: kept
+/// for operators, so readers (HMIs, historians, scanners) cannot lock the
+/// operator out of the machine.
+pub const OPERATOR_SESSIONS: usize = 4;
+
+/// Anonymous sessions may read and browse, not write or call, and never
+/// take the sessions kept for operators.
 struct PlcAuth {
     inner: DefaultAuthenticator,
+    /// The running server's state (its session count), once it is built.
+    info: std::sync::OnceLock<Arc<opcua::server::ServerInfo>>,
+}
+
+impl PlcAuth {
+    /// Sessions open now (the activating one included).
+    fn sessions(&self) -> usize {
+        use opcua::types::VariableId::Server_ServerDiagnostics_ServerDiagnosticsSummary_CurrentSessionCount as COUNT;
+        self.info
+            .get()
+            .and_then(|i| i.diagnostics.get(COUNT))
+            .and_then(|dv| match dv.value {
+                Some(Variant::UInt32(n)) => Some(n as usize),
+                _ => None,
+            })
+            .unwrap_or(0)
+    }
 }
 
 #[async_trait]
 impl AuthManager for PlcAuth {
     async fn authenticate_anonymous_token(&self, endpoint: &ServerEndpoint) -> Result<(), UaError> {
+        if self.sessions() > MAX_SESSIONS - OPERATOR_SESSIONS {
+            return Err(UaError::new(
+                StatusCode::BadTooManySessions,
+                format!(
+                    "the last {OPERATOR_SESSIONS} of {MAX_SESSIONS} sessions are kept for operators"
+                ),
+            ));
+        }
         self.inner.authenticate_anonymous_token(endpoint).await
     }
 
@@ -202,6 +236,10 @@ impl PlcServer {
             token_ids.push(u.clone());
         }
         let ids: Vec<&str> = token_ids.iter().map(String::as_str).collect();
+        let auth = Arc::new(PlcAuth {
+            inner: DefaultAuthenticator::new(users.clone()),
+            info: std::sync::OnceLock::new(),
+        });
         let mut builder = ServerBuilder::new()
             .application_name(Role::Plc.application_name())
             .application_uri(Role::Plc.application_uri())
@@ -213,9 +251,9 @@ impl PlcServer {
             .port(addr.port())
             .discovery_urls(vec![format!("opc.tcp://{}:{}/", serve.host, addr.port())])
             .with_node_manager(shovel_node_manager(NAMESPACE_URI))
-            .with_authenticator(Arc::new(PlcAuth {
-                inner: DefaultAuthenticator::new(users.clone()),
-            }))
+            .with_authenticator(auth.clone())
+            .max_sessions(MAX_SESSIONS)
+            .diagnostics_enabled(true)
             .add_endpoint(
                 "basic256sha256",
                 (
@@ -255,6 +293,7 @@ impl PlcServer {
             );
         }
         let (server, handle) = builder.build().map_err(serve_err)?;
+        let _ = auth.info.set(handle.info().clone());
         let manager = handle
             .node_managers()
             .get_of_type::<ShovelNodeManager>()

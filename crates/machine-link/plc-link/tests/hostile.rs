@@ -387,3 +387,32 @@ fn a_password_never_travels_over_security_none() {
     assert!(matches!(e, LinkError::PasswordInClear { .. }), "{e}");
     assert!(e.to_string().contains("in clear"), "{e}");
 }
+
+#[test]
+fn readers_cannot_take_the_sessions_kept_for_operators() {
+    use autoshovel_plc_link::server::{MAX_SESSIONS, OPERATOR_SESSIONS};
+    let setup = long_curve();
+    rt().block_on(async {
+        let server = start(&setup, Clock::Scaled(1.0), 0).await;
+        let endpoint = server.endpoint();
+        // Readers take every session they may.
+        let mut readers = Vec::new();
+        for _ in 0..MAX_SESSIONS - OPERATOR_SESSIONS {
+            readers.push(Link::open(&anonymous(&endpoint)).await.unwrap());
+        }
+        // One more reader is refused...
+        let mut p = anonymous(&endpoint);
+        p.connect_timeout = Duration::from_secs(3);
+        assert!(Link::open(&p).await.is_err(), "a reader past the limit");
+        // ... and the operator still gets in, claims control and acknowledges.
+        let op = Link::open(&operator(&endpoint)).await.unwrap();
+        op.claim().await.unwrap();
+        op.release().await.unwrap();
+        op.acknowledge().await.unwrap();
+        op.close().await;
+        for r in readers {
+            r.close().await;
+        }
+        server.stop().await;
+    });
+}
