@@ -117,8 +117,36 @@ pub fn ensure(root: &Path, role: Role, hosts: &[String]) -> Result<bool, LinkErr
     store
         .create_and_store_application_instance_cert(&data, false)
         .map_err(|e| pki_err(&store.own_certificate_path(), e))?;
-    owner_only(&store.own_private_key_path())?;
+    let key = store.own_private_key_path();
+    rewrap_pem(&key)?;
+    owner_only(&key)?;
     Ok(true)
+}
+
+/// Rewrites a PEM file in the standard layout (RFC 7468: the label lines
+/// on their own, base64 in lines of 64): async-opcua writes its key on one
+/// line, which it reads back but OpenSSL (`openssl`, node, many PLC tools)
+/// refuses.
+fn rewrap_pem(path: &Path) -> Result<(), LinkError> {
+    let text = fs::read_to_string(path).map_err(|e| pki_io(path, e))?;
+    let malformed = || pki_err(path, "not a PEM file");
+    let begin = text.find("-----BEGIN ").ok_or_else(malformed)?;
+    let label_end = text[begin + 11..].find("-----").ok_or_else(malformed)? + begin + 11;
+    let label = &text[begin + 11..label_end];
+    let footer = format!("-----END {label}-----");
+    let end = text.find(&footer).ok_or_else(malformed)?;
+    let body: String = text[label_end + 5..end]
+        .chars()
+        .filter(|c| !c.is_whitespace())
+        .collect();
+    let mut out = format!("-----BEGIN {label}-----\n");
+    for line in body.as_bytes().chunks(64) {
+        out.push_str(std::str::from_utf8(line).map_err(|_| malformed())?);
+        out.push('\n');
+    }
+    out.push_str(&footer);
+    out.push('\n');
+    fs::write(path, out).map_err(|e| pki_io(path, e))
 }
 
 /// Makes `key` readable and writable by its owner alone (0600), and its
@@ -272,6 +300,14 @@ mod tests {
             let mode = fs::metadata(&key).unwrap().permissions().mode() & 0o777;
             assert_eq!(mode, 0o600, "{}", key.display());
         }
+        // The key is standard PEM, lines of 64, as OpenSSL reads it.
+        let key = CertificateStore::new(&role_dir(&root, Role::Plc)).own_private_key_path();
+        let text = fs::read_to_string(&key).unwrap();
+        assert!(text.starts_with("-----BEGIN PRIVATE KEY-----\n"), "{text}");
+        assert!(text.lines().all(|l| l.len() <= 64), "{text}");
+        // ... and async-opcua still reads it.
+        let store = CertificateStore::new(&role_dir(&root, Role::Plc));
+        assert!(store.read_own_pkey().is_ok());
         // The PLC's certificate as a refused connection leaves it.
         let plc_cert = own_cert(&root, Role::Plc);
         let x = X509::from_der(&fs::read(&plc_cert).unwrap()).unwrap();

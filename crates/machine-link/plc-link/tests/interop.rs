@@ -1,12 +1,14 @@
-//! Interoperability with an OPC UA stack nobody here wrote: Python's
-//! `asyncua` (PyPI) as a client of `plc-sim`, and as a PLC that `drive`
-//! runs a scenario against, both over Basic256Sha256 SignAndEncrypt with
-//! the operator's identity; and the workstation's refusals of a PLC whose
-//! model or values are wrong.
+//! Interoperability with two OPC UA stacks nobody here wrote: Python's
+//! `asyncua` (PyPI) and `node-opcua` (npm), each as a client of `plc-sim`;
+//! asyncua also as a PLC that `drive` runs a scenario against; all over
+//! Basic256Sha256 SignAndEncrypt with the operator's identity, under the
+//! control-authority model (claims, refusals of a second operator); and
+//! the workstation's refusals of a PLC whose model or values are wrong.
 //!
-//! `.ci/run` installs asyncua in a venv and sets `AUTOSHOVEL_PYTHON`; with
-//! it set, a missing asyncua fails the test. Without it, `python3` is tried
-//! and the tests are skipped, saying so, when it has no asyncua.
+//! `.ci/run` installs asyncua in a venv and sets `AUTOSHOVEL_PYTHON`, and
+//! node-opcua with npm and sets `AUTOSHOVEL_NODE_MODULES`; with them set
+//! (or under CI), a missing peer fails the test. Without, the tests are
+//! skipped, saying so.
 
 use std::io::{BufRead, BufReader};
 use std::path::{Path, PathBuf};
@@ -39,6 +41,35 @@ fn python() -> Option<String> {
         (false, None) => {
             eprintln!(
                 "SKIPPED: python3 has no asyncua (pip install asyncua, or run .ci/run, which sets AUTOSHOVEL_PYTHON)"
+            );
+            None
+        }
+    }
+}
+
+/// node and the node_modules holding node-opcua, or None (skipped, said).
+fn node() -> Option<(String, PathBuf)> {
+    let set = std::env::var_os("AUTOSHOVEL_NODE_MODULES").map(PathBuf::from);
+    let modules = set.clone().unwrap_or_else(|| script("node/node_modules"));
+    let ok = modules.join("node-opcua").is_dir()
+        && Command::new("node")
+            .arg("--version")
+            .stdout(Stdio::null())
+            .status()
+            .map(|s| s.success())
+            .unwrap_or(false);
+    match (ok, set) {
+        (true, _) => Some(("node".into(), modules)),
+        (false, Some(m)) => panic!(
+            "AUTOSHOVEL_NODE_MODULES={} has no node-opcua, or node is missing",
+            m.display()
+        ),
+        (false, None) if std::env::var_os("CI").is_some() => {
+            panic!("CI: no node-opcua; .ci/run installs it and sets AUTOSHOVEL_NODE_MODULES")
+        }
+        (false, None) => {
+            eprintln!(
+                "SKIPPED: no node-opcua (npm ci in crates/machine-link/plc-link/tests/interop/node, or run .ci/run)"
             );
             None
         }
@@ -159,6 +190,85 @@ fn python_asyncua_client_browses_reads_and_writes_securely() {
             assert!(v["anonymous_read_east"].is_number());
             assert_ne!(v["anonymous_write"], "Good", "{v}");
         }
+        server.stop().await;
+    });
+}
+
+#[test]
+fn node_opcua_client_reads_claims_and_is_refused_as_a_second_operator() {
+    let Some((node, modules)) = node() else {
+        return;
+    };
+    let (_, root, pw) = pki_root();
+    let sc = resolve("curve", Some(Noise::Rtk), 1).unwrap();
+    rt().block_on(async {
+        let server = PlcServer::start(
+            PlcParams {
+                setup: sc.setup.clone(),
+                clock: Clock::Scaled(1.0),
+                heartbeat_timeout: HEARTBEAT_TIMEOUT,
+                auto: true,
+                schedule: Vec::new(),
+            },
+            ServeParams {
+                host: "127.0.0.1".into(),
+                port: 0,
+                pki: root.clone(),
+                insecure: false,
+                users: vec![(pki::OPERATOR.into(), pw.clone())],
+            },
+        )
+        .await
+        .unwrap();
+        let (endpoint, root, pw) = (server.endpoint(), root.clone(), pw.clone());
+        let out = tokio::task::spawn_blocking(move || {
+            Command::new(node)
+                .arg(script("node/client.js"))
+                .arg(endpoint)
+                .arg(root)
+                .arg(pw)
+                .env("NODE_PATH", modules)
+                .output()
+                .unwrap()
+        })
+        .await
+        .unwrap();
+        assert!(
+            out.status.success(),
+            "client.js: {}",
+            String::from_utf8_lossy(&out.stderr)
+        );
+        // node-opcua prints notices of its own: the JSON is the line that is an object.
+        let stdout = String::from_utf8_lossy(&out.stdout);
+        let last = stdout
+            .lines()
+            .find(|l| l.starts_with('{'))
+            .unwrap_or_default();
+        let v: serde_json::Value =
+            serde_json::from_str(last).unwrap_or_else(|e| panic!("{e}: {stdout}"));
+        let p = server.plc.lock().unwrap();
+        assert_eq!(
+            v["east_m"].as_f64().unwrap(),
+            p.fix().unwrap().east_m,
+            "{v}"
+        );
+        assert_eq!(v["instance"], server.instance_id(), "{v}");
+        assert_eq!(v["write_unclaimed"], "BadRequiresLock", "{v}");
+        assert_eq!(v["init_lock"], 0, "{v}");
+        assert_eq!(v["locking_user"], "operator", "{v}");
+        assert_eq!(v["write_claimed"], "Good", "{v}");
+        assert_eq!(v["second_init_lock"], -1, "{v}");
+        assert_eq!(v["second_write"], "BadLocked", "{v}");
+        assert!(v["anonymous_read_east"].is_number(), "{v}");
+        assert_ne!(v["anonymous_write"], "Good", "{v}");
+        assert_eq!(v["exit_lock"], 0, "{v}");
+        // The claimed write was obeyed as a setpoint; the release latched.
+        assert!(p.control.holder().is_none());
+        assert_eq!(
+            p.fault.as_ref().map(|f| f.0),
+            Some(autoshovel_plc_link::model::fault_code::CONTROL_ENDED)
+        );
+        drop(p);
         server.stop().await;
     });
 }
