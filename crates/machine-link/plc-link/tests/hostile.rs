@@ -3,9 +3,11 @@
 //! the witness: its trajectory is a pure function of the commands the PLC
 //! obeyed, so any effect a bystander had shows as a changed bit.
 //!
-//! `BYSTANDERS` sets how many connections the bystanders make during the
-//! drive (default 1000: bare TCP, GetEndpoints, anonymous reads, garbage
-//! and an oversized Hello, a second operator's claims and writes).
+//! `BYSTANDERS` sets how many connections the bystanders of our own make
+//! during the drive (default 1000: bare TCP, GetEndpoints, anonymous reads,
+//! garbage and an oversized Hello, a second operator's claims and writes);
+//! beside them, python asyncua and node-opcua read anonymously, session
+//! after session, until the drive ends.
 
 use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
@@ -20,6 +22,8 @@ use autoshovel_walk_tracker::scenario::resolve;
 use autoshovel_walk_tracker::sim::Run;
 use autoshovel_walk_tracker::{ControllerKind, Setup, TrackCommand};
 use tokio::io::AsyncWriteExt;
+
+mod peers;
 
 fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
     static PKI: OnceLock<(tempfile::TempDir, PathBuf, String)> = OnceLock::new();
@@ -183,13 +187,75 @@ async fn visit(k: usize, server: &PlcServer, endpoint: &str) -> &'static str {
 /// Bystanders visiting at once.
 const LANES: usize = 8;
 
+/// The peers' bystanders (python asyncua, node-opcua) reading anonymously
+/// at `endpoint` until `stop` exists: each one's name and process.
+fn peer_bystanders(
+    endpoint: &str,
+    stop: &std::path::Path,
+) -> Vec<(&'static str, std::process::Child)> {
+    let (_, root, _) = pki_root();
+    let mut out = Vec::new();
+    let piped = |c: &mut std::process::Command| {
+        c.stdout(std::process::Stdio::piped())
+            .stderr(std::process::Stdio::piped())
+            .spawn()
+            .unwrap()
+    };
+    if let Some(py) = peers::python() {
+        let mut c = std::process::Command::new(py);
+        c.arg(peers::script("bystander.py"))
+            .arg(endpoint)
+            .arg(root)
+            .arg("100000")
+            .arg(stop);
+        out.push(("asyncua", piped(&mut c)));
+    }
+    if let Some((node, modules)) = peers::node() {
+        let mut c = std::process::Command::new(node);
+        c.arg(peers::script("node/bystander.js"))
+            .arg(endpoint)
+            .arg(root)
+            .arg("100000")
+            .arg(stop)
+            .env("NODE_PATH", modules);
+        out.push(("node-opcua", piped(&mut c)));
+    }
+    out
+}
+
+/// Visits a peer bystander made (it must have ended well).
+fn visits_of(name: &str, child: std::process::Child) -> usize {
+    let out = child.wait_with_output().unwrap();
+    let text = String::from_utf8_lossy(&out.stdout);
+    assert!(
+        out.status.success(),
+        "{name}: {}\n{text}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    text.lines()
+        .filter_map(|l| l.trim().trim_start_matches("visits ").parse().ok())
+        .next_back()
+        .unwrap_or_else(|| panic!("{name} printed no count: {text}"))
+}
+
 /// Drives `setup` in lockstep on a fresh `plc-sim`; `bystanders` visits
-/// made meanwhile by [`LANES`] concurrent bystanders. The run, the visits made
-/// while the drive ran, and the PLC's faults and refused writes.
-fn lockstep_drive(setup: &Setup, bystanders: usize) -> (Run, usize, usize, u64) {
+/// made meanwhile by [`LANES`] concurrent bystanders of ours, and the
+/// peers' own until the drive ends. The run, the visits of ours made while
+/// the drive ran, the peers' visits, and the PLC's faults and refused writes.
+fn lockstep_drive(
+    setup: &Setup,
+    bystanders: usize,
+) -> (Run, usize, Vec<(&'static str, usize)>, usize, u64) {
     rt().block_on(async {
         let server = start(setup, Clock::Lockstep, 0).await;
         let endpoint = server.endpoint();
+        let stop_dir = tempfile::tempdir().unwrap();
+        let stop_file = stop_dir.path().join("stop");
+        let peer_procs = if bystanders > 0 {
+            peer_bystanders(&endpoint, &stop_file)
+        } else {
+            Vec::new()
+        };
         let link = Link::open(&operator(&endpoint)).await.unwrap();
         let mut ctl = ControllerKind::Fuzzy.build(&Default::default());
         let mut opts = DriveOptions::new(setup, &operator(&endpoint));
@@ -231,6 +297,15 @@ fn lockstep_drive(setup: &Setup, bystanders: usize) -> (Run, usize, usize, u64) 
             );
         };
         let (r, ()) = tokio::join!(driving, crowd);
+        std::fs::write(&stop_file, b"").unwrap();
+        let peer_visits = tokio::task::spawn_blocking(move || {
+            peer_procs
+                .into_iter()
+                .map(|(name, child)| (name, visits_of(name, child)))
+                .collect::<Vec<_>>()
+        })
+        .await
+        .unwrap();
         let run = r.unwrap();
         link.close().await;
         let (faults, refused) = {
@@ -239,7 +314,13 @@ fn lockstep_drive(setup: &Setup, bystanders: usize) -> (Run, usize, usize, u64) 
             (p.stops.len(), p.summary("", 0, "").refused_writes)
         };
         server.stop().await;
-        (run.run, during.load(Ordering::SeqCst), faults, refused)
+        (
+            run.run,
+            during.load(Ordering::SeqCst),
+            peer_visits,
+            faults,
+            refused,
+        )
     })
 }
 
@@ -252,10 +333,15 @@ fn long_curve() -> Setup {
 fn bystanders_never_move_or_stop_a_lockstep_drive() {
     let n = count("BYSTANDERS", 1000);
     let setup = long_curve();
-    let (quiet, _, quiet_faults, _) = lockstep_drive(&setup, 0);
+    let (quiet, _, _, quiet_faults, _) = lockstep_drive(&setup, 0);
     assert!(quiet.metrics.completed, "{:?}", quiet.metrics);
-    let (busy, during, faults, refused) = lockstep_drive(&setup, n);
-    eprintln!("bystanders: {during} of {n} visits while the drive ran; {refused} writes refused");
+    let (busy, during, peer_visits, faults, refused) = lockstep_drive(&setup, n);
+    eprintln!(
+        "bystanders: {during} of {n} visits while the drive ran, peers {peer_visits:?}; {refused} writes refused"
+    );
+    for (name, visits) in &peer_visits {
+        assert!(*visits > 0, "{name} read during the drive");
+    }
     assert!(
         during >= n,
         "only {during} of {n} visits came while the drive ran"
