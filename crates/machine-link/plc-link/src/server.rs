@@ -390,6 +390,12 @@ impl PlcServer {
     }
 }
 
+/// A write's effect on the PLC: the caller and the value; the status.
+type PlcWrite = Box<dyn Fn(&mut Plc, &Caller, &Variant) -> StatusCode + Send + Sync>;
+/// A method's effect on the PLC: the caller and the arguments; the outputs or a status.
+type PlcCall =
+    Box<dyn Fn(&mut Plc, &Caller, &[Variant]) -> Result<Vec<Variant>, StatusCode> + Send + Sync>;
+
 fn build_address_space(manager: &Arc<ShovelNodeManager>, ns: u16, plc: &Arc<Mutex<Plc>>) {
     {
         let space = manager.address_space();
@@ -479,14 +485,13 @@ fn build_address_space(manager: &Arc<ShovelNodeManager>, ns: u16, plc: &Arc<Mute
         }
     }
     let inner = manager.inner();
-    let on_write =
-        |var: Var, f: Box<dyn Fn(&mut Plc, &Caller, &Variant) -> StatusCode + Send + Sync>| {
-            let p = plc.clone();
-            inner.on_write(
-                nid(ns, model::spec(var).id),
-                Box::new(move |who, v| f(&mut lock(&p), who, v)),
-            );
-        };
+    let on_write = |var: Var, f: PlcWrite| {
+        let p = plc.clone();
+        inner.on_write(
+            nid(ns, model::spec(var).id),
+            Box::new(move |who, v| f(&mut lock(&p), who, v)),
+        );
+    };
     for (var, right) in [(Var::LeftSetpoint, false), (Var::RightSetpoint, true)] {
         on_write(
             var,
@@ -510,10 +515,7 @@ fn build_address_space(manager: &Arc<ShovelNodeManager>, ns: u16, plc: &Arc<Mute
             _ => StatusCode::BadTypeMismatch,
         }),
     );
-    let on_call = |id: &str,
-                   f: Box<
-        dyn Fn(&mut Plc, &Caller, &[Variant]) -> Result<Vec<Variant>, StatusCode> + Send + Sync,
-    >| {
+    let on_call = |id: &str, f: PlcCall| {
         let p = plc.clone();
         inner.on_call(
             nid(ns, id),

@@ -421,15 +421,13 @@ fn the_controlling_session_closing_stops_the_machine_at_once() {
         while server.plc.lock().unwrap().stops.len() == stops {
             tokio::time::sleep(Duration::from_millis(1)).await;
         }
-        let p = server.plc.lock().unwrap();
-        let (code, text) = p.fault.clone().expect("latched");
+        let (code, text) = server.plc.lock().unwrap().fault.clone().expect("latched");
         assert_eq!(
             code,
             autoshovel_plc_link::model::fault_code::LINK_DROPPED,
             "{text}"
         );
         assert!(text.contains("controlling session"), "{text}");
-        drop(p);
         server.stop().await;
     });
 }

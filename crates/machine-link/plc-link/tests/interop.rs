@@ -11,7 +11,7 @@
 //! skipped, saying so.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::PathBuf;
 use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::Duration;
@@ -190,29 +190,30 @@ fn node_opcua_client_reads_claims_and_is_refused_as_a_second_operator() {
             .unwrap_or_default();
         let v: serde_json::Value =
             serde_json::from_str(last).unwrap_or_else(|e| panic!("{e}: {stdout}"));
-        let p = server.plc.lock().unwrap();
-        assert_eq!(
-            v["east_m"].as_f64().unwrap(),
-            p.fix().unwrap().east_m,
-            "{v}"
-        );
-        assert_eq!(v["instance"], server.instance_id(), "{v}");
-        assert_eq!(v["write_unclaimed"], "BadRequiresLock", "{v}");
-        assert_eq!(v["init_lock"], 0, "{v}");
-        assert_eq!(v["locking_user"], "operator", "{v}");
-        assert_eq!(v["write_claimed"], "Good", "{v}");
-        assert_eq!(v["second_init_lock"], -1, "{v}");
-        assert_eq!(v["second_write"], "BadLocked", "{v}");
-        assert!(v["anonymous_read_east"].is_number(), "{v}");
-        assert_ne!(v["anonymous_write"], "Good", "{v}");
-        assert_eq!(v["exit_lock"], 0, "{v}");
-        // The claimed write was obeyed as a setpoint; the release latched.
-        assert!(p.control.holder().is_none());
-        assert_eq!(
-            p.fault.as_ref().map(|f| f.0),
-            Some(autoshovel_plc_link::model::fault_code::CONTROL_ENDED)
-        );
-        drop(p);
+        {
+            let p = server.plc.lock().unwrap();
+            assert_eq!(
+                v["east_m"].as_f64().unwrap(),
+                p.fix().unwrap().east_m,
+                "{v}"
+            );
+            assert_eq!(v["instance"], server.instance_id(), "{v}");
+            assert_eq!(v["write_unclaimed"], "BadRequiresLock", "{v}");
+            assert_eq!(v["init_lock"], 0, "{v}");
+            assert_eq!(v["locking_user"], "operator", "{v}");
+            assert_eq!(v["write_claimed"], "Good", "{v}");
+            assert_eq!(v["second_init_lock"], -1, "{v}");
+            assert_eq!(v["second_write"], "BadLocked", "{v}");
+            assert!(v["anonymous_read_east"].is_number(), "{v}");
+            assert_ne!(v["anonymous_write"], "Good", "{v}");
+            assert_eq!(v["exit_lock"], 0, "{v}");
+            // The claimed write was obeyed as a setpoint; the release latched.
+            assert!(p.control.holder().is_none());
+            assert_eq!(
+                p.fault.as_ref().map(|f| f.0),
+                Some(autoshovel_plc_link::model::fault_code::CONTROL_ENDED)
+            );
+        }
         server.stop().await;
     });
 }

@@ -383,7 +383,7 @@ pub fn replay_rtk(
         return Err(err(path, "no fixes, or a path without points"));
     };
     let off = (first.fix.to_pose().position() - *start).norm();
-    if !(off <= START_WITHIN_M) {
+    if off.is_nan() || off > START_WITHIN_M {
         return Err(err(
             path,
             format!(

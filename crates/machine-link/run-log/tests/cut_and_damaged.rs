@@ -107,7 +107,7 @@ fn a_killed_writer_leaves_a_log_that_replays_to_its_last_period() {
     // A log cut before its first message holds nothing: refused, named.
     let header_only = dir.path().join("empty.mcap");
     std::fs::write(&header_only, &std::fs::read(&path).unwrap()[..40]).unwrap();
-    let e = replay_mcap(&header_only).err().expect("refused");
+    let e = replay_mcap(&header_only).expect_err("refused");
     assert!(e.to_string().contains("empty.mcap"), "{e}");
 }
 
