@@ -6,7 +6,9 @@
 //! copy in `vendor/async-opcua-types` bounds (vendor/README.md).
 //!
 //! The messages are written byte by byte here (OPC 10000-6 §7.1, §6.7)
-//! because the point is to send what no well-behaved stack would.
+//! because the point is to send what no well-behaved stack would. Beside
+//! the nesting, a seeded run of responses with bytes overwritten at random
+//! (`HOSTILE_CASES`, default 32) must each end in a named error.
 
 use std::time::Duration;
 
@@ -64,10 +66,24 @@ fn type_id(id: u16) -> [u8; 4] {
     [1, 0, b[0], b[1]]
 }
 
-/// Serves one workstation: Hello, OpenSecureChannel, then a GetEndpoints
-/// response whose ServiceDiagnostics nest `depth` deep, in as many chunks
-/// as the client's receive buffer needs.
-async fn hostile(mut s: TcpStream, depth: usize) -> std::io::Result<()> {
+/// What the hostile server answers GetEndpoints with: the response's bytes
+/// after its type id, given the request's handle.
+type Answer = std::sync::Arc<dyn Fn(u32) -> Vec<u8> + Send + Sync>;
+
+/// A GetEndpoints response whose ServiceDiagnostics nest `depth` deep.
+fn nested(depth: usize) -> Answer {
+    std::sync::Arc::new(move |handle| {
+        let mut diagnostics = vec![0x40u8; depth]; // HasInnerDiagnosticInfo, again and again
+        diagnostics.push(0);
+        let mut body = response_header(handle, &diagnostics);
+        body.extend_from_slice(&0i32.to_le_bytes()); // Endpoints: none
+        body
+    })
+}
+
+/// Serves one workstation: Hello, OpenSecureChannel, then `answer` as the
+/// GetEndpoints response, in as many chunks as the client's receive buffer needs.
+async fn hostile(mut s: TcpStream, answer: Answer) -> std::io::Result<()> {
     let (kind, hello) = read_msg(&mut s).await?;
     assert_eq!(&kind, b"HEL");
     let receive_buffer = u32_at(&hello, 4) as usize;
@@ -112,11 +128,8 @@ async fn hostile(mut s: TcpStream, depth: usize) -> std::io::Result<()> {
     assert_eq!(&kind, b"MSG");
     let request_id = u32_at(&msg, 12);
     let handle = u32_at(&msg, 16 + 4 + 2 + 8);
-    let mut diagnostics = vec![0x40u8; depth]; // HasInnerDiagnosticInfo, again and again
-    diagnostics.push(0);
     let mut body = type_id(431).to_vec(); // GetEndpointsResponse
-    body.extend(response_header(handle, &diagnostics));
-    body.extend_from_slice(&0i32.to_le_bytes()); // Endpoints: none
+    body.extend(answer(handle));
     let room = receive_buffer.max(8192) - 24;
     let chunks: Vec<&[u8]> = body.chunks(room).collect();
     for (i, part) in chunks.iter().enumerate() {
@@ -140,8 +153,8 @@ async fn hostile(mut s: TcpStream, depth: usize) -> std::io::Result<()> {
     Ok(())
 }
 
-/// The workstation's error from a hostile server nesting `depth` deep.
-fn against(depth: usize) -> LinkError {
+/// The workstation's error from a hostile server answering with `answer`.
+fn against(answer: Answer, timeout: Duration) -> LinkError {
     let dir = tempfile::tempdir().unwrap();
     let root = dir.path().join("pki");
     pki::init(&root, &[]).unwrap();
@@ -158,7 +171,7 @@ fn against(depth: usize) -> LinkError {
         );
         tokio::spawn(async move {
             while let Ok((s, _)) = listener.accept().await {
-                tokio::spawn(hostile(s, depth));
+                tokio::spawn(hostile(s, answer.clone()));
             }
         });
         let mut p = LinkParams::new(
@@ -166,7 +179,7 @@ fn against(depth: usize) -> LinkError {
             root.clone(),
             Some(("operator".into(), "x".into())),
         );
-        p.connect_timeout = Duration::from_secs(10);
+        p.connect_timeout = timeout;
         Link::open(&p)
             .await
             .err()
@@ -177,13 +190,39 @@ fn against(depth: usize) -> LinkError {
 #[test]
 fn error_details_nested_a_million_deep_are_a_named_error_not_an_abort() {
     // 10^6 levels: more than the client takes in one message.
-    let e = against(1_000_000);
+    let e = against(nested(1_000_000), Duration::from_secs(10));
     assert!(matches!(e, LinkError::Connect { .. }), "{e}");
     assert!(e.to_string().contains("opc.tcp://127.0.0.1:"), "{e}");
     // 300 000 levels fit the client's five 64 KiB chunks and reach the
     // decoder: unbounded, its recursion overflowed the stack and aborted
     // the process; bounded, the depth gauge refuses it.
-    let e = against(300_000);
+    let e = against(nested(300_000), Duration::from_secs(10));
     assert!(matches!(e, LinkError::Connect { .. }), "{e}");
     eprintln!("300 000 deep: {}", autoshovel_core::error_chain(&e));
+}
+
+#[test]
+fn seeded_garbage_in_a_response_is_a_named_error_every_time() {
+    use rand::{Rng, SeedableRng};
+    let mut rng = rand_chacha::ChaCha8Rng::seed_from_u64(47);
+    let cases = std::env::var("HOSTILE_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(32usize);
+    for case in 0..cases {
+        // A valid empty response, then bytes of it overwritten at random:
+        // lengths, masks and encodings that claim what is not there.
+        let mut base = response_header(7, &[0]);
+        base.extend_from_slice(&1i32.to_le_bytes()); // one endpoint, then garbage
+        let n = rng.gen_range(0..2048);
+        base.extend((0..n).map(|_| rng.gen::<u8>()));
+        for _ in 0..rng.gen_range(0..8) {
+            let at = rng.gen_range(0..base.len());
+            base[at] = rng.gen();
+        }
+        let body = std::sync::Arc::new(base);
+        let answer: Answer = std::sync::Arc::new(move |_| body.to_vec());
+        let e = against(answer, Duration::from_secs(3));
+        assert!(matches!(e, LinkError::Connect { .. }), "case {case}: {e}");
+    }
 }
