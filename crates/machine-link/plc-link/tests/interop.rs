@@ -11,7 +11,7 @@
 //! skipped, saying so.
 
 use std::io::{BufRead, BufReader};
-use std::path::PathBuf;
+use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::sync::OnceLock;
 use std::time::Duration;
@@ -293,6 +293,102 @@ fn drive_runs_a_scenario_against_a_python_asyncua_plc() {
     assert!(m.completed, "{m:?} {:?}", run.run.events);
     // An ideal crawler at 10 ms steps: the same tracker keeps it within
     // a few centimetres once on the path (fig9a in process: 4.4 cm).
+    assert!(m.max_centroid_dev_m < 0.10, "{m:?}");
+    assert!(m.final_position_error_m < 0.10, "{m:?}");
+}
+
+/// A node-opcua PLC on a free port, started at `pose`.
+struct NodePlc {
+    child: Child,
+    endpoint: String,
+}
+
+impl NodePlc {
+    fn start(node: &str, modules: &Path, pose: (f64, f64, f64)) -> NodePlc {
+        let (_, root, pw) = pki_root();
+        let port = std::net::TcpListener::bind("127.0.0.1:0")
+            .unwrap()
+            .local_addr()
+            .unwrap()
+            .port();
+        let mut child = Command::new(node)
+            .arg(script("node/plc.js"))
+            .arg(port.to_string())
+            .arg(root)
+            .arg(pw)
+            .args([pose.0.to_string(), pose.1.to_string(), pose.2.to_string()])
+            .env("NODE_PATH", modules)
+            .stdout(Stdio::piped())
+            .spawn()
+            .unwrap();
+        // node-opcua may print notices of its own before "ready".
+        let mut out = BufReader::new(child.stdout.take().unwrap());
+        let mut seen = String::new();
+        loop {
+            let mut line = String::new();
+            if out.read_line(&mut line).unwrap_or(0) == 0 {
+                panic!("plc.js ended before it was ready:\n{seen}");
+            }
+            if line.trim() == "ready" {
+                break;
+            }
+            seen.push_str(&line);
+        }
+        std::thread::spawn(move || {
+            let mut rest = String::new();
+            while out.read_line(&mut rest).unwrap_or(0) > 0 {
+                rest.clear();
+            }
+        });
+        NodePlc {
+            child,
+            endpoint: format!("opc.tcp://127.0.0.1:{port}/"),
+        }
+    }
+}
+
+impl Drop for NodePlc {
+    fn drop(&mut self) {
+        let _ = self.child.kill();
+        let _ = self.child.wait();
+    }
+}
+
+#[test]
+fn drive_runs_a_scenario_against_a_node_opcua_plc() {
+    let Some((node, modules)) = node() else {
+        return;
+    };
+    let sc = resolve("fig9a", Some(Noise::Off), 1).unwrap();
+    let s = sc.setup.start;
+    let plc = NodePlc::start(&node, &modules, (s.x, s.y, s.theta));
+    let p = params(&plc.endpoint);
+    let run = rt().block_on(async {
+        let link = Link::open(&p).await.unwrap();
+        assert!(!link.simulator, "a PLC, not plc-sim");
+        assert!(link.instance.starts_with("node-"), "{}", link.instance);
+        // Another session cannot claim the machine this drive holds.
+        let other = Link::open(&p).await.unwrap();
+        let mut ctl = ControllerKind::Fuzzy.build(&sc.controllers);
+        let opts = DriveOptions::new(&sc.setup, &p);
+        let driving = drive(&link, &sc.setup, ctl.as_mut(), &opts, None);
+        let probing = async {
+            tokio::time::sleep(Duration::from_secs(2)).await;
+            let claim = other.claim().await;
+            assert!(
+                matches!(claim, Err(LinkError::ControlHeld { .. })),
+                "{claim:?}"
+            );
+        };
+        let (r, ()) = tokio::join!(driving, probing);
+        other.close().await;
+        link.close().await;
+        r.unwrap()
+    });
+    let m = &run.run.metrics;
+    assert!(!run.truth, "measured on the fixes");
+    assert!(m.completed, "{m:?} {:?}", run.run.events);
+    // The same ideal crawler as the asyncua PLC's, stepped by node's timers.
     assert!(m.max_centroid_dev_m < 0.10, "{m:?}");
     assert!(m.final_position_error_m < 0.10, "{m:?}");
 }
