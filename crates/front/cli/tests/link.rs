@@ -402,7 +402,48 @@ fn the_link_refuses_what_it_must_and_names_it() {
         other.as_os_str(),
     ])
     .fails();
-    assert!(r.error_message().contains(&endpoint), "{}", r.stderr);
+    let msg = r.error_message();
+    assert!(msg.contains(&endpoint), "{}", r.stderr);
+    // Named: whose certificate, where it was saved, the command that trusts it.
+    assert!(msg.contains("the PLC's certificate"), "{msg}");
+    assert!(msg.contains("autoshovel pki trust --dir"), "{msg}");
+    let saved = std::fs::read_dir(other.join("workstation/rejected"))
+        .unwrap()
+        .count();
+    assert_eq!(
+        saved, 1,
+        "the PLC's certificate saved for a person to check"
+    );
+    // That command, run, makes the next drive get past the certificate
+    // (to the PLC's own refusal of this workstation, named as such).
+    let rejected = std::fs::read_dir(other.join("workstation/rejected"))
+        .unwrap()
+        .next()
+        .unwrap()
+        .unwrap()
+        .path();
+    run(&[
+        "pki".as_ref(),
+        "trust".as_ref(),
+        "--dir".as_ref(),
+        other.join("workstation").as_os_str(),
+        rejected.as_os_str(),
+    ])
+    .ok();
+    let r = run(&[
+        "drive".as_ref(),
+        "--endpoint".as_ref(),
+        endpoint.as_str().as_ref(),
+        "--pki".as_ref(),
+        other.as_os_str(),
+    ])
+    .fails();
+    assert!(
+        r.error_message()
+            .contains("may not trust this workstation's certificate"),
+        "{}",
+        r.stderr
+    );
     let wrong = d.write("wrong.password", "not-the-password\n");
     let r = run(&[
         "drive".as_ref(),

@@ -291,6 +291,17 @@ impl Link {
                 )
             })?;
         endpoint.endpoint_url = p.endpoint.as_str().into();
+        // Our own check of the PLC's certificate, before any session: pinned
+        // to the trust list, named when it fails (the stack would retry
+        // until the timeout and say only that the session did not open).
+        if p.policy != Policy::None {
+            pki::check_peer(
+                &p.pki,
+                Role::Workstation,
+                endpoint.server_certificate.as_ref(),
+                &p.endpoint,
+            )?;
+        }
         let (session, event_loop) = client
             .connect_to_endpoint_directly(endpoint, identity)
             .map_err(|e| connect_failed(&p.endpoint, e, &p.pki))?;
@@ -300,9 +311,17 @@ impl Link {
             .unwrap_or(false);
         if !ok {
             event_loop.abort();
+            // The PLC's certificate is trusted here (checked above), so the
+            // likely cause is the other side's trust list, or the identity.
+            let own = pki::own_cert(&p.pki, Role::Workstation);
             return Err(connect_err(
                 &p.endpoint,
-                explain("the session did not open", &p.pki),
+                format!(
+                    "the session did not open within {:.0} s: the PLC may not trust this workstation's certificate ({}): on the PLC, `autoshovel pki trust --dir PKI/plc {}` (or move it out of the PLC's rejected/ folder); or the user name or password was refused",
+                    p.connect_timeout.as_secs_f64(),
+                    own.display(),
+                    own.display()
+                ),
             ));
         }
         let ns = session

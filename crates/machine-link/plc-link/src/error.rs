@@ -151,6 +151,22 @@ pub enum LinkError {
         /// The limit.
         limit_s: f64,
     },
+    /// The peer presented a certificate this side does not trust.
+    #[error("{endpoint}: the {side}'s certificate ({subject}, thumbprint {thumbprint}) is not in this side's trust list; saved to {saved}; {fix}", saved = saved.display())]
+    Untrusted {
+        /// The endpoint URL.
+        endpoint: String,
+        /// Whose certificate: the PLC's or the workstation's application name.
+        side: &'static str,
+        /// Its subject.
+        subject: String,
+        /// Its SHA-1 thumbprint (hex).
+        thumbprint: String,
+        /// Where it was saved for a person to check.
+        saved: PathBuf,
+        /// The command that trusts it.
+        fix: String,
+    },
     /// Another session holds control of the machine.
     #[error("{endpoint}: control of the machine is held by {by}; it moves only for that session (it releases control, or an operator breaks it at rest with the machine stopped)")]
     ControlHeld {

@@ -202,6 +202,45 @@ pub fn trust(dir: &Path, cert: &Path) -> Result<PathBuf, LinkError> {
     Ok(to)
 }
 
+/// Checks a peer's certificate (DER, as the peer presented it) against
+/// `role`'s trust list under `root`, by exact certificate: trust is pinned
+/// to the certificates in `trusted/` (a CA there trusts nothing it signed;
+/// issuer chains and revocation lists are not consulted, so a certificate
+/// is revoked by taking it out of `trusted/`). An untrusted one is saved to
+/// `rejected/`, and the error names it and the command that trusts it.
+pub fn check_peer(root: &Path, role: Role, der: &[u8], endpoint: &str) -> Result<(), LinkError> {
+    let dir = role_dir(root, role);
+    let x = X509::from_der(der).map_err(|source| LinkError::Certificate {
+        path: PathBuf::from(endpoint),
+        what: "the peer's certificate is not X.509",
+        source,
+    })?;
+    let store = CertificateStore::new(&dir);
+    store.ensure_pki_path().map_err(|e| pki_err(&dir, e))?;
+    let name = CertificateStore::cert_file_name(&x);
+    let trusted = store.trusted_certs_dir().join(&name);
+    if trusted.exists() && fs::read(&trusted).map_err(|e| pki_io(&trusted, e))? == der {
+        return Ok(());
+    }
+    let rejected = store.rejected_certs_dir().join(&name);
+    fs::write(&rejected, der).map_err(|e| pki_io(&rejected, e))?;
+    Err(LinkError::Untrusted {
+        endpoint: endpoint.to_string(),
+        side: match role {
+            Role::Workstation => "PLC",
+            Role::Plc => "workstation",
+        },
+        subject: x.subject_name(),
+        thumbprint: x.thumbprint().as_hex_string(),
+        saved: rejected.clone(),
+        fix: format!(
+            "check it, then: autoshovel pki trust --dir {} {}",
+            dir.display(),
+            rejected.display()
+        ),
+    })
+}
+
 /// What `init` did.
 #[derive(Debug, Clone, Default)]
 pub struct InitReport {
