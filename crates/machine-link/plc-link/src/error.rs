@@ -152,16 +152,14 @@ pub enum LinkError {
         limit_s: f64,
     },
     /// The peer presented a certificate this side does not trust.
-    #[error("{endpoint}: the {side}'s certificate ({subject}, thumbprint {thumbprint}) is not in this side's trust list; saved to {saved}; {fix}", saved = saved.display())]
+    #[error("{endpoint}: the {side}'s certificate ({certificate}) is not in this side's trust list; saved to {saved}; {fix}", saved = saved.display())]
     Untrusted {
         /// The endpoint URL.
         endpoint: String,
-        /// Whose certificate: the PLC's or the workstation's application name.
+        /// Whose certificate: `PLC` or `workstation`.
         side: &'static str,
-        /// Its subject.
-        subject: String,
-        /// Its SHA-1 thumbprint (hex).
-        thumbprint: String,
+        /// Its subject and SHA-1 thumbprint.
+        certificate: String,
         /// Where it was saved for a person to check.
         saved: PathBuf,
         /// The command that trusts it.

@@ -230,8 +230,11 @@ pub fn check_peer(root: &Path, role: Role, der: &[u8], endpoint: &str) -> Result
             Role::Workstation => "PLC",
             Role::Plc => "workstation",
         },
-        subject: x.subject_name(),
-        thumbprint: x.thumbprint().as_hex_string(),
+        certificate: format!(
+            "{}, thumbprint {}",
+            x.subject_name(),
+            x.thumbprint().as_hex_string()
+        ),
         saved: rejected.clone(),
         fix: format!(
             "check it, then: autoshovel pki trust --dir {} {}",
