@@ -174,7 +174,7 @@ fn replay_of_the_drive_log_gives_the_drive_metrics() {
 }
 
 #[test]
-#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test --workspace --test link_loop -- --ignored --test-threads=1)"]
 fn real_time_drive_stays_within_a_centimetre_of_the_in_process_run() {
     let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Rtk), 3).unwrap();
@@ -227,7 +227,7 @@ fn quantile(xs: &mut [f64], q: f64) -> f64 {
 }
 
 #[test]
-#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test --workspace --test link_loop -- --ignored --test-threads=1)"]
 fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowledged() {
     let _one_at_a_time = real_time();
     let n = count("LINK_CUTS", 40);
@@ -323,7 +323,7 @@ fn link_cuts_stop_the_machine_within_300_ms_and_it_stays_stopped_until_acknowled
 }
 
 #[test]
-#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test --workspace --test link_loop -- --ignored --test-threads=1)"]
 fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
     let _one_at_a_time = real_time();
     let n = count("STALE_POSES", 16);
@@ -423,7 +423,7 @@ fn a_frozen_or_dropped_rtk_zeroes_the_setpoints_once_the_pose_is_300_ms_old() {
 }
 
 #[test]
-#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test -p autoshovel-plc-link --test link_loop -- --ignored --test-threads=1)"]
+#[ignore = "real time: a wall-clock margin, run alone by .ci/run's serial step (cargo test --workspace --test link_loop -- --ignored --test-threads=1)"]
 fn a_delay_fault_holds_the_plcs_replies_back_for_its_length() {
     let _one_at_a_time = real_time();
     let sc = resolve("straight", Some(Noise::Off), 1).unwrap();
