@@ -645,30 +645,7 @@ async fn run_loop(
                 ),
                 (Var::SimStep, Variant::UInt64(p.step())),
             ]);
-            let holder = p.control.holder();
-            values.extend([
-                (Var::Locked, Variant::Boolean(holder.is_some())),
-                (
-                    Var::LockingClient,
-                    Variant::String(UAString::from(
-                        holder
-                            .map(|h| format!("{} (session {})", h.caller.client, h.caller.session))
-                            .unwrap_or_default(),
-                    )),
-                ),
-                (
-                    Var::LockingUser,
-                    Variant::String(UAString::from(
-                        holder
-                            .and_then(|h| h.caller.user.clone())
-                            .unwrap_or_default(),
-                    )),
-                ),
-                (
-                    Var::RemainingLockTime,
-                    Variant::Double(p.lock_remaining_s().unwrap_or(0.0) * 1e3),
-                ),
-            ]);
+            values.extend(control_values(&p));
             let (truth, travelled) = p.truth();
             values.extend([
                 (Var::SimTrueX, Variant::Double(truth.x)),
@@ -740,6 +717,34 @@ async fn run_loop(
             }),
         );
     }
+}
+
+/// The lock's state as `Shovel.Control` publishes it (OPC 10000-100).
+fn control_values(p: &Plc) -> [(Var, Variant); 4] {
+    let holder = p.control.holder();
+    [
+        (Var::Locked, Variant::Boolean(holder.is_some())),
+        (
+            Var::LockingClient,
+            Variant::String(UAString::from(
+                holder
+                    .map(|h| format!("{} (session {})", h.caller.client, h.caller.session))
+                    .unwrap_or_default(),
+            )),
+        ),
+        (
+            Var::LockingUser,
+            Variant::String(UAString::from(
+                holder
+                    .and_then(|h| h.caller.user.clone())
+                    .unwrap_or_default(),
+            )),
+        ),
+        (
+            Var::RemainingLockTime,
+            Variant::Double(p.lock_remaining_s().unwrap_or(0.0) * 1e3),
+        ),
+    ]
 }
 
 fn log_machine(
