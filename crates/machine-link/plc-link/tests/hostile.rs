@@ -9,14 +9,12 @@
 //! beside them, python asyncua and node-opcua read anonymously, session
 //! after session, until the drive ends.
 
-use std::path::PathBuf;
 use std::sync::atomic::{AtomicBool, AtomicUsize, Ordering};
-use std::sync::OnceLock;
 use std::time::Duration;
 
 use autoshovel_plc_link::{
-    drive, pki, Clock, DriveOptions, Link, LinkError, LinkParams, PlcParams, PlcServer, Policy,
-    ServeParams, HEARTBEAT_TIMEOUT,
+    drive, pki, Clock, DriveOptions, Link, LinkError, LinkParams, PlcServer, Policy,
+    HEARTBEAT_TIMEOUT,
 };
 use autoshovel_walk_tracker::scenario::resolve;
 use autoshovel_walk_tracker::sim::Run;
@@ -24,57 +22,10 @@ use autoshovel_walk_tracker::{ControllerKind, Setup, TrackCommand};
 use tokio::io::AsyncWriteExt;
 
 mod peers;
-
-fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
-    static PKI: OnceLock<(tempfile::TempDir, PathBuf, String)> = OnceLock::new();
-    PKI.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().join("pki");
-        pki::init(&root, &[]).unwrap();
-        let pw = pki::read_password(&root.join(pki::PASSWORD_FILE)).unwrap();
-        (dir, root, pw)
-    })
-}
-
-fn rt() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap()
-}
+use peers::{operator, pki_root, rt};
 
 async fn start(setup: &Setup, clock: Clock, port: u16) -> PlcServer {
-    let (_, root, pw) = pki_root();
-    PlcServer::start(
-        PlcParams {
-            setup: setup.clone(),
-            clock,
-            heartbeat_timeout: HEARTBEAT_TIMEOUT,
-            auto: true,
-            schedule: Vec::new(),
-        },
-        ServeParams {
-            host: "127.0.0.1".into(),
-            port,
-            pki: root.clone(),
-            insecure: false,
-            users: vec![(pki::OPERATOR.into(), pw.clone())],
-        },
-    )
-    .await
-    .unwrap()
-}
-
-fn operator(endpoint: &str) -> LinkParams {
-    let (_, root, pw) = pki_root();
-    let mut p = LinkParams::new(
-        endpoint,
-        root.clone(),
-        Some((pki::OPERATOR.into(), pw.clone())),
-    );
-    p.connect_timeout = Duration::from_secs(20);
-    p
+    peers::plc_sim(setup, clock, Vec::new(), port).await
 }
 
 fn anonymous(endpoint: &str) -> LinkParams {

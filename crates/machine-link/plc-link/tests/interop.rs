@@ -11,39 +11,16 @@
 //! skipped, saying so.
 
 use std::io::{BufRead, BufReader};
-use std::path::{Path, PathBuf};
+use std::path::Path;
 use std::process::{Child, Command, Stdio};
-use std::sync::OnceLock;
 use std::time::Duration;
 
-use autoshovel_plc_link::{
-    drive, pki, Clock, DriveOptions, Link, LinkError, LinkParams, PlcParams, PlcServer,
-    ServeParams, HEARTBEAT_TIMEOUT,
-};
+use autoshovel_plc_link::{drive, Clock, DriveOptions, Link, LinkError};
 use autoshovel_walk_tracker::scenario::resolve;
 use autoshovel_walk_tracker::{ControllerKind, Noise};
 
 mod peers;
-use peers::{node, python, script};
-
-fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
-    static PKI: OnceLock<(tempfile::TempDir, PathBuf, String)> = OnceLock::new();
-    PKI.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().join("pki");
-        pki::init(&root, &[]).unwrap();
-        let pw = pki::read_password(&root.join(pki::PASSWORD_FILE)).unwrap();
-        (dir, root, pw)
-    })
-}
-
-fn rt() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap()
-}
+use peers::{node, operator as params, pki_root, python, rt, script};
 
 #[test]
 fn python_asyncua_client_browses_reads_and_writes_securely() {
@@ -51,24 +28,7 @@ fn python_asyncua_client_browses_reads_and_writes_securely() {
     let (_, root, pw) = pki_root();
     let sc = resolve("curve", Some(Noise::Rtk), 1).unwrap();
     rt().block_on(async {
-        let server = PlcServer::start(
-            PlcParams {
-                setup: sc.setup.clone(),
-                clock: Clock::Scaled(1.0),
-                heartbeat_timeout: HEARTBEAT_TIMEOUT,
-                auto: true,
-                schedule: Vec::new(),
-            },
-            ServeParams {
-                host: "127.0.0.1".into(),
-                port: 0,
-                pki: root.clone(),
-                insecure: false,
-                users: vec![(pki::OPERATOR.into(), pw.clone())],
-            },
-        )
-        .await
-        .unwrap();
+        let server = peers::plc_sim(&sc.setup, Clock::Scaled(1.0), Vec::new(), 0).await;
         let (py, endpoint, root, pw) = (py.clone(), server.endpoint(), root.clone(), pw.clone());
         let out = tokio::task::spawn_blocking(move || {
             Command::new(py)
@@ -146,24 +106,7 @@ fn node_opcua_client_reads_claims_and_is_refused_as_a_second_operator() {
     let (_, root, pw) = pki_root();
     let sc = resolve("curve", Some(Noise::Rtk), 1).unwrap();
     rt().block_on(async {
-        let server = PlcServer::start(
-            PlcParams {
-                setup: sc.setup.clone(),
-                clock: Clock::Scaled(1.0),
-                heartbeat_timeout: HEARTBEAT_TIMEOUT,
-                auto: true,
-                schedule: Vec::new(),
-            },
-            ServeParams {
-                host: "127.0.0.1".into(),
-                port: 0,
-                pki: root.clone(),
-                insecure: false,
-                users: vec![(pki::OPERATOR.into(), pw.clone())],
-            },
-        )
-        .await
-        .unwrap();
+        let server = peers::plc_sim(&sc.setup, Clock::Scaled(1.0), Vec::new(), 0).await;
         let (endpoint, root, pw) = (server.endpoint(), root.clone(), pw.clone());
         let out = tokio::task::spawn_blocking(move || {
             Command::new(node)
@@ -259,17 +202,6 @@ impl Drop for PyPlc {
         let _ = self.child.kill();
         let _ = self.child.wait();
     }
-}
-
-fn params(endpoint: &str) -> LinkParams {
-    let (_, root, pw) = pki_root();
-    let mut p = LinkParams::new(
-        endpoint,
-        root.clone(),
-        Some((pki::OPERATOR.into(), pw.clone())),
-    );
-    p.connect_timeout = Duration::from_secs(20);
-    p
 }
 
 #[test]

@@ -12,61 +12,28 @@
 //! `Plc::zeroed_at`). `LINK_CUTS` and `STALE_POSES` set how many (default
 //! 40 and 16; docs/machine-link.md gives longer runs' figures).
 
-use std::path::PathBuf;
 use std::sync::atomic::AtomicBool;
-use std::sync::{Arc, OnceLock};
+use std::sync::Arc;
 use std::time::Duration;
 
 use autoshovel_plc_link::{
-    drive, pki, Clock, DriveOptions, FaultKind, Link, LinkParams, PlcParams, PlcServer, RunLog,
-    ServeParams, HEARTBEAT_TIMEOUT,
+    drive, pki, Clock, DriveOptions, FaultKind, Link, LinkParams, PlcServer, RunLog,
 };
 use autoshovel_walk_tracker::scenario::resolve;
+
+mod peers;
 use autoshovel_walk_tracker::sim::{simulate, Run};
 use autoshovel_walk_tracker::{ControllerKind, Noise, Setup};
+use peers::rt;
 use rand::{Rng, SeedableRng};
-
-/// One PKI (two RSA keys) for the whole file.
-fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
-    static PKI: OnceLock<(tempfile::TempDir, PathBuf, String)> = OnceLock::new();
-    PKI.get_or_init(|| {
-        let dir = tempfile::tempdir().unwrap();
-        let root = dir.path().join("pki");
-        pki::init(&root, &[]).unwrap();
-        let pw = pki::read_password(&root.join(pki::PASSWORD_FILE)).unwrap();
-        (dir, root, pw)
-    })
-}
 
 async fn start(
     setup: &Setup,
     clock: Clock,
     schedule: Vec<(f64, FaultKind)>,
 ) -> (PlcServer, LinkParams) {
-    let (_, root, pw) = pki_root();
-    let server = PlcServer::start(
-        PlcParams {
-            setup: setup.clone(),
-            clock,
-            heartbeat_timeout: HEARTBEAT_TIMEOUT,
-            auto: true,
-            schedule,
-        },
-        ServeParams {
-            host: "127.0.0.1".into(),
-            port: 0,
-            pki: root.clone(),
-            insecure: false,
-            users: vec![(pki::OPERATOR.into(), pw.clone())],
-        },
-    )
-    .await
-    .unwrap();
-    let params = LinkParams::new(
-        &server.endpoint(),
-        root.clone(),
-        Some((pki::OPERATOR.into(), pw.clone())),
-    );
+    let server = peers::plc_sim(setup, clock, schedule, 0).await;
+    let params = peers::operator(&server.endpoint());
     (server, params)
 }
 
@@ -87,14 +54,6 @@ fn person() -> autoshovel_plc_link::Caller {
         user: Some(pki::OPERATOR.into()),
         client: "the test, at the machine".into(),
     }
-}
-
-fn rt() -> tokio::runtime::Runtime {
-    tokio::runtime::Builder::new_multi_thread()
-        .worker_threads(2)
-        .enable_all()
-        .build()
-        .unwrap()
 }
 
 fn over_link(setup: &Setup, clock: Clock) -> Run {

@@ -1,5 +1,6 @@
-//! The peers the link's tests run against, nobody here wrote: python
-//! asyncua (PyPI) and node-opcua (npm). `.ci/run` installs both and sets
+//! What the link's test binaries share: one PKI, the runtime, a `plc-sim`
+//! and the operator's parameters; and the peers they run against, nobody
+//! here wrote: python asyncua (PyPI) and node-opcua (npm). `.ci/run` installs both and sets
 //! `AUTOSHOVEL_PYTHON` and `AUTOSHOVEL_NODE_MODULES`; with those set, or
 //! under CI, a missing peer fails the test. Elsewhere the tests that need
 //! one are skipped, saying so.
@@ -68,4 +69,71 @@ pub fn node() -> Option<(String, PathBuf)> {
             None
         }
     }
+}
+
+/// One PKI (two RSA keys) for a whole test binary: the root and the
+/// operator's password.
+pub fn pki_root() -> &'static (tempfile::TempDir, PathBuf, String) {
+    static PKI: std::sync::OnceLock<(tempfile::TempDir, PathBuf, String)> =
+        std::sync::OnceLock::new();
+    PKI.get_or_init(|| {
+        let dir = tempfile::tempdir().unwrap();
+        let root = dir.path().join("pki");
+        autoshovel_plc_link::pki::init(&root, &[]).unwrap();
+        let pw = autoshovel_plc_link::pki::read_password(
+            &root.join(autoshovel_plc_link::pki::PASSWORD_FILE),
+        )
+        .unwrap();
+        (dir, root, pw)
+    })
+}
+
+/// A two-worker runtime, as a 2-core machine runs the link.
+pub fn rt() -> tokio::runtime::Runtime {
+    tokio::runtime::Builder::new_multi_thread()
+        .worker_threads(2)
+        .enable_all()
+        .build()
+        .unwrap()
+}
+
+/// A `plc-sim` in auto on `port` (0: any) for `setup`, with the faults of
+/// `schedule`, secured with [`pki_root`] and the operator's password.
+pub async fn plc_sim(
+    setup: &autoshovel_walk_tracker::Setup,
+    clock: autoshovel_plc_link::Clock,
+    schedule: Vec<(f64, autoshovel_plc_link::FaultKind)>,
+    port: u16,
+) -> autoshovel_plc_link::PlcServer {
+    let (_, root, pw) = pki_root();
+    autoshovel_plc_link::PlcServer::start(
+        autoshovel_plc_link::PlcParams {
+            setup: setup.clone(),
+            clock,
+            heartbeat_timeout: autoshovel_plc_link::HEARTBEAT_TIMEOUT,
+            auto: true,
+            schedule,
+        },
+        autoshovel_plc_link::ServeParams {
+            host: "127.0.0.1".into(),
+            port,
+            pki: root.clone(),
+            insecure: false,
+            users: vec![(autoshovel_plc_link::pki::OPERATOR.into(), pw.clone())],
+        },
+    )
+    .await
+    .unwrap()
+}
+
+/// The operator's link parameters for `endpoint` (20 s to connect).
+pub fn operator(endpoint: &str) -> autoshovel_plc_link::LinkParams {
+    let (_, root, pw) = pki_root();
+    let mut p = autoshovel_plc_link::LinkParams::new(
+        endpoint,
+        root.clone(),
+        Some((autoshovel_plc_link::pki::OPERATOR.into(), pw.clone())),
+    );
+    p.connect_timeout = std::time::Duration::from_secs(20);
+    p
 }

@@ -14,10 +14,7 @@ const {
   SecurityPolicy,
   AttributeIds,
 } = require("node-opcua");
-
-function pemLines(label, b64) {
-  return `-----BEGIN ${label}-----\n${b64.match(/.{1,64}/g).join("\n")}\n-----END ${label}-----\n`;
-}
+const { ownPem } = require("./pem.js");
 
 async function main() {
   const [endpoint, pki, n, stop] = process.argv.slice(2);
@@ -28,13 +25,7 @@ async function main() {
   });
   await manager.initialize();
   await manager.trustCertificate(fs.readFileSync(path.join(pki, "plc", "own", "cert.der")));
-  const cert = path.join(scratch, "cert.pem");
-  const der = fs.readFileSync(path.join(pki, "workstation", "own", "cert.der"));
-  fs.writeFileSync(cert, pemLines("CERTIFICATE", der.toString("base64")));
-  const keyText = fs.readFileSync(path.join(pki, "workstation", "private", "private.pem"), "utf8");
-  const m = keyText.match(/-----BEGIN ([A-Z ]+)-----([\s\S]*?)-----END \1-----/);
-  const key = path.join(scratch, "key.pem");
-  fs.writeFileSync(key, pemLines(m[1], m[2].replace(/\s+/g, "")), { mode: 0o600 });
+  const { cert, key } = ownPem(pki, "workstation", scratch);
   let made = 0;
   while (made < Number(n) && !fs.existsSync(stop)) {
     const c = OPCUAClient.create({

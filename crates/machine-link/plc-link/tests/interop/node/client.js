@@ -22,21 +22,9 @@ const {
   DataType,
   UserTokenType,
 } = require("node-opcua");
+const { ownPem } = require("./pem.js");
 
 const NS_URI = "urn:autoshovel:shovel-plc";
-
-// A PEM file in the standard layout (keys made before autoshovel rewrapped
-// them are on one line, which OpenSSL refuses).
-function rewrap(text) {
-  const m = text.match(/-----BEGIN ([A-Z ]+)-----([\s\S]*?)-----END \1-----/);
-  const b64 = m[2].replace(/\s+/g, "").match(/.{1,64}/g).join("\n");
-  return `-----BEGIN ${m[1]}-----\n${b64}\n-----END ${m[1]}-----\n`;
-}
-
-function pem(der) {
-  const b64 = der.toString("base64").match(/.{1,64}/g).join("\n");
-  return `-----BEGIN CERTIFICATE-----\n${b64}\n-----END CERTIFICATE-----\n`;
-}
 
 async function client(endpoint, pki, scratch) {
   const manager = new OPCUACertificateManager({
@@ -45,11 +33,7 @@ async function client(endpoint, pki, scratch) {
   });
   await manager.initialize();
   await manager.trustCertificate(fs.readFileSync(path.join(pki, "plc", "own", "cert.der")));
-  const cert = path.join(scratch, "workstation.pem");
-  fs.writeFileSync(cert, pem(fs.readFileSync(path.join(pki, "workstation", "own", "cert.der"))));
-  const key = path.join(scratch, "workstation.key");
-  const keyText = fs.readFileSync(path.join(pki, "workstation", "private", "private.pem"), "utf8");
-  fs.writeFileSync(key, rewrap(keyText), { mode: 0o600 });
+  const { cert, key } = ownPem(pki, "workstation", scratch);
   const c = OPCUAClient.create({
     applicationName: "autoshovel-workstation",
     applicationUri: "urn:autoshovel:workstation",

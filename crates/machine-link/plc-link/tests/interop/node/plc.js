@@ -25,14 +25,11 @@ const {
   DataType,
   StatusCodes,
 } = require("node-opcua");
+const { ownPem } = require("./pem.js");
 
 const NS_URI = "urn:autoshovel:shovel-plc";
 const [GAUGE, R_S, GEAR, MAX_RPM, MAX_ACC] = [1.5, 0.3, 38.0, 3000.0, 6000.0];
 const K = (2 * Math.PI * R_S) / (60 * GEAR); // m/s per rpm
-
-function pemLines(label, b64) {
-  return `-----BEGIN ${label}-----\n${b64.match(/.{1,64}/g).join("\n")}\n-----END ${label}-----\n`;
-}
 
 async function main() {
   const [port, pki, password, x0, y0, th0] = process.argv.slice(2);
@@ -43,13 +40,7 @@ async function main() {
   });
   await manager.initialize();
   await manager.trustCertificate(fs.readFileSync(path.join(pki, "workstation", "own", "cert.der")));
-  const cert = path.join(scratch, "cert.pem");
-  const der = fs.readFileSync(path.join(pki, "plc", "own", "cert.der"));
-  fs.writeFileSync(cert, pemLines("CERTIFICATE", der.toString("base64")));
-  const keyText = fs.readFileSync(path.join(pki, "plc", "private", "private.pem"), "utf8");
-  const m = keyText.match(/-----BEGIN ([A-Z ]+)-----([\s\S]*?)-----END \1-----/);
-  const key = path.join(scratch, "key.pem");
-  fs.writeFileSync(key, pemLines(m[1], m[2].replace(/\s+/g, "")), { mode: 0o600 });
+  const { cert, key } = ownPem(pki, "plc", scratch);
 
   const server = new OPCUAServer({
     port: Number(port),
