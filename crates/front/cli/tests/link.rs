@@ -65,6 +65,27 @@ fn finish(mut child: Child) -> String {
     s
 }
 
+/// Starts `drive` on the straight scenario against `endpoint`, logging to
+/// `log`, its stderr piped; the process.
+fn spawn_drive(endpoint: &str, pki: &Path, log: &Path) -> Child {
+    Command::new(bin())
+        .args([
+            "drive",
+            "--endpoint",
+            endpoint,
+            "--scenario",
+            "straight",
+            "--pki",
+        ])
+        .arg(pki)
+        .arg("--log")
+        .arg(log)
+        .stdout(Stdio::null())
+        .stderr(Stdio::piped())
+        .spawn()
+        .unwrap()
+}
+
 #[test]
 fn plc_sim_and_drive_run_the_loop_and_replay_gives_its_metrics() {
     let d = TempDir::new("link-loop");
@@ -166,22 +187,7 @@ fn killing_drive_stops_the_machine_and_it_stays_stopped_until_acknowledged() {
         &pki,
         &["--scenario", "straight", "--duration", "8", "--json"],
     );
-    let mut drive = Command::new(bin())
-        .args([
-            "drive",
-            "--endpoint",
-            &endpoint,
-            "--scenario",
-            "straight",
-            "--pki",
-        ])
-        .arg(&pki)
-        .arg("--log")
-        .arg(d.path().join("d.mcap"))
-        .stdout(Stdio::null())
-        .stderr(Stdio::null())
-        .spawn()
-        .unwrap();
+    let mut drive = spawn_drive(&endpoint, &pki, &d.path().join("d.mcap"));
     std::thread::sleep(Duration::from_millis(3000));
     drive.kill().unwrap(); // SIGKILL: no chance to say goodbye
     let _ = drive.wait();
@@ -220,22 +226,7 @@ fn sigterm_and_ctrl_c_zero_the_setpoints_and_leave_a_log_that_says_why() {
             &pki,
             &["--scenario", "straight", "--duration", "8", "--json"],
         );
-        let mut drive = Command::new(bin())
-            .args([
-                "drive",
-                "--endpoint",
-                &endpoint,
-                "--scenario",
-                "straight",
-                "--pki",
-            ])
-            .arg(&pki)
-            .arg("--log")
-            .arg(d.path().join("d.mcap"))
-            .stdout(Stdio::null())
-            .stderr(Stdio::piped())
-            .spawn()
-            .unwrap();
+        let mut drive = spawn_drive(&endpoint, &pki, &d.path().join("d.mcap"));
         std::thread::sleep(Duration::from_millis(3000));
         let ok = Command::new("kill")
             .args([signal, &drive.id().to_string()])
